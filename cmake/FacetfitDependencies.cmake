@@ -1,0 +1,10 @@
+# All third-party packages come from Debian bookworm (scripts/deps-debian.txt).
+find_package(Threads REQUIRED)
+find_package(TBB REQUIRED)
+find_package(glm REQUIRED)
+find_package(nlohmann_json 3.10 REQUIRED)
+find_package(CLI11 REQUIRED)
+find_package(GTest REQUIRED)
+if(FACETFIT_BUILD_TOOLS)
+  find_package(benchmark REQUIRED)
+endif()

@@ -1,0 +1,11 @@
+# facetfit_warnings(TARGET): the project's warning set, applied to our own targets only.
+function(facetfit_warnings target)
+  target_compile_options(${target} PRIVATE -Wall -Wextra -Wpedantic -Wshadow -Wconversion -Wno-sign-conversion)
+  if(FACETFIT_WERROR)
+    target_compile_options(${target} PRIVATE -Werror)
+  endif()
+  if(FACETFIT_SANITIZE)
+    target_compile_options(${target} PRIVATE -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer)
+    target_link_options(${target} PRIVATE -fsanitize=address,undefined)
+  endif()
+endfunction()

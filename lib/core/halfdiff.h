@@ -1,0 +1,46 @@
+// Rusinkiewicz's half/difference angles, the coordinates of MERL tables.
+//
+// h = normalize(i + o); d is i expressed in the frame of h: rotate i by -phi_h about z, then by
+// -theta_h about y. Swapping i and o maps phi_d to phi_d + pi, so a reciprocal BRDF has period pi in
+// phi_d, which is why MERL stores phi_d in [0, pi) only.
+#pragma once
+
+#include <cmath>
+#include <utility>
+
+#include "core/vec.h"
+
+namespace facetfit {
+
+struct HalfDiff {
+  double theta_h = 0, phi_h = 0, theta_d = 0, phi_d = 0;
+};
+
+inline HalfDiff to_half_diff(const Vec3& i, const Vec3& o) {
+  Vec3 h = i + o;
+  const double len = glm::length(h);
+  h = len > 1e-12 ? h / len : Vec3(0, 0, 1);
+  HalfDiff hd;
+  hd.theta_h = std::acos(clamp(h.z, -1.0, 1.0));
+  hd.phi_h = std::atan2(h.y, h.x);
+  // d = R_y(-theta_h) R_z(-phi_h) i
+  const double cp = std::cos(hd.phi_h), sp = std::sin(hd.phi_h);
+  const Vec3 t(cp * i.x + sp * i.y, -sp * i.x + cp * i.y, i.z);
+  const double ct = std::cos(hd.theta_h), st = std::sin(hd.theta_h);
+  const Vec3 d(ct * t.x - st * t.z, t.y, st * t.x + ct * t.z);
+  hd.theta_d = std::acos(clamp(d.z, -1.0, 1.0));
+  hd.phi_d = std::atan2(d.y, d.x);
+  return hd;
+}
+
+// The pair (i, o) at half/diff angles with phi_h = 0 (isotropic materials do not depend on phi_h).
+inline std::pair<Vec3, Vec3> from_half_diff(double theta_h, double theta_d, double phi_d) {
+  const Vec3 d = spherical_direction(theta_d, phi_d);
+  const double ct = std::cos(theta_h), st = std::sin(theta_h);
+  const Vec3 i(ct * d.x + st * d.z, d.y, -st * d.x + ct * d.z);  // i = R_y(theta_h) d
+  const Vec3 h(st, 0.0, ct);
+  const Vec3 o = 2.0 * glm::dot(i, h) * h - i;  // mirror of i about h
+  return {i, o};
+}
+
+}  // namespace facetfit

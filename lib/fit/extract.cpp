@@ -1,0 +1,106 @@
+#include "fit/extract.h"
+
+#include <cmath>
+#include <string>
+
+namespace facetfit {
+
+namespace {
+
+// Samples the kernel factor q(theta) on the grid nodes, piecewise linear in u between measurements and
+// extrapolated linearly in u past the last one. For masking and correlated q = f(k,k) cos(theta_k): it
+// stays finite at grazing angles where f(k,k) itself grows like 1 / cos(theta_k).
+std::vector<double> kernel_factor(const Backscatter& back, const ThetaGrid& grid, Smith smith) {
+  const bool times_cos = smith != Smith::separable;
+  const std::size_t m = back.theta.size();
+  std::vector<double> us(m), qs(m);
+  for (std::size_t t = 0; t < m; ++t) {
+    us[t] = ThetaGrid::u_of_theta(back.theta[t]);
+    qs[t] = back.value[t] * (times_cos ? std::cos(back.theta[t]) : 1.0);
+  }
+  std::vector<double> q(static_cast<std::size_t>(grid.size()));
+  std::size_t seg = 0;
+  for (int j = 0; j < grid.size(); ++j) {
+    const double u = grid.u(j);
+    while (seg + 2 < m && us[seg + 1] < u) ++seg;
+    // Past the last measurement t > 1: linear extrapolation from the last two.
+    const double t = (u - us[seg]) / (us[seg + 1] - us[seg]);
+    const double value = u <= us[0] ? qs[0] : qs[seg] + t * (qs[seg + 1] - qs[seg]);
+    q[std::size_t(j)] = std::max(0.0, value);
+  }
+  return q;
+}
+
+double dot(const double* a, const std::vector<double>& b) {
+  double s = 0.0;
+  for (std::size_t j = 0; j < b.size(); ++j) s += a[j] * b[j];
+  return s;
+}
+
+}  // namespace
+
+Extraction extract_ndf(const Backscatter& back, const Quadrature& quad, const ExtractOptions& options) {
+  Extraction out;
+  const ThetaGrid& grid = quad.grid();
+  const int n = grid.size();
+  out.ndf.grid = grid;
+  out.ndf.ndf.assign(std::size_t(n), 0.0);
+  out.ndf.sigma.assign(std::size_t(n), 0.0);
+  if (back.theta.size() < 2) {
+    out.problem = "fewer than two back-scattering measurements";
+    return out;
+  }
+  const std::vector<double> q = kernel_factor(back, grid, options.smith);
+  const std::vector<double>& area = quad.projected_area();
+
+  // Normalizes y so that its projected area is one; returns that area (the eigenvalue estimate).
+  const auto normalize = [&](std::vector<double>& y) {
+    const double s = dot(area.data(), y);
+    if (!(s > 0.0) || !std::isfinite(s)) return 0.0;
+    for (double& v : y) v /= s;
+    return s;
+  };
+
+  // Start from D proportional to f(k,k) cos^2(theta_k), the answer for sigma(k) = cos(theta_k).
+  std::vector<double>& D = out.ndf.ndf;
+  for (int k = 0; k < n; ++k) D[std::size_t(k)] = q[std::size_t(k)] * std::cos(grid.theta(k));
+  if (normalize(D) == 0.0) {
+    out.problem = "no back-scattered signal (all-zero or missing measurements)";
+    return out;
+  }
+
+  std::vector<double> y(static_cast<std::size_t>(n));
+  for (out.iterations = 1; out.iterations <= options.max_iterations; ++out.iterations) {
+    for (int k = 0; k < n; ++k) {
+      const std::size_t kk = std::size_t(k);
+      switch (options.smith) {
+        // The spline can dip below zero between nodes; the integrals of a peak never do, but clip anyway.
+        case Smith::masking: y[kk] = 4.0 * q[kk] * std::max(0.0, dot(quad.positive_row(k), D)); break;
+        case Smith::correlated: y[kk] = 4.0 * q[kk] * std::max(0.0, dot(quad.absolute_row(k), D)); break;
+        case Smith::separable: {
+          const double sigma = std::max(0.0, dot(quad.positive_row(k), D));
+          y[kk] = 4.0 * q[kk] * sigma * sigma;
+          break;
+        }
+      }
+    }
+    out.eigenvalue = normalize(y);
+    if (out.eigenvalue == 0.0) {
+      out.problem = "the back-scattering operator maps the distribution to zero";
+      return out;
+    }
+    double change = 0.0;
+    for (int k = 0; k < n; ++k) change += area[std::size_t(k)] * std::abs(y[std::size_t(k)] - D[std::size_t(k)]);
+    D.swap(y);
+    out.residual = change;
+    if (change <= options.tolerance) {
+      out.converged = true;
+      break;
+    }
+  }
+  out.iterations = std::min(out.iterations, options.max_iterations);
+  for (int k = 0; k < n; ++k) out.ndf.sigma[std::size_t(k)] = dot(quad.positive_row(k), D);
+  return out;
+}
+
+}  // namespace facetfit

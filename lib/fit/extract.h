@@ -1,0 +1,45 @@
+// Extraction of the NDF by power iteration (Dupuy et al. 2015), consistent with a chosen Smith model.
+//
+// Back-scattering (i = o = k, so h = k and theta_d = 0) of a microfacet BRDF gives
+//   f(k, k) = F0 D(k) G2(k, k) / (4 cos^2 theta_k).
+// With G1(k) = cos theta_k / sigma(k), each Smith model turns this into an equation for D alone:
+//   masking     G2(k,k) = G1(k):          F0 D(k) = 4 cos theta_k f(k,k) integral max(0, k.h) D(h) dw_h
+//   correlated  G2(k,k) = 1/(1 + 2 Lambda): F0 D(k) = 4 cos theta_k f(k,k) integral |k.h| D(h) dw_h
+//   separable   G2(k,k) = G1(k)^2:        F0 D(k) = 4 f(k,k) sigma(k)^2
+// The first two are linear eigenproblems with non-negative kernels: D is the dominant eigenvector
+// (Perron-Frobenius) and F0 its eigenvalue. The third is a non-linear fixed point, homogeneous of degree
+// two, solved by the same normalized iteration. Derivations: docs/extraction.md.
+#pragma once
+
+#include <vector>
+
+#include "fit/quadrature.h"
+#include "fit/tabulated_ndf.h"
+#include "model/smith.h"
+
+namespace facetfit {
+
+// f(k, k) measured at polar angles theta (increasing, any spacing), e.g. at MERL's theta_h bins.
+struct Backscatter {
+  std::vector<double> theta;
+  std::vector<double> value;
+};
+
+struct ExtractOptions {
+  Smith smith = Smith::correlated;
+  double tolerance = 1e-10;  // on the relative L1 change of D between two iterations
+  int max_iterations = 1000;
+};
+
+struct Extraction {
+  TabulatedNdf ndf;
+  double eigenvalue = 0.0;  // the back-scattering estimate of F0 (luminance)
+  int iterations = 0;
+  double residual = 0.0;    // relative L1 change of D in the last iteration
+  bool converged = false;
+  std::string problem;      // empty when D is meaningful; otherwise why not
+};
+
+Extraction extract_ndf(const Backscatter& backscatter, const Quadrature& quadrature, const ExtractOptions& options);
+
+}  // namespace facetfit

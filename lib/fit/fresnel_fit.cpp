@@ -1,0 +1,130 @@
+#include "fit/fresnel_fit.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_reduce.h>
+
+#include <cmath>
+
+namespace facetfit {
+
+Rgb FresnelCurve::eval(double theta_d) const {
+  const double x = clamp(theta_d / (0.5 * kPi) * kSize, 0.0, double(kSize - 1));
+  const int j = std::min(int(x), kSize - 2);
+  const double t = x - j;
+  return value[std::size_t(j)] * (1.0 - t) + value[std::size_t(j) + 1] * t;
+}
+
+namespace {
+
+constexpr int kH = MerlTable::kThetaH, kD = MerlTable::kThetaD, kP = MerlTable::kPhiD;
+
+struct Sums {
+  std::array<std::array<double, 3>, kD> measured{};
+  std::array<std::array<double, 3>, kD> model{};
+  std::array<std::array<std::int64_t, 3>, kD> count{};
+
+  void join(const Sums& o) {
+    for (int j = 0; j < kD; ++j)
+      for (int c = 0; c < 3; ++c) {
+        measured[j][c] += o.measured[j][c];
+        model[j][c] += o.model[j][c];
+        count[j][c] += o.count[j][c];
+      }
+  }
+};
+
+}  // namespace
+
+FresnelCurve fit_fresnel(const MerlTable& table, const TabulatedNdf& ndf, Smith smith, std::string* problem) {
+  // Everything that depends on one axis only is computed once.
+  std::array<double, kH> d_h{}, cos_h{}, sin_h{};
+  for (int i = 0; i < kH; ++i) {
+    d_h[i] = ndf.D(MerlTable::theta_h(i));
+    cos_h[i] = std::cos(MerlTable::theta_h(i));
+    sin_h[i] = std::sin(MerlTable::theta_h(i));
+  }
+  std::array<double, kD> cos_d{}, sin_d{};
+  for (int j = 0; j < kD; ++j) {
+    cos_d[j] = std::cos(MerlTable::theta_d(j));
+    sin_d[j] = std::sin(MerlTable::theta_d(j));
+  }
+  std::array<double, kP / 2 + 1> cos_p{};
+  for (int k = 0; k <= kP / 2; ++k) cos_p[k] = std::cos(MerlTable::phi_d(k));
+  const G1Table g1(ndf);
+  const float* channel[3] = {table.channel(0), table.channel(1), table.channel(2)};
+
+  const Sums sums = tbb::parallel_reduce(
+      tbb::blocked_range<int>(0, kH), Sums{},
+      [&](const tbb::blocked_range<int>& rows, Sums acc) {
+        for (int i = rows.begin(); i < rows.end(); ++i) {
+          for (int j = 0; j < kD; ++j) {
+            // cos(theta_i) = A - B cos(phi_d), cos(theta_o) = A + B cos(phi_d) (docs/conventions.md).
+            const double a = cos_h[i] * cos_d[j], b = sin_h[i] * sin_d[j];
+            const std::size_t row = MerlTable::index(i, j, 0);
+            auto& measured = acc.measured[j];
+            auto& model = acc.model[j];
+            auto& count = acc.count[j];
+            // phi_d and pi - phi_d swap i and o: the model is the same for both bins.
+            for (int k = 0; k <= kP / 2; ++k) {
+              const double mu_i = a - b * cos_p[k], mu_o = a + b * cos_p[k];
+              if (mu_i <= 0.0 || mu_o <= 0.0) continue;
+              const double f1 = d_h[i] * smith_g2_from_g1(smith, g1(mu_i), g1(mu_o)) / (4.0 * mu_i * mu_o);
+              const int mirror = kP - k;
+              for (int c = 0; c < 3; ++c) {
+                const float v = channel[c][row + std::size_t(k)];
+                if (v >= 0.0f) {
+                  measured[c] += v;
+                  model[c] += f1;
+                  ++count[c];
+                }
+                if (k == 0 || mirror == k) continue;
+                const float w = channel[c][row + std::size_t(mirror)];
+                if (w >= 0.0f) {
+                  measured[c] += w;
+                  model[c] += f1;
+                  ++count[c];
+                }
+              }
+            }
+          }
+        }
+        return acc;
+      },
+      [](Sums x, const Sums& y) {
+        x.join(y);
+        return x;
+      });
+
+  FresnelCurve curve;
+  for (int c = 0; c < 3; ++c) {
+    // Entries without a usable measurement take the nearest usable ones, linearly in theta_d.
+    std::vector<int> usable;
+    for (int j = 0; j < kD; ++j) {
+      curve.count[std::size_t(j)][c] = sums.count[j][c];
+      if (sums.model[j][c] > 0.0 && sums.count[j][c] > 0) {
+        usable.push_back(j);
+        curve.value[std::size_t(j)][c] = sums.measured[j][c] / sums.model[j][c];
+      }
+    }
+    if (usable.empty()) {
+      if (problem) *problem = "no measurement where the microfacet model is nonzero (all missing?)";
+      return curve;
+    }
+    std::size_t u = 0;
+    for (int j = 0; j < kD; ++j) {
+      while (u + 1 < usable.size() && usable[u + 1] <= j) ++u;
+      const int j0 = usable[u];
+      if (j0 == j) continue;
+      if (j < j0 || u + 1 == usable.size()) {
+        curve.value[std::size_t(j)][c] = curve.value[std::size_t(j0)][c];
+      } else {
+        const int j1 = usable[u + 1];
+        const double t = double(j - j0) / (j1 - j0);
+        curve.value[std::size_t(j)][c] = (1.0 - t) * curve.value[std::size_t(j0)][c] + t * curve.value[std::size_t(j1)][c];
+      }
+    }
+  }
+  return curve;
+}
+
+}  // namespace facetfit

@@ -1,0 +1,55 @@
+#include "io/atomic_file.h"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <random>
+
+#include "core/error.h"
+
+namespace facetfit {
+
+namespace fs = std::filesystem;
+
+AtomicFile::AtomicFile(std::string path) : path_(std::move(path)) {
+  const fs::path target(path_);
+  fs::path dir = target.parent_path();
+  if (dir.empty()) dir = ".";
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec)) fail(path_, "cannot write: folder " + dir.string() + " does not exist");
+  std::random_device rd;
+  const unsigned tag = rd();
+  char suffix[64];
+  std::snprintf(suffix, sizeof suffix, ".tmp-%ld-%08x", static_cast<long>(::getpid()), tag);
+  temp_ = (dir / ("." + target.stem().string() + suffix + target.extension().string())).string();
+}
+
+AtomicFile::~AtomicFile() {
+  if (!committed_) ::unlink(temp_.c_str());
+}
+
+void AtomicFile::commit() {
+  // fsync before rename so that a crash cannot leave a renamed but empty file.
+  const int fd = ::open(temp_.c_str(), O_RDONLY);
+  if (fd < 0) fail(path_, std::string("cannot write: ") + std::strerror(errno));
+  ::fsync(fd);
+  ::close(fd);
+  if (std::rename(temp_.c_str(), path_.c_str()) != 0)
+    fail(path_, std::string("cannot write: ") + std::strerror(errno));
+  committed_ = true;
+}
+
+void write_file_atomic(const std::string& path, const std::string& content) {
+  AtomicFile out(path);
+  std::FILE* f = std::fopen(out.temp_path().c_str(), "wb");
+  if (!f) fail(path, std::string("cannot write: ") + std::strerror(errno));
+  const bool ok = std::fwrite(content.data(), 1, content.size(), f) == content.size();
+  if (std::fclose(f) != 0 || !ok) fail(path, "cannot write: short write (disk full?)");
+  out.commit();
+}
+
+}  // namespace facetfit

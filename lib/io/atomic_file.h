@@ -1,0 +1,33 @@
+// Nothing is lost: every output is written under a temporary name beside its target and renamed into
+// place only when complete. A run that stops early (an error, a kill) never leaves a half-written
+// file under the target's name.
+#pragma once
+
+#include <string>
+
+namespace facetfit {
+
+class AtomicFile {
+ public:
+  // Picks a hidden temporary name in the target's folder, keeping its extension (image writers choose
+  // the format by extension). Throws Error naming `path` when the folder does not exist.
+  explicit AtomicFile(std::string path);
+  ~AtomicFile();  // removes the temporary unless committed
+  AtomicFile(const AtomicFile&) = delete;
+  AtomicFile& operator=(const AtomicFile&) = delete;
+
+  const std::string& path() const { return path_; }
+  const std::string& temp_path() const { return temp_; }
+  // Flushes the temporary to disk and renames it over the target. Throws Error naming the target.
+  void commit();
+
+ private:
+  std::string path_;
+  std::string temp_;
+  bool committed_ = false;
+};
+
+// Writes `content` to `path` through an AtomicFile.
+void write_file_atomic(const std::string& path, const std::string& content);
+
+}  // namespace facetfit

@@ -1,0 +1,209 @@
+#include "io/merl.h"
+
+#include <tbb/parallel_for.h>
+
+#include <cerrno>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <memory>
+
+#include "core/error.h"
+#include "core/halfdiff.h"
+#include "io/atomic_file.h"
+
+namespace facetfit {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr float kMissing = -1.0f;
+
+struct FileCloser {
+  void operator()(std::FILE* f) const { std::fclose(f); }
+};
+using File = std::unique_ptr<std::FILE, FileCloser>;
+
+// Continuous bin coordinates of a direction pair: bin i of each axis sits at coordinate i.
+struct BinCoords {
+  double h, d, p;
+};
+
+BinCoords bin_coords(const Vec3& i, const Vec3& o) {
+  const HalfDiff hd = to_half_diff(i, o);
+  double phi_d = hd.phi_d;
+  if (phi_d < 0.0) phi_d += kPi;  // reciprocity: period pi
+  if (phi_d >= kPi) phi_d -= kPi;
+  return {std::sqrt(std::max(0.0, hd.theta_h) / (0.5 * kPi)) * MerlTable::kThetaH,
+          hd.theta_d / (0.5 * kPi) * MerlTable::kThetaD, phi_d / kPi * MerlTable::kPhiD};
+}
+
+const char* channel_name(int c) { return c == 0 ? "red" : (c == 1 ? "green" : "blue"); }
+
+}  // namespace
+
+MerlTable::MerlTable() : data_(3 * kBins, kMissing) {}
+
+double MerlTable::theta_h(int i) {
+  const double u = double(i) / kThetaH;
+  return u * u * 0.5 * kPi;
+}
+double MerlTable::theta_d(int j) { return double(j) / kThetaD * 0.5 * kPi; }
+double MerlTable::phi_d(int k) { return double(k) / kPhiD * kPi; }
+
+void MerlTable::set(int i, int j, int k, const Rgb& v) {
+  const std::size_t n = index(i, j, k);
+  for (int c = 0; c < 3; ++c) channel(c)[n] = float(v[c]);
+}
+
+void MerlTable::set_missing(int i, int j, int k) {
+  const std::size_t n = index(i, j, k);
+  for (int c = 0; c < 3; ++c) channel(c)[n] = kMissing;
+}
+
+MerlTable MerlTable::read(const std::string& path) {
+  std::error_code ec;
+  const auto status = fs::status(path, ec);
+  if (!fs::exists(status)) fail(path, "cannot open: no such file");
+  if (fs::is_directory(status)) fail(path, "is a folder, not a MERL .binary file");
+  File file(std::fopen(path.c_str(), "rb"));
+  if (!file) fail(path, std::string("cannot open: ") + std::strerror(errno));
+
+  const auto size = fs::file_size(path, ec);
+  if (ec) fail(path, "cannot read its size: " + ec.message());
+  if (size == 0) fail(path, "file is empty");
+  std::int32_t dims[3] = {0, 0, 0};
+  if (size < sizeof dims || std::fread(dims, sizeof(std::int32_t), 3, file.get()) != 3)
+    fail(path, "truncated header (" + std::to_string(size) + " bytes; a MERL file starts with three 32-bit dimensions)");
+  // Check the dimensions before trusting them with any allocation.
+  if (dims[0] != kThetaH || dims[1] != kThetaD || dims[2] != kPhiD)
+    fail(path, "header claims " + std::to_string(dims[0]) + " x " + std::to_string(dims[1]) + " x " +
+                   std::to_string(dims[2]) + " bins; a MERL isotropic table is 90 x 90 x 180");
+  if (size != kFileBytes)
+    fail(path, "size is " + std::to_string(size) + " bytes, expected " + std::to_string(kFileBytes) +
+                   (size < kFileBytes ? " (truncated)" : " (trailing data)"));
+
+  MerlTable table;
+  // Stream in chunks: the 35 MB of doubles never sit in memory at once.
+  constexpr std::size_t kChunk = 1 << 15;
+  std::vector<double> buf(kChunk);
+  for (int c = 0; c < 3; ++c) {
+    float* out = table.channel(c);
+    for (std::size_t done = 0; done < kBins;) {
+      const std::size_t n = std::min(kChunk, kBins - done);
+      if (std::fread(buf.data(), sizeof(double), n, file.get()) != n) fail(path, "read error (file changed while reading?)");
+      const double scale = kScale[c];
+      bool finite = true;
+      for (std::size_t t = 0; t < n; ++t) {
+        finite &= std::isfinite(buf[t]);
+        out[done + t] = buf[t] < 0.0 ? kMissing : float(buf[t] * scale);
+      }
+      if (!finite) {
+        for (std::size_t t = 0; t < n; ++t) {
+          if (std::isfinite(buf[t])) continue;
+          const std::size_t bin = done + t;
+          const std::size_t offset = sizeof dims + (std::size_t(c) * kBins + bin) * sizeof(double);
+          const int k = int(bin % kPhiD), j = int(bin / kPhiD % kThetaD), i = int(bin / (kPhiD * kThetaD));
+          fail(path, std::string(std::isnan(buf[t]) ? "NaN" : "Inf") + " at byte offset " + std::to_string(offset) +
+                         " (" + channel_name(c) + " channel, bin theta_h " + std::to_string(i) + ", theta_d " +
+                         std::to_string(j) + ", phi_d " + std::to_string(k) + ")");
+        }
+      }
+      done += n;
+    }
+  }
+  return table;
+}
+
+MerlTable MerlTable::tabulate(const Brdf& brdf) {
+  MerlTable table;
+  tbb::parallel_for(0, kThetaH, [&](int i) {
+    for (int j = 0; j < kThetaD; ++j) {
+      for (int k = 0; k < kPhiD; ++k) {
+        const auto [wi, wo] = from_half_diff(theta_h(i), theta_d(j), phi_d(k));
+        if (wi.z <= 0.0 || wo.z <= 0.0) continue;  // stays missing: no measurement below the horizon
+        const auto f = brdf.eval(wi, wo);
+        if (!f || !std::isfinite(f->r) || !std::isfinite(f->g) || !std::isfinite(f->b)) continue;
+        table.set(i, j, k, glm::max(*f, Rgb(0.0)));
+      }
+    }
+  });
+  return table;
+}
+
+void MerlTable::write(const std::string& path) const {
+  AtomicFile out(path);
+  File file(std::fopen(out.temp_path().c_str(), "wb"));
+  if (!file) fail(path, std::string("cannot write: ") + std::strerror(errno));
+  const std::int32_t dims[3] = {kThetaH, kThetaD, kPhiD};
+  bool ok = std::fwrite(dims, sizeof(std::int32_t), 3, file.get()) == 3;
+  std::vector<double> buf(kPhiD * kThetaD);
+  for (int c = 0; c < 3 && ok; ++c) {
+    const float* in = channel(c);
+    for (std::size_t done = 0; done < kBins && ok; done += buf.size()) {
+      for (std::size_t t = 0; t < buf.size(); ++t) {
+        const float v = in[done + t];
+        buf[t] = v < 0.0f ? -1.0 : double(v) / kScale[c];
+      }
+      ok = std::fwrite(buf.data(), sizeof(double), buf.size(), file.get()) == buf.size();
+    }
+  }
+  if (std::fclose(file.release()) != 0 || !ok) fail(path, "cannot write: short write (disk full?)");
+  out.commit();
+}
+
+std::optional<Rgb> MerlTable::eval(const Vec3& i, const Vec3& o) const {
+  if (i.z <= 0.0 || o.z <= 0.0) return Rgb(0.0);
+  const BinCoords x = bin_coords(i, o);
+  return lookup_ == Lookup::nearest ? eval_nearest(x.h, x.d, x.p) : eval_linear(x.h, x.d, x.p);
+}
+
+std::optional<Rgb> MerlTable::eval_nearest(double x_h, double x_d, double x_p) const {
+  const int i = std::min(int(x_h), kThetaH - 1);
+  const int j = std::min(int(x_d), kThetaD - 1);
+  const int k = std::min(int(x_p), kPhiD - 1);
+  const std::size_t n = index(i, j, k);
+  Rgb v;
+  for (int c = 0; c < 3; ++c) {
+    if (channel(c)[n] < 0.0f) return std::nullopt;
+    v[c] = channel(c)[n];
+  }
+  return v;
+}
+
+std::optional<Rgb> MerlTable::eval_linear(double x_h, double x_d, double x_p) const {
+  // Weights of the two neighbours along one axis; theta axes clamp at their last bin.
+  struct Axis {
+    int i0, i1;
+    double t;
+  };
+  const auto clamped = [](double x, int res) {
+    const int i0 = std::min(int(x), res - 1);
+    return i0 >= res - 1 ? Axis{res - 1, res - 1, 0.0} : Axis{i0, i0 + 1, x - i0};
+  };
+  const Axis ah = clamped(x_h, kThetaH), ad = clamped(x_d, kThetaD);
+  const int p0 = std::min(int(x_p), kPhiD - 1);
+  const Axis ap{p0, (p0 + 1) % kPhiD, x_p - p0};
+
+  // Missing neighbours drop out and the remaining weights are renormalized, per channel.
+  Rgb sum(0.0), weight(0.0);
+  for (int corner = 0; corner < 8; ++corner) {
+    const double w = ((corner & 1) ? ah.t : 1.0 - ah.t) * ((corner & 2) ? ad.t : 1.0 - ad.t) *
+                     ((corner & 4) ? ap.t : 1.0 - ap.t);
+    if (w <= 0.0) continue;
+    const std::size_t n = index((corner & 1) ? ah.i1 : ah.i0, (corner & 2) ? ad.i1 : ad.i0, (corner & 4) ? ap.i1 : ap.i0);
+    for (int c = 0; c < 3; ++c) {
+      const float v = channel(c)[n];
+      if (v < 0.0f) continue;
+      sum[c] += w * v;
+      weight[c] += w;
+    }
+  }
+  if (weight.r <= 0.0 || weight.g <= 0.0 || weight.b <= 0.0) return std::nullopt;
+  return sum / weight;
+}
+
+}  // namespace facetfit

@@ -1,0 +1,66 @@
+// MERL isotropic BRDF tables (Matusik et al. 2003): 90 x 90 x 180 bins over (theta_h, theta_d, phi_d).
+//
+// Bin positions (docs/conventions.md): theta_h bin i sits at theta_h = (i / 90)^2 pi/2, theta_d bin j
+// at j/90 pi/2, phi_d bin k at k/180 pi, the inverse of the index maps of MERL's reference reader
+// (which truncates). Values are held in 1/sr, already multiplied by MERL's channel scales. A negative
+// value is a missing measurement: no computation reads it as zero.
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "core/brdf.h"
+
+namespace facetfit {
+
+class MerlTable final : public Brdf {
+ public:
+  static constexpr int kThetaH = 90;
+  static constexpr int kThetaD = 90;
+  static constexpr int kPhiD = 180;
+  static constexpr std::size_t kBins = std::size_t(kThetaH) * kThetaD * kPhiD;
+  static constexpr std::size_t kFileBytes = 3 * sizeof(int) + 3 * kBins * sizeof(double);
+  // MERL's reference reader multiplies the stored doubles by these.
+  static constexpr double kScale[3] = {1.0 / 1500.0, 1.15 / 1500.0, 1.66 / 1500.0};
+
+  // How eval() reads between bins. The fit never calls eval(): it reads the bins themselves.
+  enum class Lookup {
+    nearest,  // the bin containing the point, as MERL's reference reader does
+    linear,   // trilinear in (sqrt(theta_h), theta_d, phi_d) bin coordinates, periodic in phi_d
+  };
+
+  MerlTable();  // every bin missing
+
+  // Throws Error("<path>: <problem>") for anything that is not a complete, finite MERL table.
+  static MerlTable read(const std::string& path);
+  // Tabulates any BRDF at the bin positions; pairs below the horizon become missing bins.
+  static MerlTable tabulate(const Brdf& brdf);
+  // Writes MERL layout through a temporary file; missing bins are written as -1.
+  void write(const std::string& path) const;
+
+  std::optional<Rgb> eval(const Vec3& i, const Vec3& o) const override;
+  Lookup lookup() const { return lookup_; }
+  void set_lookup(Lookup lookup) { lookup_ = lookup; }
+
+  static double theta_h(int i);
+  static double theta_d(int j);
+  static double phi_d(int k);
+  static std::size_t index(int i, int j, int k) { return std::size_t(k) + kPhiD * (std::size_t(j) + kThetaD * std::size_t(i)); }
+
+  // Channel c (0 red, 1 green, 2 blue) as kBins contiguous values in index() order.
+  const float* channel(int c) const { return data_.data() + std::size_t(c) * kBins; }
+  float* channel(int c) { return data_.data() + std::size_t(c) * kBins; }
+  float value(int c, int i, int j, int k) const { return channel(c)[index(i, j, k)]; }
+  void set(int i, int j, int k, const Rgb& v);
+  void set_missing(int i, int j, int k);
+
+ private:
+  std::optional<Rgb> eval_nearest(double x_h, double x_d, double x_p) const;
+  std::optional<Rgb> eval_linear(double x_h, double x_d, double x_p) const;
+
+  std::vector<float> data_;  // 3 * kBins, channel-planar as in the file
+  Lookup lookup_ = Lookup::linear;
+};
+
+}  // namespace facetfit

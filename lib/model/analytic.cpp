@@ -1,0 +1,34 @@
+#include "model/analytic.h"
+
+namespace facetfit {
+
+std::optional<Rgb> MicrofacetBrdf::eval(const Vec3& i, const Vec3& o) const {
+  if (i.z <= 0.0 || o.z <= 0.0) return Rgb(0.0);
+  const Vec3 h = glm::normalize(i + o);
+  const double g2 = smith_g2(smith_, ndf_.lambda(i), ndf_.lambda(o));
+  const double scalar = ndf_.D(h) * g2 / (4.0 * i.z * o.z);
+  return fresnel_.eval(glm::dot(i, h)) * scalar;
+}
+
+std::optional<Rgb> LambertBrdf::eval(const Vec3& i, const Vec3& o) const {
+  if (i.z <= 0.0 || o.z <= 0.0) return Rgb(0.0);
+  return albedo_ * kInvPi;
+}
+
+std::optional<Rgb> SumBrdf::eval(const Vec3& i, const Vec3& o) const {
+  Rgb sum(0.0);
+  for (const auto& lobe : lobes_) {
+    const auto f = lobe->eval(i, o);
+    if (!f) return std::nullopt;
+    sum += *f;
+  }
+  return sum;
+}
+
+std::optional<Rgb> ScaledBrdf::eval(const Vec3& i, const Vec3& o) const {
+  const auto f = base_->eval(i, o);
+  if (!f) return std::nullopt;
+  return *f * scale_;
+}
+
+}  // namespace facetfit

@@ -1,0 +1,60 @@
+// Analytic BRDFs: the ground truth facetfit's accuracy is measured against.
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "core/brdf.h"
+#include "model/fresnel.h"
+#include "model/ndf.h"
+#include "model/smith.h"
+
+namespace facetfit {
+
+// f(i, o) = F(i.h) D(h) G2(i, o) / (4 cos(theta_i) cos(theta_o)).
+class MicrofacetBrdf final : public Brdf {
+ public:
+  MicrofacetBrdf(Ndf ndf, Smith smith, Fresnel fresnel) : ndf_(ndf), smith_(smith), fresnel_(fresnel) {}
+  std::optional<Rgb> eval(const Vec3& i, const Vec3& o) const override;
+
+  const Ndf& ndf() const { return ndf_; }
+  Smith smith() const { return smith_; }
+  const Fresnel& fresnel() const { return fresnel_; }
+
+ private:
+  Ndf ndf_;
+  Smith smith_;
+  Fresnel fresnel_;
+};
+
+class LambertBrdf final : public Brdf {
+ public:
+  explicit LambertBrdf(const Rgb& albedo) : albedo_(albedo) {}
+  std::optional<Rgb> eval(const Vec3& i, const Vec3& o) const override;
+
+ private:
+  Rgb albedo_;
+};
+
+// A layered look without the layering: the plain sum of its lobes.
+class SumBrdf final : public Brdf {
+ public:
+  explicit SumBrdf(std::vector<std::shared_ptr<const Brdf>> lobes) : lobes_(std::move(lobes)) {}
+  std::optional<Rgb> eval(const Vec3& i, const Vec3& o) const override;
+
+ private:
+  std::vector<std::shared_ptr<const Brdf>> lobes_;
+};
+
+// Scales another BRDF per channel (a coloured coat, a dimmer measurement).
+class ScaledBrdf final : public Brdf {
+ public:
+  ScaledBrdf(std::shared_ptr<const Brdf> base, const Rgb& scale) : base_(std::move(base)), scale_(scale) {}
+  std::optional<Rgb> eval(const Vec3& i, const Vec3& o) const override;
+
+ private:
+  std::shared_ptr<const Brdf> base_;
+  Rgb scale_;
+};
+
+}  // namespace facetfit

@@ -1,0 +1,68 @@
+#include "model/fresnel.h"
+
+#include <cmath>
+#include <complex>
+
+namespace facetfit {
+
+Rgb fresnel_schlick(const Rgb& f0, double cos_d) {
+  const double m = clamp(1.0 - cos_d, 0.0, 1.0);
+  const double m5 = (m * m) * (m * m) * m;
+  return f0 + (Rgb(1.0) - f0) * m5;
+}
+
+namespace {
+
+// Unpolarized reflectance of a conductor, from the complex Snell law (pbrt-v4's FrComplex).
+double conductor_channel(double eta, double k, double cos_i) {
+  using C = std::complex<double>;
+  cos_i = clamp(cos_i, 0.0, 1.0);
+  const C n(eta, k);
+  const double sin2_i = 1.0 - cos_i * cos_i;
+  const C sin2_t = sin2_i / (n * n);
+  const C cos_t = std::sqrt(C(1.0) - sin2_t);
+  const C r_parl = (n * cos_i - cos_t) / (n * cos_i + cos_t);
+  const C r_perp = (cos_i - n * cos_t) / (cos_i + n * cos_t);
+  return 0.5 * (std::norm(r_parl) + std::norm(r_perp));
+}
+
+}  // namespace
+
+Rgb fresnel_conductor(const Rgb& eta, const Rgb& k, double cos_d) {
+  return {conductor_channel(eta.r, k.r, cos_d), conductor_channel(eta.g, k.g, cos_d),
+          conductor_channel(eta.b, k.b, cos_d)};
+}
+
+double fresnel_dielectric(double eta, double cos_d) {
+  cos_d = clamp(cos_d, 0.0, 1.0);
+  const double sin2_t = (1.0 - cos_d * cos_d) / (eta * eta);
+  if (sin2_t >= 1.0) return 1.0;
+  const double cos_t = std::sqrt(1.0 - sin2_t);
+  const double r_parl = (eta * cos_d - cos_t) / (eta * cos_d + cos_t);
+  const double r_perp = (cos_d - eta * cos_t) / (cos_d + eta * cos_t);
+  return 0.5 * (r_parl * r_parl + r_perp * r_perp);
+}
+
+Rgb fresnel_f82_tint(const Rgb& f0, const Rgb& f82, double cos_d) {
+  // F(mu) = Schlick(f0, mu) - a mu (1 - mu)^6, with a chosen so that F(1/7) = f82.
+  constexpr double mu82 = 1.0 / 7.0;
+  const double m82 = 1.0 - mu82;
+  const Rgb schlick82 = fresnel_schlick(f0, mu82);
+  const double basis82 = mu82 * std::pow(m82, 6.0);
+  const Rgb a = (schlick82 - f82) / basis82;
+  const double mu = clamp(cos_d, 0.0, 1.0);
+  const Rgb f = fresnel_schlick(f0, mu) - a * (mu * std::pow(1.0 - mu, 6.0));
+  return glm::max(f, Rgb(0.0));
+}
+
+Rgb Fresnel::eval(double cos_d) const {
+  switch (kind) {
+    case Kind::one: return Rgb(1.0);
+    case Kind::schlick: return fresnel_schlick(f0, cos_d);
+    case Kind::conductor: return fresnel_conductor(eta, k, cos_d);
+    case Kind::dielectric: return Rgb(fresnel_dielectric(eta.x, cos_d));
+  }
+  return Rgb(1.0);
+}
+
+}  // namespace facetfit

@@ -1,0 +1,61 @@
+// Smith masking-shadowing: the three ways facetfit couples masking G1 and shadowing into G2.
+//
+// All three are written through Smith's Lambda, with G1(k) = 1 / (1 + Lambda(k)) = cos(theta_k) / sigma(k).
+#pragma once
+
+#include <algorithm>
+#include <optional>
+#include <string>
+
+namespace facetfit {
+
+enum class Smith {
+  // G2(i, o) = 1 / (1 + max(Lambda_i, Lambda_o)) = min(G1(i), G1(o)): fully direction-correlated.
+  // It is the Smith form with G2(k, k) = G1(k), the back-scattering assumption of Dupuy et al. 2015.
+  masking,
+  // Height-correlated: G2 = 1 / (1 + Lambda_i + Lambda_o). pbrt-v4 and Cycles render with it.
+  correlated,
+  // Uncorrelated: G2 = G1(i) G1(o).
+  separable,
+};
+
+inline double smith_g2(Smith smith, double lambda_i, double lambda_o) {
+  switch (smith) {
+    case Smith::masking: return 1.0 / (1.0 + std::max(lambda_i, lambda_o));
+    case Smith::correlated: return 1.0 / (1.0 + lambda_i + lambda_o);
+    case Smith::separable: return 1.0 / ((1.0 + lambda_i) * (1.0 + lambda_o));
+  }
+  return 0.0;
+}
+
+// The same G2 from the two G1 values (G1 in [0, 1]; 0 at the horizon), without dividing by zero.
+inline double smith_g2_from_g1(Smith smith, double g1_i, double g1_o) {
+  switch (smith) {
+    case Smith::masking: return std::min(g1_i, g1_o);
+    case Smith::correlated: {
+      // 1 / (1/G1i + 1/G1o - 1) rewritten so that G1 = 0 gives 0.
+      const double den = g1_i + g1_o - g1_i * g1_o;
+      return den > 0.0 ? g1_i * g1_o / den : 0.0;
+    }
+    case Smith::separable: return g1_i * g1_o;
+  }
+  return 0.0;
+}
+
+inline const char* to_string(Smith smith) {
+  switch (smith) {
+    case Smith::masking: return "masking";
+    case Smith::correlated: return "correlated";
+    case Smith::separable: return "separable";
+  }
+  return "?";
+}
+
+inline std::optional<Smith> parse_smith(const std::string& name) {
+  if (name == "masking") return Smith::masking;
+  if (name == "correlated") return Smith::correlated;
+  if (name == "separable") return Smith::separable;
+  return std::nullopt;
+}
+
+}  // namespace facetfit
