@@ -1,0 +1,128 @@
+// facetfit fit INPUT... : NDF, Fresnel and roughness of each material, as a table or JSON lines.
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <nlohmann/json.hpp>
+
+#include "commands.h"
+#include "core/error.h"
+#include "fit/fit.h"
+#include "io/input.h"
+
+namespace facetfit::cli {
+
+namespace {
+
+struct FitArgs {
+  std::vector<std::string> inputs;
+  bool builtin = false;
+  std::string smith = "correlated";
+  int resolution = 90;
+  double tolerance = 1e-10;
+  int max_iterations = 1000;
+  bool refine = false;
+  bool json = false;
+};
+
+nlohmann::json rgb_json(const Rgb& c) { return {c.r, c.g, c.b}; }
+
+nlohmann::json fit_json(const std::string& source, const FitResult& r, double seconds) {
+  nlohmann::json j;
+  j["source"] = source;
+  if (r.ok()) {
+    j["alpha_ggx"] = r.alpha_ggx;
+    j["alpha_beckmann"] = r.alpha_beckmann;
+    j["f0"] = rgb_json(r.f0);
+    j["f82"] = rgb_json(r.f82);
+  } else {  // JSON has no NaN: a meaningless fit has null parameters
+    for (const char* key : {"alpha_ggx", "alpha_beckmann", "f0", "f82"}) j[key] = nullptr;
+  }
+  j["iterations"] = r.extraction.iterations;
+  j["residual"] = r.extraction.residual;
+  j["seconds"] = seconds;
+  return j;
+}
+
+void print_row(const std::string& source, const FitResult& r, double seconds) {
+  if (!r.ok()) {
+    std::printf("%-28s  %-s\n", source.c_str(), ("no fit: " + r.problem).c_str());
+    return;
+  }
+  std::printf("%-28s  %9.4f  %9.4f  %5.3f %5.3f %5.3f  %5.3f %5.3f %5.3f  %5d  %8.1e  %7.1f\n", source.c_str(), r.alpha_ggx,
+              r.alpha_beckmann, r.f0.r, r.f0.g, r.f0.b, r.f82.r, r.f82.g, r.f82.b, r.extraction.iterations,
+              r.extraction.residual, seconds * 1e3);
+}
+
+void run_fit(const FitArgs& args, int& status) {
+  const auto smith = parse_smith(args.smith);
+  if (!smith) {
+    report_error("--smith " + args.smith + ": must be masking, correlated or separable");
+    status = 2;
+    return;
+  }
+  std::vector<std::string> raw = args.inputs;
+  if (args.builtin) raw.push_back(kBuiltinPrefix);
+  const std::vector<std::string> inputs = expand_inputs(raw);
+  if (inputs.empty()) {
+    report_error("no input (give files, folders, builtin:NAME, or --builtin)");
+    status = 2;
+    return;
+  }
+  FitOptions options;
+  options.resolution = args.resolution;
+  options.smith = *smith;
+  options.tolerance = args.tolerance;
+  options.max_iterations = args.max_iterations;
+  options.refine = args.refine;
+  const Fitter fitter(options);
+
+  if (!args.json)
+    std::printf("%-28s  %9s  %9s  %-17s  %-17s  %5s  %8s  %7s\n", "material", "alpha_ggx", "alpha_bkm", "f0 (r g b)",
+                "f82 (r g b)", "iters", "residual", "ms");
+  int failures = 0;
+  for (const std::string& source : inputs) {
+    try {
+      const auto start = std::chrono::steady_clock::now();
+      const FitResult result = fitter.fit(load_table(source));
+      const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      if (!result.ok()) {
+        report_error(source + ": meaningless fit: " + result.problem);
+        ++failures;
+      }
+      if (args.json)
+        std::printf("%s\n", fit_json(source, result, seconds).dump().c_str());
+      else
+        print_row(args.builtin || source.rfind(kBuiltinPrefix, 0) == 0 ? source_name(source) : source, result, seconds);
+      std::fflush(stdout);
+    } catch (const Error& e) {
+      report_error(e.what());
+      ++failures;
+    }
+  }
+  if (failures > 0) {
+    std::fprintf(stderr, "facetfit: %d of %zu inputs failed\n", failures, inputs.size());
+    status = 1;
+  }
+}
+
+}  // namespace
+
+void add_fit_command(CLI::App& app, int& status) {
+  auto args = std::make_shared<FitArgs>();
+  CLI::App* cmd = app.add_subcommand("fit", "Fit microfacet components to measured materials");
+  cmd->add_option("inputs", args->inputs, "MERL .binary files, folders, or builtin:NAME (builtin: for all)");
+  cmd->add_flag("--builtin", args->builtin, "Fit every built-in synthetic material");
+  cmd->add_option("--smith", args->smith,
+                  "Masking-shadowing model the fit is consistent with: masking (the paper), correlated "
+                  "(height-correlated, as pbrt-v4 and Cycles render), separable")
+      ->capture_default_str();
+  cmd->add_option("--resolution", args->resolution, "Intervals of the theta = u^2 pi/2 grid (90: MERL's own bins)")
+      ->capture_default_str();
+  cmd->add_option("--tolerance", args->tolerance, "Power-iteration stop: relative L1 change of the NDF")->capture_default_str();
+  cmd->add_option("--max-iterations", args->max_iterations, "Power-iteration limit")->capture_default_str();
+  cmd->add_flag("--refine", args->refine, "Refine both alphas by least squares against the tabulated NDF");
+  cmd->add_flag("--json", args->json, "One JSON object per material on stdout");
+  cmd->callback([args, &status] { run_fit(*args, status); });
+}
+
+}  // namespace facetfit::cli

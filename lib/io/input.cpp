@@ -1,0 +1,61 @@
+#include "io/input.h"
+
+#include <algorithm>
+#include <filesystem>
+
+#include "core/error.h"
+#include "model/builtin.h"
+
+namespace facetfit {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+bool starts_with(const std::string& s, const std::string& prefix) { return s.compare(0, prefix.size(), prefix) == 0; }
+
+bool is_supported_file(const fs::path& p) { return p.extension() == ".binary"; }
+
+}  // namespace
+
+MerlTable load_table(const std::string& source) {
+  if (starts_with(source, kBuiltinPrefix)) {
+    const std::string name = source.substr(std::string(kBuiltinPrefix).size());
+    const auto material = find_builtin(name);
+    if (!material) fail(source, "no such built-in material (facetfit list-builtins shows them)");
+    return MerlTable::tabulate(*material->brdf);
+  }
+  const fs::path path(source);
+  if (path.extension() == ".binary") return MerlTable::read(source);
+  std::error_code ec;
+  if (fs::is_directory(path, ec)) fail(source, "is a folder with no supported material file");
+  if (!fs::exists(path, ec)) fail(source, "cannot open: no such file");
+  fail(source, "unsupported format '" + path.extension().string() + "' (supported: .binary, builtin:NAME)");
+}
+
+std::vector<std::string> expand_inputs(const std::vector<std::string>& args) {
+  std::vector<std::string> out;
+  for (const std::string& arg : args) {
+    std::error_code ec;
+    if (arg == kBuiltinPrefix) {
+      for (const auto& m : builtin_materials()) out.push_back(kBuiltinPrefix + m.name);
+    } else if (!starts_with(arg, kBuiltinPrefix) && fs::is_directory(arg, ec)) {
+      std::vector<std::string> files;
+      for (const auto& entry : fs::directory_iterator(arg, ec))
+        if (entry.is_regular_file(ec) && is_supported_file(entry.path())) files.push_back(entry.path().string());
+      std::sort(files.begin(), files.end());
+      if (files.empty()) out.push_back(arg);  // reported when loaded
+      out.insert(out.end(), files.begin(), files.end());
+    } else {
+      out.push_back(arg);
+    }
+  }
+  return out;
+}
+
+std::string source_name(const std::string& source) {
+  if (starts_with(source, kBuiltinPrefix)) return source.substr(std::string(kBuiltinPrefix).size());
+  return fs::path(source).stem().string();
+}
+
+}  // namespace facetfit

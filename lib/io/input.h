@@ -1,0 +1,26 @@
+// Material inputs named on a command line, whatever their format, as MERL-layout tables.
+//
+// Sources: a MERL `.binary` file, or `builtin:NAME` (tabulated on the fly). Folders expand to the
+// supported files they hold, sorted by name.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "io/merl.h"
+
+namespace facetfit {
+
+constexpr const char* kBuiltinPrefix = "builtin:";
+
+// Loads one source. Throws Error("<source>: <problem>").
+MerlTable load_table(const std::string& source);
+
+// Folders become the supported files inside them; `builtin:` alone becomes every built-in material.
+// Anything else is passed through (and fails later, with its own message, if it is not loadable).
+std::vector<std::string> expand_inputs(const std::vector<std::string>& args);
+
+// The short name of a source: file stem, or the built-in's name.
+std::string source_name(const std::string& source);
+
+}  // namespace facetfit

@@ -1,0 +1,525 @@
+#include "io/rgl.h"
+
+#include <algorithm>
+#include <array>
+#include <cerrno>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <limits>
+#include <map>
+#include <utility>
+#include <vector>
+
+#include "core/error.h"
+
+namespace facetfit {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// Tensor file layout (little-endian), as written by RGL's tools and read by Mitsuba's TensorFile:
+//   "tensor_file\0" (12 bytes), version major, minor (1 byte each), field count (uint32), then per
+//   field: name length (uint16), name, rank (uint16), dtype (uint8), data offset from the start of
+//   the file (uint64), extent of each dimension (uint64 each). The arrays follow the table.
+constexpr char kMagic[12] = {'t', 'e', 'n', 's', 'o', 'r', '_', 'f', 'i', 'l', 'e', '\0'};
+constexpr std::size_t kPreamble = 12 + 2 + 4;
+// Smallest possible table entry: a one-character name, rank 1.
+constexpr std::size_t kMinFieldEntry = 2 + 1 + 2 + 1 + 8 + 8;
+constexpr unsigned kMaxRank = 8;
+// A spectral anisotropic material is tens of MB; anything this large is not an RGL material file.
+constexpr std::uintmax_t kMaxFileBytes = std::uintmax_t(1) << 30;
+
+// dtype codes of the format (the order of Mitsuba's Struct::Type at the time the files were made):
+// 1 uint8, 2 int8, 3 uint16, 4 int16, 5 uint32, 6 int32, 7 uint64, 8 int64, 9 float16, 10 float32,
+// 11 float64. Verified on the database files: `description` is 1, `version` 5, the tables 10.
+constexpr std::uint8_t kUInt8 = 1;
+constexpr std::uint8_t kFloat32 = 10;
+
+std::size_t dtype_bytes(std::uint8_t dtype) {
+  static constexpr std::size_t kBytes[] = {0, 1, 1, 2, 2, 4, 4, 8, 8, 2, 4, 8};
+  return dtype < std::size(kBytes) ? kBytes[dtype] : 0;
+}
+
+const char* dtype_name(std::uint8_t dtype) {
+  static constexpr const char* kNames[] = {"invalid", "uint8",  "int8",   "uint16",  "int16",   "uint32",
+                                           "int32",   "uint64", "int64",  "float16", "float32", "float64"};
+  return dtype < std::size(kNames) ? kNames[dtype] : "unknown";
+}
+
+struct Field {
+  std::uint8_t dtype = 0;
+  std::uint64_t offset = 0;
+  std::vector<std::uint64_t> shape;
+  std::size_t count = 0;  // product of shape, checked against the file size
+};
+
+std::string shape_string(const std::vector<std::uint64_t>& shape) {
+  std::string s;
+  for (std::size_t k = 0; k < shape.size(); ++k) s += (k ? " x " : "") + std::to_string(shape[k]);
+  return s.empty() ? "(scalar)" : s;
+}
+
+// Bounded little-endian reads of the header; running off the end is a truncated header.
+class HeaderCursor {
+ public:
+  HeaderCursor(const std::string& path, const std::vector<unsigned char>& bytes) : path_(path), bytes_(bytes) {}
+
+  std::uint64_t uint(std::size_t width, const std::string& what) {
+    need(width, what);
+    std::uint64_t v = 0;
+    for (std::size_t k = 0; k < width; ++k) v |= std::uint64_t(bytes_[pos_ + k]) << (8 * k);
+    pos_ += width;
+    return v;
+  }
+
+  std::string text(std::size_t length, const std::string& what) {
+    need(length, what);
+    std::string s(reinterpret_cast<const char*>(bytes_.data() + pos_), length);
+    pos_ += length;
+    return s;
+  }
+
+  std::size_t pos() const { return pos_; }
+
+ private:
+  void need(std::size_t width, const std::string& what) const {
+    if (width > bytes_.size() - pos_)
+      fail(path_, "truncated header: " + what + " at byte " + std::to_string(pos_) + " runs past the end of the file (" +
+                      std::to_string(bytes_.size()) + " bytes)");
+  }
+
+  const std::string& path_;
+  const std::vector<unsigned char>& bytes_;
+  std::size_t pos_ = 0;
+};
+
+std::vector<unsigned char> slurp(const std::string& path) {
+  std::error_code ec;
+  const auto status = fs::status(path, ec);
+  if (!fs::exists(status)) fail(path, "cannot open: no such file");
+  if (fs::is_directory(status)) fail(path, "is a folder, not an RGL .bsdf file");
+  const std::uintmax_t size = fs::file_size(path, ec);
+  if (ec) fail(path, "cannot read its size: " + ec.message());
+  if (size == 0) fail(path, "file is empty");
+  if (size > kMaxFileBytes)
+    fail(path, "file is " + std::to_string(size) + " bytes, larger than any RGL material file (limit " +
+                   std::to_string(kMaxFileBytes) + ")");
+
+  struct Closer {
+    void operator()(std::FILE* f) const { std::fclose(f); }
+  };
+  std::unique_ptr<std::FILE, Closer> file(std::fopen(path.c_str(), "rb"));
+  if (!file) fail(path, std::string("cannot open: ") + std::strerror(errno));
+  std::vector<unsigned char> bytes(static_cast<std::size_t>(size));
+  if (std::fread(bytes.data(), 1, bytes.size(), file.get()) != bytes.size())
+    fail(path, "read error (file changed while reading?)");
+  return bytes;
+}
+
+// Reads the field table, checking every extent against the file before anything trusts it.
+std::map<std::string, Field> parse_header(const std::string& path, const std::vector<unsigned char>& bytes) {
+  if (bytes.size() < kPreamble)
+    fail(path, "truncated header (" + std::to_string(bytes.size()) + " bytes; a tensor file starts with an " +
+                   std::to_string(kPreamble) + "-byte preamble)");
+  if (std::memcmp(bytes.data(), kMagic, sizeof kMagic) != 0)
+    fail(path, "not a tensor file (the first 12 bytes are not \"tensor_file\\0\")");
+  if (bytes[12] != 1 || bytes[13] != 0)
+    fail(path, "unsupported tensor file version " + std::to_string(bytes[12]) + "." + std::to_string(bytes[13]) +
+                   " (this reader knows 1.0)");
+
+  HeaderCursor in(path, bytes);
+  in.text(14, "preamble");
+  const std::uint64_t n_fields = in.uint(4, "field count");
+  if (n_fields == 0) fail(path, "tensor file has no fields");
+  if (n_fields > (bytes.size() - kPreamble) / kMinFieldEntry)
+    fail(path, "header claims " + std::to_string(n_fields) + " fields, more than a file of " +
+                   std::to_string(bytes.size()) + " bytes can describe");
+
+  std::map<std::string, Field> fields;
+  for (std::uint64_t k = 0; k < n_fields; ++k) {
+    const std::string entry = "entry " + std::to_string(k) + " of the field table";
+    const std::size_t name_length = static_cast<std::size_t>(in.uint(2, entry));
+    if (name_length == 0) fail(path, entry + " has an empty name");
+    const std::string name = in.text(name_length, entry);
+    const std::string what = "field '" + name + "'";
+    Field f;
+    const std::uint64_t rank = in.uint(2, what);
+    f.dtype = static_cast<std::uint8_t>(in.uint(1, what));
+    f.offset = in.uint(8, what);
+    if (rank == 0 || rank > kMaxRank)
+      fail(path, what + " claims " + std::to_string(rank) + " dimensions (expected 1 to " + std::to_string(kMaxRank) + ")");
+    const std::size_t elem = dtype_bytes(f.dtype);
+    if (elem == 0) fail(path, what + " has unknown dtype " + std::to_string(f.dtype));
+    for (std::uint64_t d = 0; d < rank; ++d) f.shape.push_back(in.uint(8, what));
+
+    // Element count and byte size without overflow: both must fit in the file.
+    std::uint64_t count = 1;
+    bool overflow = false;
+    for (const std::uint64_t n : f.shape) {
+      if (n != 0 && count > std::numeric_limits<std::uint64_t>::max() / n) overflow = true;
+      if (!overflow) count *= n;
+    }
+    if (overflow || count > (std::numeric_limits<std::uint64_t>::max() / elem))
+      fail(path, what + " has impossible dimensions " + shape_string(f.shape) + " (size overflows)");
+    const std::uint64_t size = count * elem;
+    if (f.offset > bytes.size() || size > bytes.size() - f.offset)
+      fail(path, what + " (" + shape_string(f.shape) + " " + dtype_name(f.dtype) + ", " + std::to_string(size) +
+                     " bytes at offset " + std::to_string(f.offset) + ") extends past the end of the file (" +
+                     std::to_string(bytes.size()) + " bytes; truncated?)");
+    f.count = static_cast<std::size_t>(count);
+    if (!fields.emplace(name, std::move(f)).second) fail(path, what + " appears twice in the field table");
+  }
+  for (const auto& [name, f] : fields) {
+    if (f.offset < in.pos() && f.count > 0)
+      fail(path, "field '" + name + "' at offset " + std::to_string(f.offset) + " overlaps the field table (which ends at byte " +
+                     std::to_string(in.pos()) + ")");
+  }
+  return fields;
+}
+
+// Required fields with their expected dtype and rank; shapes are cross-checked by the caller.
+class FieldSet {
+ public:
+  FieldSet(const std::string& path, const std::vector<unsigned char>& bytes, std::map<std::string, Field> fields)
+      : path_(path), bytes_(bytes), fields_(std::move(fields)) {}
+
+  bool has(const std::string& name) const { return fields_.count(name) != 0; }
+
+  const Field& get(const std::string& name, std::uint8_t dtype, std::size_t rank) const {
+    const auto it = fields_.find(name);
+    if (it == fields_.end()) fail(path_, "required field '" + name + "' is missing");
+    const Field& f = it->second;
+    if (f.dtype != dtype)
+      fail(path_, "field '" + name + "' is " + dtype_name(f.dtype) + ", expected " + dtype_name(dtype));
+    if (f.shape.size() != rank)
+      fail(path_, "field '" + name + "' has shape " + shape_string(f.shape) + ", expected " + std::to_string(rank) +
+                      " dimension" + (rank == 1 ? "" : "s"));
+    return f;
+  }
+
+  // float32 payload as doubles; NaN or infinity is an error, since every table here feeds eval.
+  std::vector<double> floats(const std::string& name, const Field& f) const {
+    std::vector<double> out(f.count);
+    const unsigned char* p = bytes_.data() + f.offset;
+    for (std::size_t k = 0; k < f.count; ++k, p += 4) {
+      const std::uint32_t bits = std::uint32_t(p[0]) | std::uint32_t(p[1]) << 8 | std::uint32_t(p[2]) << 16 |
+                                 std::uint32_t(p[3]) << 24;
+      float v;
+      std::memcpy(&v, &bits, sizeof v);
+      if (!std::isfinite(v))
+        fail(path_, "field '" + name + "' has " + (std::isnan(v) ? "a NaN" : "an infinity") + " at element " +
+                        std::to_string(k) + " (byte offset " + std::to_string(f.offset + 4 * k) + ")");
+      out[k] = double(v);
+    }
+    return out;
+  }
+
+  const unsigned char* data(const Field& f) const { return bytes_.data() + f.offset; }
+
+  void check(bool ok, const std::string& problem) const {
+    if (!ok) fail(path_, problem);
+  }
+
+ private:
+  const std::string& path_;
+  const std::vector<unsigned char>& bytes_;
+  std::map<std::string, Field> fields_;
+};
+
+std::string dims(const Field& f) { return shape_string(f.shape); }
+
+// A value table on the nodes of a uniform nx x ny grid over [0,1]^2, rows of nx along x.
+struct Grid {
+  std::size_t nx = 0, ny = 0;
+  std::vector<double> v;
+};
+
+// Position between nodes k and k + 1 of a grid, t in [0, 1].
+struct Segment {
+  std::size_t k;
+  double t;
+};
+
+Segment uniform_segment(double u, std::size_t n) {
+  const double g = clamp(u, 0.0, 1.0) * double(n - 1);
+  const std::size_t k = std::min(static_cast<std::size_t>(g), n - 2);
+  return {k, g - double(k)};
+}
+
+double bilinear(const double* v, std::size_t nx, std::size_t ny, double u0, double u1) {
+  const Segment x = uniform_segment(u0, nx), y = uniform_segment(u1, ny);
+  const double* r0 = v + y.k * nx + x.k;
+  const double* r1 = r0 + nx;
+  return (1.0 - y.t) * ((1.0 - x.t) * r0[0] + x.t * r0[1]) + y.t * ((1.0 - x.t) * r1[0] + x.t * r1[1]);
+}
+
+double bilinear(const Grid& g, double u0, double u1) { return bilinear(g.v.data(), g.nx, g.ny, u0, u1); }
+
+// The sample-space coordinate of an elevation: theta = (pi/2) u^2 concentrates resolution near the
+// normal, where specular peaks live.
+double theta_to_u(double theta) { return std::sqrt(std::max(0.0, theta) / (0.5 * kPi)); }
+
+// Angle from +z of a unit vector; unlike acos(z), accurate near the normal.
+double elevation(const Vec3& d) {
+  const double chord = std::sqrt(d.x * d.x + d.y * d.y + (d.z - 1.0) * (d.z - 1.0));
+  return 2.0 * std::asin(std::min(1.0, 0.5 * chord));
+}
+
+// Five-point Gauss-Legendre rule on [-1, 1].
+constexpr double kGaussX[5] = {-0.9061798459386640, -0.5384693101056831, 0.0, 0.5384693101056831, 0.9061798459386640};
+constexpr double kGaussW[5] = {0.2369268850561891, 0.4786286704993665, 0.5688888888888889, 0.4786286704993665,
+                               0.2369268850561891};
+
+// Linear blend of two theta_i slices, as Mitsuba's conditioned Marginal2D interpolates every table
+// (density and CDFs alike) between the bracketing parameter values; clamped outside them.
+struct SliceBlend {
+  std::size_t s0 = 0, s1 = 0;
+  double w1 = 0.0;
+
+  double operator()(const double* table, std::size_t slice_size, std::size_t index) const {
+    const double a = table[s0 * slice_size + index];
+    return w1 == 0.0 ? a : a + w1 * (table[s1 * slice_size + index] - a);
+  }
+};
+
+SliceBlend blend_for(const std::vector<double>& nodes, double theta) {
+  if (nodes.size() == 1) return {};
+  const auto it = std::upper_bound(nodes.begin(), nodes.end(), theta);
+  const std::size_t above = static_cast<std::size_t>(it - nodes.begin());
+  const std::size_t k = std::min(above == 0 ? 0 : above - 1, nodes.size() - 2);
+  const double t = clamp((theta - nodes[k]) / (nodes[k + 1] - nodes[k]), 0.0, 1.0);
+  return {k, k + 1, t};
+}
+
+// Builds the CDFs of one slice of bilinear density (in units of grid patches) and normalizes all
+// three arrays; returns the total before normalization.
+double build_warp_slice(double* pdf, double* cond, double* marg, std::size_t nx, std::size_t ny) {
+  for (std::size_t y = 0; y < ny; ++y) {
+    const double* row = pdf + y * nx;
+    double* c = cond + y * nx;
+    c[0] = 0.0;
+    for (std::size_t x = 1; x < nx; ++x) c[x] = c[x - 1] + 0.5 * (row[x - 1] + row[x]);
+  }
+  marg[0] = 0.0;
+  for (std::size_t y = 1; y < ny; ++y) marg[y] = marg[y - 1] + 0.5 * (cond[y * nx - 1] + cond[(y + 1) * nx - 1]);
+  const double total = marg[ny - 1];
+  if (!(total > 0.0)) return total;
+  const double inv = 1.0 / total;
+  for (std::size_t k = 0; k < nx * ny; ++k) {
+    pdf[k] *= inv;
+    cond[k] *= inv;
+  }
+  for (std::size_t y = 0; y < ny; ++y) marg[y] *= inv;
+  return total;
+}
+
+}  // namespace
+
+struct RglBsdf::Tables {
+  std::string description;
+  bool jacobian = true;
+  std::vector<double> theta_i;  // incident elevations of the slices, strictly increasing
+
+  Grid ndf;    // D over (u_theta, u_phi) of the half vector
+  Grid sigma;  // projected microfacet area over (u_theta, u_phi) of i
+
+  // VNDF warp per theta_i slice, over (u_theta, u_phi) of the half vector: the density normalized
+  // to integrate to 1 over the square, its conditional CDF along x within each row, and the
+  // marginal CDF over rows, both integrating the bilinear density exactly.
+  std::size_t vx = 0, vy = 0;
+  std::vector<double> vndf_pdf, vndf_cond, vndf_marg;
+
+  // RGB over the sample square, per theta_i slice and channel: [slice][channel][ry][rx].
+  std::size_t rx = 0, ry = 0;
+  std::vector<double> rgb;
+
+  std::vector<double> ndf_iso;  // D averaged over u_phi, at the nx nodes of u_theta
+  double ndf_integral = 0.0;    // integral D cos d(omega) of ndf_iso
+
+  std::array<double, 2> invert_vndf(const SliceBlend& b, double u0, double u1) const;
+};
+
+// The point of the sample square that the VNDF warp of slice blend b maps to u (the inverse of
+// sampling rows from the marginal CDF, then the column from the conditional CDF, each under the
+// bilinear density). Monotone in both coordinates; corners map to corners.
+std::array<double, 2> RglBsdf::Tables::invert_vndf(const SliceBlend& b, double u0, double u1) const {
+  const std::size_t nx = vx, ny = vy, slice = nx * ny;
+  const Segment x = uniform_segment(u0, nx), y = uniform_segment(u1, ny);
+  const std::size_t at = y.k * nx + x.k;
+  const double* pdf = vndf_pdf.data();
+  const double* cond = vndf_cond.data();
+
+  // Density along this row's x, linear in x within the patch.
+  const double c0 = (1.0 - y.t) * b(pdf, slice, at) + y.t * b(pdf, slice, at + nx);
+  const double c1 = (1.0 - y.t) * b(pdf, slice, at + 1) + y.t * b(pdf, slice, at + 1 + nx);
+  // Mass left of u0 in the (interpolated) row, over the row's total.
+  const double left = (1.0 - y.t) * b(cond, slice, at) + y.t * b(cond, slice, at + nx);
+  const double r0 = b(cond, slice, y.k * nx + nx - 1), r1 = b(cond, slice, (y.k + 1) * nx + nx - 1);
+  const double row_total = (1.0 - y.t) * r0 + y.t * r1;
+  const double within = x.t * (c0 + 0.5 * x.t * (c1 - c0));
+  const double s0 = row_total > 0.0 ? (left + within) / row_total : clamp(u0, 0.0, 1.0);
+  // Mass below u1: whole rows from the marginal CDF, plus the part of this patch row.
+  const double s1 = b(vndf_marg.data(), ny, y.k) + y.t * (r0 + 0.5 * y.t * (r1 - r0));
+  return {clamp(s0, 0.0, 1.0), clamp(s1, 0.0, 1.0)};
+}
+
+
+RglBsdf::RglBsdf(std::shared_ptr<const Tables> tables) : t_(std::move(tables)) {}
+
+const std::string& RglBsdf::description() const { return t_->description; }
+bool RglBsdf::jacobian() const { return t_->jacobian; }
+double RglBsdf::measured_ndf_stored_integral() const { return t_->ndf_integral; }
+
+RglBsdf RglBsdf::read(const std::string& path) {
+  const std::vector<unsigned char> bytes = slurp(path);
+  const FieldSet in(path, bytes, parse_header(path, bytes));
+  auto t = std::make_shared<Tables>();
+
+  // Anisotropy first: such files are otherwise well formed, and deserve the specific message.
+  const Field& phi_i = in.get("phi_i", kFloat32, 1);
+  in.check(phi_i.count >= 1, "field 'phi_i' is empty");
+  in.check(phi_i.count == 1, "anisotropic RGL files are not supported yet (phi_i has " + std::to_string(phi_i.count) +
+                                 " entries; isotropic files have 1)");
+  in.floats("phi_i", phi_i);
+
+  const Field& desc = in.get("description", kUInt8, 1);
+  t->description.assign(reinterpret_cast<const char*>(in.data(desc)), desc.count);
+  while (!t->description.empty() && t->description.back() == '\0') t->description.pop_back();
+
+  const Field& theta_i = in.get("theta_i", kFloat32, 1);
+  in.check(theta_i.count >= 1, "field 'theta_i' is empty");
+  t->theta_i = in.floats("theta_i", theta_i);
+  for (std::size_t k = 0; k < t->theta_i.size(); ++k) {
+    const double v = t->theta_i[k];
+    in.check(v >= 0.0 && v <= 0.5 * kPi + 1e-4, "field 'theta_i' has " + std::to_string(v) + " at element " +
+                                                    std::to_string(k) + ", outside [0, pi/2]");
+    in.check(k == 0 || v > t->theta_i[k - 1], "field 'theta_i' is not strictly increasing at element " + std::to_string(k));
+  }
+  const std::uint64_t n_theta = theta_i.count;
+
+  const auto read_grid = [&](const char* name, Grid& g, bool positive) {
+    const Field& f = in.get(name, kFloat32, 2);
+    in.check(f.shape[0] >= 2 && f.shape[1] >= 2,
+             std::string("field '") + name + "' has shape " + dims(f) + "; interpolation needs at least 2 x 2");
+    g.ny = static_cast<std::size_t>(f.shape[0]);
+    g.nx = static_cast<std::size_t>(f.shape[1]);
+    g.v = in.floats(name, f);
+    for (std::size_t k = 0; k < g.v.size(); ++k)
+      in.check(positive ? g.v[k] > 0.0 : g.v[k] >= 0.0, std::string("field '") + name + "' has " +
+                                                              (positive ? "a non-positive" : "a negative") +
+                                                              " value at element " + std::to_string(k));
+  };
+  read_grid("ndf", t->ndf, false);
+  read_grid("sigma", t->sigma, true);  // eval divides by it
+
+  const Field& vndf = in.get("vndf", kFloat32, 4);
+  in.check(vndf.shape[0] == 1 && vndf.shape[1] == n_theta && vndf.shape[2] >= 2 && vndf.shape[3] >= 2,
+           "field 'vndf' has shape " + dims(vndf) + ", expected 1 x " + std::to_string(n_theta) +
+               " (theta_i) x rows x columns, at least 2 x 2");
+  t->vy = static_cast<std::size_t>(vndf.shape[2]);
+  t->vx = static_cast<std::size_t>(vndf.shape[3]);
+  t->vndf_pdf = in.floats("vndf", vndf);
+  for (std::size_t k = 0; k < t->vndf_pdf.size(); ++k)
+    in.check(t->vndf_pdf[k] >= 0.0, "field 'vndf' has a negative density at element " + std::to_string(k));
+  t->vndf_cond.resize(t->vndf_pdf.size());
+  t->vndf_marg.resize(static_cast<std::size_t>(n_theta) * t->vy);
+  for (std::size_t s = 0; s < n_theta; ++s) {
+    const std::size_t slice = t->vx * t->vy;
+    const double total = build_warp_slice(t->vndf_pdf.data() + s * slice, t->vndf_cond.data() + s * slice,
+                                          t->vndf_marg.data() + s * t->vy, t->vx, t->vy);
+    in.check(total > 0.0 && std::isfinite(total),
+             "field 'vndf' slice " + std::to_string(s) + " (theta_i " + std::to_string(t->theta_i[s]) + ") has no mass");
+  }
+
+  const Field& rgb = in.get("rgb", kFloat32, 5);
+  in.check(rgb.shape[0] == 1 && rgb.shape[1] == n_theta && rgb.shape[2] == 3 && rgb.shape[3] >= 2 && rgb.shape[4] >= 2,
+           "field 'rgb' has shape " + dims(rgb) + ", expected 1 x " + std::to_string(n_theta) +
+               " (theta_i) x 3 x rows x columns, at least 2 x 2");
+  t->ry = static_cast<std::size_t>(rgb.shape[3]);
+  t->rx = static_cast<std::size_t>(rgb.shape[4]);
+  t->rgb = in.floats("rgb", rgb);  // slightly negative values are out-of-gamut colour, clipped in eval
+
+  // Unused by eval (it drives importance sampling), but a file whose luminance disagrees with its
+  // RGB table is inconsistent.
+  if (in.has("luminance")) {
+    const Field& lum = in.get("luminance", kFloat32, 4);
+    in.check(lum.shape[0] == 1 && lum.shape[1] == n_theta && lum.shape[2] == rgb.shape[3] && lum.shape[3] == rgb.shape[4],
+             "field 'luminance' has shape " + dims(lum) + ", expected 1 x " + std::to_string(n_theta) + " x " +
+                 std::to_string(rgb.shape[3]) + " x " + std::to_string(rgb.shape[4]) + " to match 'rgb'");
+  }
+
+  const Field& jac = in.get("jacobian", kUInt8, 1);
+  in.check(jac.count == 1, "field 'jacobian' has shape " + dims(jac) + ", expected 1");
+  t->jacobian = in.data(jac)[0] != 0;
+
+  // Phi-averaged NDF: the mean of the bilinear interpolant over u_phi is the trapezoid rule over rows.
+  const Grid& g = t->ndf;
+  t->ndf_iso.assign(g.nx, 0.0);
+  for (std::size_t y = 0; y < g.ny; ++y) {
+    const double w = (y == 0 || y + 1 == g.ny ? 0.5 : 1.0) / double(g.ny - 1);
+    for (std::size_t x = 0; x < g.nx; ++x) t->ndf_iso[x] += w * g.v[y * g.nx + x];
+  }
+  // integral D cos d(omega) = 2 pi int_0^1 D(u) cos(theta) sin(theta) (d theta / du) du, theta = (pi/2) u^2.
+  double integral = 0.0;
+  const double du = 1.0 / double(g.nx - 1);
+  for (std::size_t x = 0; x + 1 < g.nx; ++x) {
+    for (int q = 0; q < 5; ++q) {
+      const double s = 0.5 * (1.0 + kGaussX[q]);
+      const double u = (double(x) + s) * du;
+      const double theta = 0.5 * kPi * u * u;
+      const double d = (1.0 - s) * t->ndf_iso[x] + s * t->ndf_iso[x + 1];
+      integral += 0.5 * du * kGaussW[q] * d * std::cos(theta) * std::sin(theta) * kPi * u;
+    }
+  }
+  t->ndf_integral = 2.0 * kPi * integral;
+  in.check(t->ndf_integral > 0.0, "field 'ndf' is zero everywhere");
+
+  return RglBsdf(std::move(t));
+}
+
+double RglBsdf::measured_ndf(double theta) const {
+  if (!(theta >= 0.0 && theta <= 0.5 * kPi)) return 0.0;
+  const Segment s = uniform_segment(theta_to_u(theta), t_->ndf_iso.size());
+  const double d = (1.0 - s.t) * t_->ndf_iso[s.k] + s.t * t_->ndf_iso[s.k + 1];
+  return d / t_->ndf_integral;
+}
+
+std::optional<Rgb> RglBsdf::eval(const Vec3& i_in, const Vec3& o_in) const {
+  if (!(i_in.z > 0.0) || !(o_in.z > 0.0)) return Rgb(0.0);
+  const Tables& t = *t_;
+  const Vec3 i = glm::normalize(i_in), o = glm::normalize(o_in);
+  const Vec3 h = glm::normalize(i + o);
+
+  const double theta_i = elevation(i), phi_i = std::atan2(i.y, i.x);
+  const double theta_h = elevation(h), phi_h = std::atan2(h.y, h.x);
+  // Isotropic tables measure the half vector's azimuth from the incident plane.
+  double u_h1 = (phi_h - phi_i + kPi) / (2.0 * kPi);
+  u_h1 -= std::floor(u_h1);
+  const double u_h0 = theta_to_u(theta_h);
+
+  const SliceBlend b = blend_for(t.theta_i, theta_i);
+  const std::array<double, 2> s = t.invert_vndf(b, u_h0, u_h1);
+
+  Rgb f;
+  const std::size_t plane = t.rx * t.ry;
+  for (int c = 0; c < 3; ++c) {
+    const auto at = [&](std::size_t slice) {
+      return bilinear(t.rgb.data() + (slice * 3 + std::size_t(c)) * plane, t.rx, t.ry, s[0], s[1]);
+    };
+    const double a = at(b.s0);
+    f[c] = std::max(0.0, b.w1 == 0.0 ? a : a + b.w1 * (at(b.s1) - a));
+  }
+  double scale = 1.0;
+  if (t.jacobian) {
+    const double u_i1 = (phi_i + kPi) / (2.0 * kPi);
+    scale = bilinear(t.ndf, u_h0, u_h1) / (4.0 * bilinear(t.sigma, theta_to_u(theta_i), u_i1));
+  }
+  // The table holds f cos(theta_o).
+  return f * (scale / o.z);
+}
+
+}  // namespace facetfit

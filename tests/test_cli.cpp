@@ -1,0 +1,155 @@
+// The facetfit command as users run it: bad inputs, batches, JSON output.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <cstdint>
+#include <cstring>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "io/merl.h"
+#include "test_util.h"
+
+namespace facetfit {
+namespace {
+
+using test::TempDir;
+
+struct RunResult {
+  int status = -1;
+  std::string out, err;
+};
+
+// Runs the facetfit command with `args` (shell words), capturing stdout and stderr.
+RunResult facetfit(const std::string& args) {
+  TempDir dir;
+  const std::string cmd = std::string(FACETFIT_CLI) + " " + args + " >" + dir.file("out") + " 2>" + dir.file("err");
+  RunResult r;
+  const int raw = std::system(cmd.c_str());
+  r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+  r.out = test::read_bytes(dir.file("out"));
+  r.err = test::read_bytes(dir.file("err"));
+  return r;
+}
+
+int lines(const std::string& s) { return int(std::count(s.begin(), s.end(), '\n')); }
+
+std::string merl_header(std::int32_t a, std::int32_t b, std::int32_t c) {
+  std::string s(12, '\0');
+  std::memcpy(s.data(), &a, 4);
+  std::memcpy(s.data() + 4, &b, 4);
+  std::memcpy(s.data() + 8, &c, 4);
+  return s;
+}
+
+class CliBadFile : public testing::TestWithParam<std::pair<std::string, std::string>> {};
+
+// Each bad file: exactly one error line naming the file and the problem, exit status 1, no crash.
+TEST_P(CliBadFile, OneClearLine) {
+  TempDir dir;
+  const auto& [name, expected] = GetParam();
+  const std::string path = dir.file(name);
+  if (name == "empty.binary") test::write_bytes(path, "");
+  if (name == "truncated.binary") test::write_bytes(path, merl_header(90, 90, 180) + std::string(4096, '\0'));
+  if (name == "dims.binary") test::write_bytes(path, merl_header(90, 90, 90) + std::string(4096, '\0'));
+  if (name == "huge.binary") test::write_bytes(path, merl_header(1000, 1000, 1000));
+  if (name == "nan.binary") {
+    std::string bytes = merl_header(90, 90, 180) + std::string(3 * MerlTable::kBins * 8, '\0');
+    std::memset(bytes.data() + 12 + 8 * 1000, 0xff, 8);  // all ones: a NaN
+    test::write_bytes(path, bytes);
+  }
+  if (name == "folder.binary") std::filesystem::create_directory(path);
+  const RunResult r = facetfit("fit " + path);
+  EXPECT_EQ(r.status, 1);
+  EXPECT_EQ(lines(r.err), 2) << r.err;  // the error, then the batch summary
+  EXPECT_NE(r.err.find("facetfit: error: " + path + ": "), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find(expected), std::string::npos) << r.err;
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Merl, CliBadFile,
+    testing::Values(std::make_pair("missing.binary", "no such file"), std::make_pair("empty.binary", "file is empty"),
+                    std::make_pair("truncated.binary", "truncated"), std::make_pair("dims.binary", "90 x 90 x 90"),
+                    std::make_pair("huge.binary", "1000 x 1000 x 1000"),
+                    std::make_pair("nan.binary", "NaN at byte offset 8012"), std::make_pair("folder.binary", "is a folder")),
+    [](const testing::TestParamInfo<std::pair<std::string, std::string>>& param) {
+      return param.param.first.substr(0, param.param.first.find('.'));
+    });
+
+TEST(Cli, BatchGoesOnPastABadFile) {
+  TempDir dir;
+  test::write_bytes(dir.file("bad.binary"), "garbage");
+  const RunResult r = facetfit("fit builtin:gold-ggx-0.15 " + dir.file("bad.binary") + " builtin:aluminium-ggx-0.05 --json");
+  EXPECT_EQ(r.status, 1);
+  EXPECT_EQ(lines(r.out), 2) << r.out;
+  EXPECT_NE(r.err.find("bad.binary"), std::string::npos);
+  EXPECT_NE(r.err.find("1 of 3 inputs failed"), std::string::npos) << r.err;
+}
+
+TEST(Cli, JsonHasExactlyTheDocumentedKeys) {
+  const RunResult r = facetfit("fit builtin:copper-beckmann-0.30 --json");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  std::vector<std::string> keys;
+  for (const auto& item : j.items()) keys.push_back(item.key());
+  EXPECT_EQ(keys, (std::vector<std::string>{"alpha_beckmann", "alpha_ggx", "f0", "f82", "iterations", "residual", "seconds", "source"}));
+  EXPECT_NEAR(j["alpha_beckmann"].get<double>(), 0.30, 0.30 * 0.005);
+  EXPECT_EQ(j["f0"].size(), 3u);
+  EXPECT_EQ(j["source"], "builtin:copper-beckmann-0.30");
+}
+
+TEST(Cli, ConvertThenFitTheFile) {
+  TempDir dir;
+  const std::string path = dir.file("gold.binary");
+  ASSERT_EQ(facetfit("convert builtin:gold-ggx-0.15 -o " + path).status, 0);
+  const RunResult r = facetfit("fit " + path + " --json --smith correlated --resolution 90");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NEAR(nlohmann::json::parse(r.out)["alpha_ggx"].get<double>(), 0.15, 0.15 * 0.005);
+}
+
+TEST(Cli, FolderInputFitsEveryTableInIt) {
+  TempDir dir;
+  ASSERT_EQ(facetfit("convert builtin:gold-ggx-0.15 -o " + dir.file("a.binary")).status, 0);
+  ASSERT_EQ(facetfit("convert builtin:silver-ggx-0.60 -o " + dir.file("b.binary")).status, 0);
+  const RunResult r = facetfit("fit " + dir.path().string() + " --json");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(lines(r.out), 2);
+}
+
+TEST(Cli, UsageErrors) {
+  EXPECT_EQ(facetfit("fit builtin:gold-ggx-0.15 --smith wrong").status, 2);
+  EXPECT_NE(facetfit("fit").status, 0);
+  EXPECT_NE(facetfit("fit builtin:gold-ggx-0.15 --resolution 1").status, 0);
+  const RunResult unknown = facetfit("fit builtin:no-such-material");
+  EXPECT_EQ(unknown.status, 1);
+  EXPECT_NE(unknown.err.find("no such built-in material"), std::string::npos);
+}
+
+TEST(Cli, ConvertIntoReadOnlyFolderFailsCleanly) {
+  // Root writes through permission bits, but nobody creates files in /proc.
+  TempDir dir;
+  std::filesystem::permissions(dir.path(), std::filesystem::perms::owner_read | std::filesystem::perms::owner_exec);
+  const std::string target = ::geteuid() == 0 ? "/proc/facetfit-x.binary" : dir.file("x.binary");
+  const RunResult r = facetfit("convert builtin:gold-ggx-0.15 -o " + target);
+  EXPECT_EQ(r.status, 1);
+  EXPECT_EQ(lines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find(target + ": cannot write"), std::string::npos) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(target));
+}
+
+TEST(Cli, MeaninglessFitIsReportedWithNulls) {
+  TempDir dir;
+  // A table with every measurement zero.
+  MerlTable table;
+  for (int c = 0; c < 3; ++c)
+    for (std::size_t n = 0; n < MerlTable::kBins; ++n) table.channel(c)[n] = 0.0f;
+  table.write(dir.file("zero.binary"));
+  const RunResult r = facetfit("fit " + dir.file("zero.binary") + " --json");
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("meaningless fit: no back-scattered signal"), std::string::npos) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_TRUE(j["alpha_ggx"].is_null());
+}
+
+}  // namespace
+}  // namespace facetfit

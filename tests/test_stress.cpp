@@ -1,0 +1,147 @@
+// Numerical stability: extreme roughness and Fresnel, missing samples, noise, degenerate inputs.
+// Nothing may produce NaN or Inf; a meaningless fit is reported as such.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "fit/fit.h"
+#include "model/analytic.h"
+
+namespace facetfit {
+namespace {
+
+bool finite(double x) { return std::isfinite(x); }
+bool finite(const Rgb& c) { return finite(c.r) && finite(c.g) && finite(c.b); }
+
+// Every number a fit exposes is finite, whether or not the fit is meaningful.
+void expect_all_finite(const FitResult& r) {
+  for (double v : r.ndf().ndf) ASSERT_TRUE(finite(v) && v >= 0.0);
+  for (double v : r.ndf().sigma) ASSERT_TRUE(finite(v) && v >= 0.0);
+  for (const Rgb& v : r.fresnel.value) ASSERT_TRUE(finite(v));
+  EXPECT_TRUE(finite(r.alpha_ggx) && finite(r.alpha_beckmann) && finite(r.f0) && finite(r.f82));
+  EXPECT_TRUE(finite(r.extraction.eigenvalue) && finite(r.extraction.residual));
+  // The tabulated model itself, at grazing angles too.
+  for (double theta : {0.0, 1e-6, 1.0, 1.5, 1.5707, 0.5 * kPi}) {
+    EXPECT_TRUE(finite(r.ndf().D(theta)));
+    EXPECT_TRUE(finite(r.ndf().g1(std::cos(theta))));
+  }
+}
+
+FitResult fit(const MerlTable& table, Smith smith = Smith::correlated) {
+  FitOptions options;
+  options.smith = smith;
+  return Fitter(options).fit(table);
+}
+
+MerlTable table_of(NdfType type, double alpha, const Fresnel& fresnel) {
+  return MerlTable::tabulate(MicrofacetBrdf(Ndf::isotropic(type, alpha), Smith::correlated, fresnel));
+}
+
+class ExtremeRoughness : public testing::TestWithParam<std::tuple<NdfType, double>> {};
+
+TEST_P(ExtremeRoughness, FiniteAndClose) {
+  const auto [type, alpha] = GetParam();
+  const FitResult r = fit(table_of(type, alpha, Fresnel::schlick(Rgb(0.5))));
+  ASSERT_TRUE(r.ok()) << r.problem;
+  expect_all_finite(r);
+  const double fitted = type == NdfType::ggx ? r.alpha_ggx : r.alpha_beckmann;
+  // The grid resolves alpha = 0.005 with about five nodes: a percent is what it can do.
+  EXPECT_NEAR(fitted, alpha, alpha * (alpha < 0.01 ? 0.015 : 0.005));
+}
+
+INSTANTIATE_TEST_SUITE_P(Alpha, ExtremeRoughness,
+                         testing::Combine(testing::Values(NdfType::ggx, NdfType::beckmann),
+                                          testing::Values(0.005, 0.01, 1.2, 1.5)));
+
+TEST(Stress, FresnelFromDarkToWhite) {
+  for (double f0 : {0.01, 0.04, 0.3, 1.0}) {
+    const FitResult r = fit(table_of(NdfType::ggx, 0.2, Fresnel::schlick(Rgb(f0))));
+    ASSERT_TRUE(r.ok());
+    expect_all_finite(r);
+    EXPECT_NEAR(r.f0.g, f0, 0.005 * std::max(f0, 0.1)) << "f0 " << f0;
+    EXPECT_NEAR(r.alpha_ggx, 0.2, 0.001);
+  }
+}
+
+TEST(Stress, ThirtyPercentMissing) {
+  MerlTable table = table_of(NdfType::ggx, 0.3, Fresnel::conductor({0.2, 0.9, 1.1}, {3.9, 2.4, 2.1}));
+  std::mt19937 rng(1);
+  std::bernoulli_distribution drop(0.3);
+  for (int i = 0; i < MerlTable::kThetaH; ++i)
+    for (int j = 0; j < MerlTable::kThetaD; ++j)
+      for (int k = 0; k < MerlTable::kPhiD; ++k)
+        if (drop(rng)) table.set_missing(i, j, k);
+  const FitResult r = fit(table);
+  ASSERT_TRUE(r.ok()) << r.problem;
+  expect_all_finite(r);
+  EXPECT_NEAR(r.alpha_ggx, 0.3, 0.3 * 0.005);
+  const Rgb truth = fresnel_conductor({0.2, 0.9, 1.1}, {3.9, 2.4, 2.1}, 1.0);
+  EXPECT_NEAR(r.f0.r, truth.r, 0.005);
+  for (const auto& count : r.fresnel.count) EXPECT_GT(count[0], 0);
+}
+
+TEST(Stress, WholeBackScatteringRowsMissing) {
+  MerlTable table = table_of(NdfType::beckmann, 0.2, Fresnel::schlick(Rgb(0.8)));
+  for (int i = 10; i < 30; i += 3)
+    for (int k = 0; k < MerlTable::kPhiD; ++k) table.set_missing(i, 0, k);
+  const FitResult r = fit(table);
+  ASSERT_TRUE(r.ok());
+  expect_all_finite(r);
+  EXPECT_NEAR(r.alpha_beckmann, 0.2, 0.2 * 0.02);
+}
+
+TEST(Stress, MultiplicativeNoise) {
+  MerlTable table = table_of(NdfType::ggx, 0.25, Fresnel::schlick(Rgb(0.9, 0.7, 0.4)));
+  std::mt19937 rng(2);
+  std::lognormal_distribution<float> noise(0.0f, 0.1f);  // about 10% per measurement
+  for (int c = 0; c < 3; ++c)
+    for (std::size_t n = 0; n < MerlTable::kBins; ++n)
+      if (table.channel(c)[n] >= 0.0f) table.channel(c)[n] *= noise(rng);
+  const FitResult r = fit(table);
+  ASSERT_TRUE(r.ok());
+  expect_all_finite(r);
+  EXPECT_NEAR(r.alpha_ggx, 0.25, 0.25 * 0.03);
+  EXPECT_NEAR(r.f0.r, 0.9 * std::exp(0.005), 0.02);  // E[lognormal(0, 0.1)] = exp(0.005)
+}
+
+TEST(Stress, AllZeroInputIsMeaningless) {
+  MerlTable table = table_of(NdfType::ggx, 0.3, Fresnel::one());
+  for (int c = 0; c < 3; ++c)
+    for (std::size_t n = 0; n < MerlTable::kBins; ++n)
+      if (table.channel(c)[n] >= 0.0f) table.channel(c)[n] = 0.0f;
+  for (Smith smith : {Smith::masking, Smith::correlated, Smith::separable}) {
+    const FitResult r = fit(table, smith);
+    EXPECT_FALSE(r.ok());
+    EXPECT_NE(r.problem.find("no back-scattered signal"), std::string::npos) << r.problem;
+    expect_all_finite(r);
+  }
+}
+
+TEST(Stress, AllMissingInputIsMeaningless) {
+  const FitResult r = fit(MerlTable());
+  EXPECT_FALSE(r.ok());
+  expect_all_finite(r);
+}
+
+TEST(Stress, PureLambertianStaysFinite) {
+  // Not a microfacet material: the numbers mean little, but they are numbers.
+  for (Smith smith : {Smith::masking, Smith::correlated, Smith::separable}) {
+    const FitResult r = fit(MerlTable::tabulate(LambertBrdf(Rgb(0.8))), smith);
+    expect_all_finite(r);
+    EXPECT_TRUE(r.ok()) << r.problem;
+  }
+}
+
+TEST(Stress, SeparableAndMaskingAtExtremes) {
+  for (Smith smith : {Smith::masking, Smith::separable})
+    for (double alpha : {0.005, 1.5}) {
+      const FitResult r = fit(MerlTable::tabulate(MicrofacetBrdf(Ndf::isotropic(NdfType::ggx, alpha), smith, Fresnel::one())), smith);
+      ASSERT_TRUE(r.ok());
+      expect_all_finite(r);
+      EXPECT_NEAR(r.alpha_ggx, alpha, alpha * 0.015);
+    }
+}
+
+}  // namespace
+}  // namespace facetfit
