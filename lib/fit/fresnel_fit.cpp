@@ -56,35 +56,43 @@ FresnelCurve fit_fresnel(const MerlTable& table, const TabulatedNdf& ndf, Smith 
   const Sums sums = tbb::parallel_reduce(
       tbb::blocked_range<int>(0, kH), Sums{},
       [&](const tbb::blocked_range<int>& rows, Sums acc) {
+        // The F = 1 model along one phi_d row, and 1 where both directions are above the horizon (0 below,
+        // where no bin counts whatever the file holds).
+        alignas(64) float model_row[kP];
+        alignas(64) float above_row[kP];
         for (int i = rows.begin(); i < rows.end(); ++i) {
           for (int j = 0; j < kD; ++j) {
             // cos(theta_i) = A - B cos(phi_d), cos(theta_o) = A + B cos(phi_d) (docs/conventions.md).
             const double a = cos_h[i] * cos_d[j], b = sin_h[i] * sin_d[j];
-            const std::size_t row = MerlTable::index(i, j, 0);
-            auto& measured = acc.measured[j];
-            auto& model = acc.model[j];
-            auto& count = acc.count[j];
-            // phi_d and pi - phi_d swap i and o: the model is the same for both bins.
+            if (a <= 0.0) continue;  // theta_i + theta_o >= 180 degrees: the whole row is below the horizon
+            // phi_d and pi - phi_d swap i and o: one model value serves both bins.
             for (int k = 0; k <= kP / 2; ++k) {
               const double mu_i = a - b * cos_p[k], mu_o = a + b * cos_p[k];
-              if (mu_i <= 0.0 || mu_o <= 0.0) continue;
-              const double f1 = d_h[i] * smith_g2_from_g1(smith, g1(mu_i), g1(mu_o)) / (4.0 * mu_i * mu_o);
-              const int mirror = kP - k;
-              for (int c = 0; c < 3; ++c) {
-                const float v = channel[c][row + std::size_t(k)];
-                if (v >= 0.0f) {
-                  measured[c] += v;
-                  model[c] += f1;
-                  ++count[c];
-                }
-                if (k == 0 || mirror == k) continue;
-                const float w = channel[c][row + std::size_t(mirror)];
-                if (w >= 0.0f) {
-                  measured[c] += w;
-                  model[c] += f1;
-                  ++count[c];
-                }
+              const bool above = mu_i > 0.0 && mu_o > 0.0;
+              const double f1 = above ? d_h[i] * smith_g2_from_g1(smith, g1(mu_i), g1(mu_o)) / (4.0 * mu_i * mu_o) : 0.0;
+              model_row[k] = float(f1);
+              above_row[k] = above ? 1.0f : 0.0f;
+              if (k > 0 && k < kP / 2) {
+                model_row[kP - k] = model_row[k];
+                above_row[kP - k] = above_row[k];
               }
+            }
+            const std::size_t row = MerlTable::index(i, j, 0);
+            for (int c = 0; c < 3; ++c) {
+              const float* values = channel[c] + row;
+              // Branch-free so that it vectorizes: the weight is 1 for a valid bin, 0 otherwise. Row sums
+              // in float (at most 180 terms), totals in double.
+              float measured = 0.0f, model = 0.0f, count = 0.0f;
+#pragma omp simd reduction(+ : measured, model, count)
+              for (int k = 0; k < kP; ++k) {
+                const float w = values[k] >= 0.0f ? above_row[k] : 0.0f;
+                measured += w * values[k];
+                model += w * model_row[k];
+                count += w;
+              }
+              acc.measured[j][c] += measured;
+              acc.model[j][c] += model;
+              acc.count[j][c] += std::int64_t(count);
             }
           }
         }

@@ -30,10 +30,11 @@ constexpr std::size_t kPreamble = 12 + 2 + 4;
 // Smallest possible table entry: a one-character name, rank 1.
 constexpr std::size_t kMinFieldEntry = 2 + 1 + 2 + 1 + 8 + 8;
 constexpr unsigned kMaxRank = 8;
-// A spectral anisotropic material is tens of MB; anything this large is not an RGL material file.
+// Far above any RGL material file (the RGB isotropic ones are 0.66 MB); guards the one allocation
+// sized from outside, the file buffer.
 constexpr std::uintmax_t kMaxFileBytes = std::uintmax_t(1) << 30;
 
-// dtype codes of the format (the order of Mitsuba's Struct::Type at the time the files were made):
+// dtype codes of the format (as enumerated by RGL's own reader, powitacq's Tensor::Type):
 // 1 uint8, 2 int8, 3 uint16, 4 int16, 5 uint32, 6 int32, 7 uint64, 8 int64, 9 float16, 10 float32,
 // 11 float64. Verified on the database files: `description` is 1, `version` 5, the tables 10.
 constexpr std::uint8_t kUInt8 = 1;
@@ -54,7 +55,8 @@ struct Field {
   std::uint8_t dtype = 0;
   std::uint64_t offset = 0;
   std::vector<std::uint64_t> shape;
-  std::size_t count = 0;  // product of shape, checked against the file size
+  std::size_t count = 0;     // product of shape; fits in the file once extents are checked
+  std::uint64_t bytes = 0;  // count times the element size, without overflow
 };
 
 std::string shape_string(const std::vector<std::uint64_t>& shape) {
@@ -137,7 +139,7 @@ std::map<std::string, Field> parse_header(const std::string& path, const std::ve
   if (n_fields == 0) fail(path, "tensor file has no fields");
   if (n_fields > (bytes.size() - kPreamble) / kMinFieldEntry)
     fail(path, "header claims " + std::to_string(n_fields) + " fields, more than a file of " +
-                   std::to_string(bytes.size()) + " bytes can describe");
+                   std::to_string(bytes.size()) + " bytes can describe (truncated, or a corrupt count)");
 
   std::map<std::string, Field> fields;
   for (std::uint64_t k = 0; k < n_fields; ++k) {
@@ -145,6 +147,9 @@ std::map<std::string, Field> parse_header(const std::string& path, const std::ve
     const std::size_t name_length = static_cast<std::size_t>(in.uint(2, entry));
     if (name_length == 0) fail(path, entry + " has an empty name");
     const std::string name = in.text(name_length, entry);
+    // Names go into error messages, which must stay one printable line.
+    for (const char ch : name)
+      if (ch < 0x20 || ch > 0x7e) fail(path, entry + " has a name with non-printable bytes");
     const std::string what = "field '" + name + "'";
     Field f;
     const std::uint64_t rank = in.uint(2, what);
@@ -165,16 +170,18 @@ std::map<std::string, Field> parse_header(const std::string& path, const std::ve
     }
     if (overflow || count > (std::numeric_limits<std::uint64_t>::max() / elem))
       fail(path, what + " has impossible dimensions " + shape_string(f.shape) + " (size overflows)");
-    const std::uint64_t size = count * elem;
-    if (f.offset > bytes.size() || size > bytes.size() - f.offset)
-      fail(path, what + " (" + shape_string(f.shape) + " " + dtype_name(f.dtype) + ", " + std::to_string(size) +
-                     " bytes at offset " + std::to_string(f.offset) + ") extends past the end of the file (" +
-                     std::to_string(bytes.size()) + " bytes; truncated?)");
-    f.count = static_cast<std::size_t>(count);
+    f.count = static_cast<std::size_t>(std::min<std::uint64_t>(count, std::numeric_limits<std::size_t>::max()));
+    f.bytes = count * elem;
     if (!fields.emplace(name, std::move(f)).second) fail(path, what + " appears twice in the field table");
   }
+  // Extents only once the whole table has been read, so that a file cut inside the table reads as
+  // a truncated header rather than as some field's missing data.
   for (const auto& [name, f] : fields) {
-    if (f.offset < in.pos() && f.count > 0)
+    if (f.offset > bytes.size() || f.bytes > bytes.size() - f.offset)
+      fail(path, "field '" + name + "' (" + shape_string(f.shape) + " " + dtype_name(f.dtype) + ", " +
+                     std::to_string(f.bytes) + " bytes at offset " + std::to_string(f.offset) +
+                     ") extends past the end of the file (" + std::to_string(bytes.size()) + " bytes; truncated?)");
+    if (f.offset < in.pos() && f.bytes > 0)
       fail(path, "field '" + name + "' at offset " + std::to_string(f.offset) + " overlaps the field table (which ends at byte " +
                      std::to_string(in.pos()) + ")");
   }
@@ -408,10 +415,11 @@ RglBsdf RglBsdf::read(const std::string& path) {
     g.ny = static_cast<std::size_t>(f.shape[0]);
     g.nx = static_cast<std::size_t>(f.shape[1]);
     g.v = in.floats(name, f);
-    for (std::size_t k = 0; k < g.v.size(); ++k)
-      in.check(positive ? g.v[k] > 0.0 : g.v[k] >= 0.0, std::string("field '") + name + "' has " +
-                                                              (positive ? "a non-positive" : "a negative") +
-                                                              " value at element " + std::to_string(k));
+    for (std::size_t k = 0; k < g.v.size(); ++k) {
+      if (positive ? g.v[k] > 0.0 : g.v[k] >= 0.0) continue;
+      fail(path, std::string("field '") + name + "' has " + (positive ? "a non-positive" : "a negative") +
+                     " value at element " + std::to_string(k));
+    }
   };
   read_grid("ndf", t->ndf, false);
   read_grid("sigma", t->sigma, true);  // eval divides by it
@@ -424,7 +432,7 @@ RglBsdf RglBsdf::read(const std::string& path) {
   t->vx = static_cast<std::size_t>(vndf.shape[3]);
   t->vndf_pdf = in.floats("vndf", vndf);
   for (std::size_t k = 0; k < t->vndf_pdf.size(); ++k)
-    in.check(t->vndf_pdf[k] >= 0.0, "field 'vndf' has a negative density at element " + std::to_string(k));
+    if (t->vndf_pdf[k] < 0.0) fail(path, "field 'vndf' has a negative density at element " + std::to_string(k));
   t->vndf_cond.resize(t->vndf_pdf.size());
   t->vndf_marg.resize(static_cast<std::size_t>(n_theta) * t->vy);
   for (std::size_t s = 0; s < n_theta; ++s) {
@@ -488,38 +496,43 @@ double RglBsdf::measured_ndf(double theta) const {
   return d / t_->ndf_integral;
 }
 
-std::optional<Rgb> RglBsdf::eval(const Vec3& i_in, const Vec3& o_in) const {
-  if (!(i_in.z > 0.0) || !(o_in.z > 0.0)) return Rgb(0.0);
+Rgb RglBsdf::table_value(const Vec3& p, const Vec3& q) const {
   const Tables& t = *t_;
-  const Vec3 i = glm::normalize(i_in), o = glm::normalize(o_in);
-  const Vec3 h = glm::normalize(i + o);
-
-  const double theta_i = elevation(i), phi_i = std::atan2(i.y, i.x);
+  const Vec3 h = glm::normalize(p + q);
+  const double theta_p = elevation(p), phi_p = std::atan2(p.y, p.x);
   const double theta_h = elevation(h), phi_h = std::atan2(h.y, h.x);
-  // Isotropic tables measure the half vector's azimuth from the incident plane.
-  double u_h1 = (phi_h - phi_i + kPi) / (2.0 * kPi);
+  // Isotropic tables measure the half vector's azimuth from the plane of the slice direction.
+  double u_h1 = (phi_h - phi_p + kPi) / (2.0 * kPi);
   u_h1 -= std::floor(u_h1);
   const double u_h0 = theta_to_u(theta_h);
 
-  const SliceBlend b = blend_for(t.theta_i, theta_i);
+  const SliceBlend b = blend_for(t.theta_i, theta_p);
   const std::array<double, 2> s = t.invert_vndf(b, u_h0, u_h1);
 
-  Rgb f;
+  Rgb v;
   const std::size_t plane = t.rx * t.ry;
   for (int c = 0; c < 3; ++c) {
     const auto at = [&](std::size_t slice) {
       return bilinear(t.rgb.data() + (slice * 3 + std::size_t(c)) * plane, t.rx, t.ry, s[0], s[1]);
     };
     const double a = at(b.s0);
-    f[c] = std::max(0.0, b.w1 == 0.0 ? a : a + b.w1 * (at(b.s1) - a));
+    v[c] = std::max(0.0, b.w1 == 0.0 ? a : a + b.w1 * (at(b.s1) - a));
   }
-  double scale = 1.0;
-  if (t.jacobian) {
-    const double u_i1 = (phi_i + kPi) / (2.0 * kPi);
-    scale = bilinear(t.ndf, u_h0, u_h1) / (4.0 * bilinear(t.sigma, theta_to_u(theta_i), u_i1));
+  if (!t.jacobian) return v;
+  const double u_p1 = (phi_p + kPi) / (2.0 * kPi);
+  return v * (bilinear(t.ndf, u_h0, u_h1) / (4.0 * bilinear(t.sigma, theta_to_u(theta_p), u_p1)));
+}
+
+std::optional<Rgb> RglBsdf::eval(const Vec3& i_in, const Vec3& o_in) const {
+  if (!(i_in.z > 0.0) || !(o_in.z > 0.0)) return Rgb(0.0);
+  const Vec3 i = glm::normalize(i_in), o = glm::normalize(o_in);
+  switch (slices_) {
+    case Slices::light: return table_value(i, o) / o.z;
+    case Slices::view: return table_value(o, i) / i.z;
+    case Slices::symmetric: break;
   }
-  // The table holds f cos(theta_o).
-  return f * (scale / o.z);
+  // Each one-sided value is f times the other cosine, so their sum is f (cos i + cos o).
+  return (table_value(i, o) + table_value(o, i)) / (i.z + o.z);
 }
 
 }  // namespace facetfit

@@ -1,19 +1,18 @@
 // RGL EPFL material database `.bsdf` files: Dupuy & Jakob 2018, "An Adaptive Parameterization for
-// Efficient Material Acquisition and Rendering" (the tensor files read by Mitsuba's `measured` BSDF).
+// Efficient Material Acquisition and Rendering" (the tensor files of Mitsuba's `measured` BSDF).
 //
-// The measurement is not stored per direction pair: for each incident elevation theta_i it is stored
-// on a 2D "sample space" [0,1]^2 that the material's own visible-normal distribution (VNDF) warps onto
-// half vectors. Evaluating f(i, o) therefore inverts that warp: h = normalize(i + o) in the unit
-// coordinates u = (sqrt(theta_h / (pi/2)), (phi_h - phi_i + pi) / 2pi) is mapped back to the sample
-// (s0, s1) whose warp lands on it, and the RGB table is read there. Following Mitsuba's `measured`
-// eval (and RGL's reference loader powitacq_rgb), the product
+// The measurement is not stored per direction pair. For each elevation theta_i of one direction p it
+// lives on a "sample square" [0,1]^2 that the material's own visible-normal distribution (VNDF)
+// warps onto half vectors. So evaluating T(p, q) inverts that warp: the half vector h of p and q, in
+// the unit coordinates u = (sqrt(theta_h / (pi/2)), (phi_h - phi_p + pi) / 2pi), goes back to the
+// point s of the square whose warp lands on it, and the RGB table is read at s, linearly between
+// the two bracketing theta_i slices. As in Mitsuba's `measured` eval and RGL's powitacq_rgb loader,
 //
-//   rgb(theta_i, s) * ndf(u_h) / (4 sigma(u_i))  =  f(i, o) cos(theta_o)
+//   T(p, q) = rgb(theta_p, s) * ndf(u_h) / (4 sigma(u_p))  =  f(p, q) cos(theta_q),
 //
-// already contains the cosine of the direction that is not the table parameter, so f is that product
-// divided by cos(theta_o). The file's theta_i axis is indexed by our i (toward the light). Mitsuba's
-// renderer puts its camera-side direction there instead; a reciprocal material cannot tell the two
-// apart, and the measured files are reciprocal to within a few percent (tests/test_rgl.cpp).
+// the cosine being that of the direction which does not pick the slices (powitacq_rgb documents its
+// eval as "f_r * cos"; the data agree: dividing by the other cosine instead breaks reciprocity by
+// ~90%, and the white paper's albedo comes out 0.82 at normal incidence, f = 0.28/sr).
 //
 // Only isotropic files (phi_i with a single entry) are supported. Negative (out-of-gamut) RGB values
 // of the colour-converted spectra are clipped to zero, as powitacq_rgb does.
@@ -32,9 +31,21 @@ class RglBsdf final : public Brdf {
   // isotropic RGB tensor file. Every size in the header is checked before it is trusted.
   static RglBsdf read(const std::string& path);
 
+  // Which direction picks the theta_i slices. A one-sided estimate divides T by a cosine that
+  // vanishes at the horizon, where the tables' interpolation floor (about 1% of the diffuse level)
+  // becomes spikes of hundreds per steradian. The default weighs the two one-sided estimates by
+  // those cosines: bounded unless both directions graze, and reciprocal by construction.
+  enum class Slices {
+    symmetric,  // both: (T(i,o) + T(o,i)) / (cos i + cos o); reciprocal, bounded unless both graze
+    light,      // i, as the file's name theta_i suggests: T(i,o) / cos o
+    view,       // o, as Mitsuba renders it (its wi is the camera side): T(o,i) / cos i
+  };
+
   // f(i, o) in 1/sr, RGB; zero when either direction is not strictly above the horizon. The table
   // covers the whole hemisphere, so there is always an answer.
   std::optional<Rgb> eval(const Vec3& i, const Vec3& o) const override;
+  Slices slices() const { return slices_; }
+  void set_slices(Slices slices) { slices_ = slices; }
 
   // The `description` field: material name and provider.
   const std::string& description() const;
@@ -53,9 +64,12 @@ class RglBsdf final : public Brdf {
  private:
   struct Tables;
   explicit RglBsdf(std::shared_ptr<const Tables> tables);
+  // T(p, q) = f(p, q) cos(theta_q) from the slices of direction p; both above the horizon, unit.
+  Rgb table_value(const Vec3& p, const Vec3& q) const;
 
   // Immutable once read: copies share it, and const eval needs no locking.
   std::shared_ptr<const Tables> t_;
+  Slices slices_ = Slices::symmetric;
 };
 
 }  // namespace facetfit

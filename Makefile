@@ -1,0 +1,43 @@
+# facetfit: the two commands of the README, and the maintenance targets.
+#   make demo   install what is missing, build, fit the built-in material set
+#   make test   install what is missing, build, run every test (and the unit and stress tests under ASan+UBSan)
+
+BUILD      ?= build/release
+ASAN_BUILD ?= build/asan
+JOBS       ?= $(shell nproc)
+CMAKE_GEN  := -G Ninja
+
+.PHONY: all deps build demo test asan bench accuracy clean
+
+all: build
+
+deps:
+	@scripts/install-deps.sh
+
+build: deps
+	@cmake -S . -B $(BUILD) $(CMAKE_GEN) -DCMAKE_BUILD_TYPE=Release -DFACETFIT_WERROR=ON >/dev/null
+	@cmake --build $(BUILD) -j $(JOBS)
+
+demo: build
+	$(BUILD)/bin/facetfit fit --builtin
+
+asan: deps
+	@cmake -S . -B $(ASAN_BUILD) $(CMAKE_GEN) -DCMAKE_BUILD_TYPE=RelWithDebInfo -DFACETFIT_SANITIZE=ON \
+	  -DFACETFIT_BUILD_TOOLS=OFF -DFACETFIT_WERROR=ON >/dev/null
+	@cmake --build $(ASAN_BUILD) -j $(JOBS) --target facetfit_unit_tests facetfit_stress_tests
+
+test: build asan
+	cd $(BUILD) && ctest --output-on-failure -j $(JOBS)
+	cd $(ASAN_BUILD) && ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1 \
+	  ctest --output-on-failure -j $(JOBS) -L 'unit|stress'
+
+# Regenerates docs/benchmarks.md (Google Benchmark, this machine).
+bench: build
+	scripts/bench.sh $(BUILD)
+
+# Regenerates docs/accuracy.md (ground-truth fits).
+accuracy: build
+	$(BUILD)/bench/facetfit_accuracy docs/accuracy.md
+
+clean:
+	rm -rf build

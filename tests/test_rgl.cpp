@@ -1,0 +1,569 @@
+// RglBsdf: the reader's validation on synthetic and corrupted tensor files, the evaluator against a
+// synthetic material whose answer is known in closed form, and the six real database files.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <random>
+#include <string>
+#include <thread>
+#include <type_traits>
+#include <vector>
+
+#include "core/error.h"
+#include "io/rgl.h"
+
+namespace facetfit {
+namespace {
+
+namespace fs = std::filesystem;
+
+static_assert(std::is_nothrow_move_constructible_v<RglBsdf>);
+static_assert(std::is_move_assignable_v<RglBsdf>);
+
+// ---------------------------------------------------------------------------------------------
+// Data location and scratch files
+
+// FACETFIT_RGL_DIR overrides; otherwise ../shared/data/rgl next to the source tree.
+fs::path rgl_dir() {
+  if (const char* env = std::getenv("FACETFIT_RGL_DIR"); env && *env) return env;
+#ifdef FACETFIT_SOURCE_DIR
+  return fs::path(FACETFIT_SOURCE_DIR) / ".." / "shared" / "data" / "rgl";
+#else
+  return fs::path(__FILE__).parent_path().parent_path() / ".." / "shared" / "data" / "rgl";
+#endif
+}
+
+struct RealFile {
+  const char* name;
+  const char* description_start;
+};
+constexpr RealFile kRealFiles[] = {
+    {"ilm_l3_37_metallic_rgb.bsdf", "Metallic paint from L3-37"},
+    {"paper_white_rgb.bsdf", "White A4 paper"},
+    {"satin_rosaline_rgb.bsdf", "TeckWrap vinyl wrapping film (Rosaline"},
+    {"cc_ibiza_sunset_rgb.bsdf", "TeckWrap vinyl wrapping film (Ibiza"},
+    {"vch_golden_yellow_rgb.bsdf", "TeckWrap vinyl wrapping film (Golden"},
+    {"acrylic_felt_green_rgb.bsdf", "Green acrylic felt"},
+};
+
+#define REQUIRE_RGL_DATA()                                                                             \
+  do {                                                                                                 \
+    if (!fs::is_directory(rgl_dir()))                                                                  \
+      GTEST_SKIP() << "RGL data folder " << rgl_dir().string()                                         \
+                   << " is absent (set FACETFIT_RGL_DIR to the folder holding the .bsdf files)";       \
+  } while (0)
+
+std::string real_path(const RealFile& f) { return (rgl_dir() / f.name).string(); }
+
+std::vector<unsigned char> read_bytes(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+class ScratchDir : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    std::random_device rd;
+    dir_ = fs::temp_directory_path() / ("facetfit_rgl_" + std::to_string(rd()) + std::to_string(rd()));
+    fs::create_directories(dir_);
+  }
+  void TearDown() override {
+    std::error_code ec;
+    fs::remove_all(dir_, ec);
+  }
+
+  std::string write(const std::string& name, const std::vector<unsigned char>& bytes) const {
+    const fs::path p = dir_ / name;
+    std::ofstream out(p, std::ios::binary);
+    out.write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
+    return p.string();
+  }
+
+  // read() must fail with one line "<path>: ...", the problem mentioning `needle`.
+  static void expect_error(const std::string& path, const std::string& needle) {
+    try {
+      RglBsdf::read(path);
+      ADD_FAILURE() << path << ": read() accepted a bad file (expected \"" << needle << "\")";
+    } catch (const Error& e) {
+      const std::string msg = e.what();
+      EXPECT_EQ(msg.rfind(path + ": ", 0), 0u) << "message does not start with the path: " << msg;
+      EXPECT_EQ(msg.find('\n'), std::string::npos) << "message is not one line: " << msg;
+      EXPECT_NE(msg.find(needle), std::string::npos) << "expected \"" << needle << "\" in: " << msg;
+    }
+  }
+
+  fs::path dir_;
+};
+
+// ---------------------------------------------------------------------------------------------
+// A tensor-file writer for synthetic materials
+
+constexpr std::uint8_t kU8 = 1, kF32 = 10, kF64 = 11;
+
+struct TField {
+  std::string name;
+  std::uint8_t dtype;
+  std::vector<std::uint64_t> shape;
+  std::vector<unsigned char> payload;
+  std::uint64_t offset_override = 0;  // nonzero: written instead of the true offset
+};
+
+TField f32(const std::string& name, std::vector<std::uint64_t> shape, const std::vector<float>& v) {
+  TField f{name, kF32, std::move(shape), std::vector<unsigned char>(v.size() * 4)};
+  std::memcpy(f.payload.data(), v.data(), f.payload.size());  // test hosts are little-endian
+  return f;
+}
+
+TField u8(const std::string& name, std::vector<std::uint64_t> shape, const std::vector<unsigned char>& v) {
+  return TField{name, kU8, std::move(shape), v};
+}
+
+void put(std::vector<unsigned char>& out, std::uint64_t v, int bytes) {
+  for (int k = 0; k < bytes; ++k) out.push_back(static_cast<unsigned char>(v >> (8 * k)));
+}
+
+std::vector<unsigned char> serialize(const std::vector<TField>& fields, unsigned char major = 1, unsigned char minor = 0) {
+  std::vector<unsigned char> out = {'t', 'e', 'n', 's', 'o', 'r', '_', 'f', 'i', 'l', 'e', '\0', major, minor};
+  put(out, fields.size(), 4);
+  std::size_t table = out.size();
+  for (const TField& f : fields) table += 2 + f.name.size() + 2 + 1 + 8 + 8 * f.shape.size();
+  std::size_t at = (table + 7) / 8 * 8;
+  std::vector<std::size_t> offsets;
+  for (const TField& f : fields) {
+    offsets.push_back(at);
+    at = (at + f.payload.size() + 7) / 8 * 8;
+  }
+  for (std::size_t k = 0; k < fields.size(); ++k) {
+    const TField& f = fields[k];
+    put(out, f.name.size(), 2);
+    out.insert(out.end(), f.name.begin(), f.name.end());
+    put(out, f.shape.size(), 2);
+    put(out, f.dtype, 1);
+    put(out, f.offset_override ? f.offset_override : offsets[k], 8);
+    for (const std::uint64_t n : f.shape) put(out, n, 8);
+  }
+  for (std::size_t k = 0; k < fields.size(); ++k) {
+    out.resize(offsets[k], 0);
+    out.insert(out.end(), fields[k].payload.begin(), fields[k].payload.end());
+  }
+  out.resize(at, 0);
+  return out;
+}
+
+// The synthetic material, chosen so that every stage has a closed form:
+//  - ndf and sigma are constant (D = 1/pi integrates to 1 against cos), so ndf / (4 sigma) = 1/(4 pi);
+//  - the VNDF density of slice k is (1 + a_k x)(1 + y) over the half-vector square (x the theta
+//    axis), which bilinear interpolation reproduces exactly; its inverse warp is the pair of
+//    normalized CDFs F_a(x) = (x + a x^2 / 2) / (1 + a / 2) and (y + y^2 / 2) / 1.5, and between
+//    slices the normalized CDFs blend linearly, as Mitsuba's conditioned Marginal2D does;
+//  - rgb is (s0, s1, theta_i of the slice), so eval exposes the inverse warp and the slice weights.
+constexpr std::uint64_t kNx = 5, kNy = 4, kRx = 6, kRy = 5;
+const std::vector<float> kSynthThetaI = {0.0f, float(kPi / 4), float(kPi / 2)};
+constexpr double kSlope[3] = {3.0, 0.0, 1.0};
+
+std::vector<TField> synthetic_fields() {
+  const std::uint64_t nt = kSynthThetaI.size();
+  std::vector<float> vndf, rgb;
+  for (std::uint64_t s = 0; s < nt; ++s)
+    for (std::uint64_t y = 0; y < kNy; ++y)
+      for (std::uint64_t x = 0; x < kNx; ++x)
+        vndf.push_back(float((1.0 + kSlope[s] * double(x) / double(kNx - 1)) * (1.0 + double(y) / double(kNy - 1))));
+  for (std::uint64_t s = 0; s < nt; ++s)
+    for (int c = 0; c < 3; ++c)
+      for (std::uint64_t y = 0; y < kRy; ++y)
+        for (std::uint64_t x = 0; x < kRx; ++x)
+          rgb.push_back(c == 0 ? float(double(x) / double(kRx - 1)) : c == 1 ? float(double(y) / double(kRy - 1)) : kSynthThetaI[s]);
+  const std::string desc = "Synthetic test material";
+  return {
+      u8("description", {desc.size()}, std::vector<unsigned char>(desc.begin(), desc.end())),
+      f32("phi_i", {1}, {0.0f}),
+      f32("theta_i", {nt}, kSynthThetaI),
+      f32("ndf", {2, 7}, std::vector<float>(14, float(kInvPi))),
+      f32("sigma", {2, 7}, std::vector<float>(14, 1.0f)),
+      f32("vndf", {1, nt, kNy, kNx}, vndf),
+      f32("luminance", {1, nt, kRy, kRx}, std::vector<float>(nt * kRy * kRx, 0.5f)),
+      f32("rgb", {1, nt, 3, kRy, kRx}, rgb),
+      u8("jacobian", {1}, {1}),
+  };
+}
+
+TField& field(std::vector<TField>& fields, const std::string& name) {
+  return *std::find_if(fields.begin(), fields.end(), [&](const TField& f) { return f.name == name; });
+}
+
+// T(p, q) = f cos(theta_q) of the synthetic material with p picking the slices.
+Rgb synthetic_table(const Vec3& p, const Vec3& q) {
+  const Vec3 h = glm::normalize(p + q);
+  const double x = std::sqrt(std::acos(clamp(h.z, -1.0, 1.0)) / (0.5 * kPi));
+  double y = (std::atan2(h.y, h.x) - std::atan2(p.y, p.x) + kPi) / (2.0 * kPi);
+  y -= std::floor(y);
+  const double theta_p = std::acos(clamp(p.z, -1.0, 1.0));
+  const int k = theta_p < kPi / 4 ? 0 : 1;
+  const double w = (theta_p - k * kPi / 4) / (kPi / 4);
+  const auto cdf = [x](double a) { return (x + 0.5 * a * x * x) / (1.0 + 0.5 * a); };
+  const double s0 = (1.0 - w) * cdf(kSlope[k]) + w * cdf(kSlope[k + 1]);
+  const double s1 = (y + 0.5 * y * y) / 1.5;
+  return Rgb(s0, s1, theta_p) * (kInvPi / 4.0);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Synthetic files: the evaluator
+
+class RglSynthetic : public ScratchDir {};
+
+TEST_F(RglSynthetic, EvalMatchesClosedForm) {
+  const std::string path = write("synthetic.bsdf", serialize(synthetic_fields()));
+  RglBsdf b = RglBsdf::read(path);
+  EXPECT_EQ(b.description(), "Synthetic test material");
+  EXPECT_TRUE(b.jacobian());
+
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> theta(0.0, 0.49 * kPi), phi(-kPi, kPi);
+  for (int n = 0; n < 500; ++n) {
+    const Vec3 i = spherical_direction(theta(rng), phi(rng)), o = spherical_direction(theta(rng), phi(rng));
+    const Rgb t_io = synthetic_table(i, o), t_oi = synthetic_table(o, i);
+    const Rgb want[3] = {(t_io + t_oi) / (i.z + o.z), t_io / o.z, t_oi / i.z};
+    const RglBsdf::Slices modes[3] = {RglBsdf::Slices::symmetric, RglBsdf::Slices::light, RglBsdf::Slices::view};
+    for (int m = 0; m < 3; ++m) {
+      b.set_slices(modes[m]);
+      const Rgb got = *b.eval(i, o);
+      for (int c = 0; c < 3; ++c)
+        ASSERT_NEAR(got[c], want[m][c], 1e-6 * (1.0 + want[m][c])) << "mode " << m << " channel " << c;
+    }
+  }
+}
+
+TEST_F(RglSynthetic, BelowHorizonIsZeroAndNdfIsNormalized) {
+  const RglBsdf b = RglBsdf::read(write("synthetic.bsdf", serialize(synthetic_fields())));
+  const Vec3 up(0, 0, 1), down = spherical_direction(0.6 * kPi, 0.3), flat(1, 0, 0);
+  EXPECT_EQ(*b.eval(up, down), Rgb(0.0));
+  EXPECT_EQ(*b.eval(down, up), Rgb(0.0));
+  EXPECT_EQ(*b.eval(flat, up), Rgb(0.0));
+  EXPECT_NEAR(b.measured_ndf(0.0), kInvPi, 1e-6);
+  EXPECT_NEAR(b.measured_ndf(1.0), kInvPi, 1e-6);
+  EXPECT_EQ(b.measured_ndf(-0.1), 0.0);
+  EXPECT_EQ(b.measured_ndf(2.0), 0.0);
+  EXPECT_NEAR(b.measured_ndf_stored_integral(), 1.0, 1e-6);
+}
+
+TEST_F(RglSynthetic, CopiesShareTablesAndMovesWork) {
+  RglBsdf a = RglBsdf::read(write("synthetic.bsdf", serialize(synthetic_fields())));
+  const Vec3 i = spherical_direction(0.3, 0.1), o = spherical_direction(0.7, 2.0);
+  const Rgb ref = *a.eval(i, o);
+  RglBsdf copy = a;
+  copy.set_slices(RglBsdf::Slices::light);  // per-object setting, tables shared
+  EXPECT_EQ(*a.eval(i, o), ref);
+  RglBsdf moved = std::move(a);
+  EXPECT_EQ(*moved.eval(i, o), ref);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Synthetic files: validation
+
+class RglBadFile : public ScratchDir {};
+
+TEST_F(RglBadFile, FilesystemProblems) {
+  expect_error((dir_ / "no_such.bsdf").string(), "no such file");
+  fs::create_directories(dir_ / "folder.bsdf");
+  expect_error((dir_ / "folder.bsdf").string(), "is a folder");
+  expect_error(write("empty.bsdf", {}), "file is empty");
+}
+
+TEST_F(RglBadFile, Preamble) {
+  const std::vector<unsigned char> good = serialize(synthetic_fields());
+  expect_error(write("short.bsdf", {good.begin(), good.begin() + 10}), "truncated header");
+
+  std::vector<unsigned char> bad = good;
+  bad[0] = 'T';
+  expect_error(write("magic.bsdf", bad), "not a tensor file");
+  const std::string png = "\x89PNG\r\n\x1a\n and then some more bytes";
+  expect_error(write("png.bsdf", {png.begin(), png.end()}), "not a tensor file");
+
+  expect_error(write("version.bsdf", serialize(synthetic_fields(), 2, 0)), "unsupported tensor file version 2.0");
+
+  bad = good;
+  bad[14] = bad[15] = bad[16] = bad[17] = 0xff;  // 4 billion fields
+  expect_error(write("count.bsdf", bad), "header claims 4294967295 fields");
+}
+
+TEST_F(RglBadFile, Truncation) {
+  const std::vector<unsigned char> good = serialize(synthetic_fields());
+  // Inside the field table, and inside the arrays.
+  expect_error(write("table.bsdf", {good.begin(), good.begin() + 250}), "truncated header");
+  expect_error(write("arrays.bsdf", {good.begin(), good.end() - 16}), "extends past the end of the file");
+}
+
+TEST_F(RglBadFile, FieldTable) {
+  auto fields = synthetic_fields();
+  field(fields, "rgb").offset_override = std::uint64_t(1) << 40;
+  expect_error(write("offset.bsdf", serialize(fields)), "field 'rgb'");
+  expect_error(write("offset.bsdf", serialize(fields)), "extends past the end of the file");
+
+  fields = synthetic_fields();
+  field(fields, "vndf").shape = {1, 3, std::uint64_t(1) << 40, std::uint64_t(1) << 40};
+  expect_error(write("overflow.bsdf", serialize(fields)), "field 'vndf' has impossible dimensions");
+
+  fields = synthetic_fields();
+  field(fields, "ndf").shape = {2, std::uint64_t(1) << 32};  // no overflow, just far too big
+  expect_error(write("huge.bsdf", serialize(fields)), "extends past the end of the file");
+
+  fields = synthetic_fields();
+  field(fields, "sigma").dtype = 42;
+  expect_error(write("dtype.bsdf", serialize(fields)), "field 'sigma' has unknown dtype 42");
+
+  fields = synthetic_fields();
+  field(fields, "sigma").shape = {2, 7, 1, 1, 1, 1, 1, 1, 1};
+  expect_error(write("rank.bsdf", serialize(fields)), "claims 9 dimensions");
+
+  fields = synthetic_fields();
+  field(fields, "theta_i").offset_override = 8;
+  expect_error(write("overlap.bsdf", serialize(fields)), "overlaps the field table");
+
+  fields = synthetic_fields();
+  field(fields, "ndf").name = "nd\nf";
+  expect_error(write("name.bsdf", serialize(fields)), "non-printable");
+
+  fields = synthetic_fields();
+  fields.push_back(fields[1]);
+  expect_error(write("twice.bsdf", serialize(fields)), "field 'phi_i' appears twice");
+}
+
+TEST_F(RglBadFile, Contents) {
+  auto fields = synthetic_fields();
+  fields.erase(std::find_if(fields.begin(), fields.end(), [](const TField& f) { return f.name == "rgb"; }));
+  expect_error(write("missing.bsdf", serialize(fields)), "required field 'rgb' is missing");
+
+  fields = synthetic_fields();
+  field(fields, "rgb").dtype = kF64;
+  field(fields, "rgb").shape[4] /= 2;  // same byte size as float64
+  expect_error(write("f64.bsdf", serialize(fields)), "field 'rgb' is float64, expected float32");
+
+  // vndf with two theta_i slices where theta_i has three.
+  fields = synthetic_fields();
+  TField& v = field(fields, "vndf");
+  v.shape[1] = 2;
+  v.payload.resize(v.payload.size() * 2 / 3);
+  expect_error(write("mismatch.bsdf", serialize(fields)), "field 'vndf' has shape 1 x 2 x 4 x 5, expected 1 x 3");
+
+  fields = synthetic_fields();
+  const float nan = std::nanf("");
+  std::memcpy(field(fields, "vndf").payload.data() + 4 * 17, &nan, 4);
+  expect_error(write("nan.bsdf", serialize(fields)), "field 'vndf' has a NaN at element 17");
+
+  fields = synthetic_fields();
+  field(fields, "sigma") = f32("sigma", {2, 7}, std::vector<float>(14, 0.0f));
+  expect_error(write("sigma0.bsdf", serialize(fields)), "field 'sigma' has a non-positive value");
+
+  fields = synthetic_fields();
+  field(fields, "vndf") = f32("vndf", {1, 3, kNy, kNx}, std::vector<float>(3 * kNy * kNx, 0.0f));
+  expect_error(write("novndf.bsdf", serialize(fields)), "has no mass");
+
+  fields = synthetic_fields();
+  field(fields, "theta_i") = f32("theta_i", {3}, {0.0f, 1.0f, 0.5f});
+  expect_error(write("order.bsdf", serialize(fields)), "not strictly increasing");
+
+  fields = synthetic_fields();
+  field(fields, "phi_i") = f32("phi_i", {4}, {0.0f, 0.5f, 1.0f, 1.5f});
+  expect_error(write("aniso.bsdf", serialize(fields)), "anisotropic RGL files are not supported yet");
+}
+
+// ---------------------------------------------------------------------------------------------
+// The real database files
+
+// integral f(i, o) cos(theta_o) d(omega_o) per channel, midpoint rule in u = sqrt(theta / (pi/2)).
+Rgb albedo(const RglBsdf& b, const Vec3& i) {
+  constexpr int kTheta = 256, kPhi = 128;
+  Rgb sum(0.0);
+  for (int k = 0; k < kTheta; ++k) {
+    const double u = (k + 0.5) / kTheta, th = 0.5 * kPi * u * u;
+    const double w = std::cos(th) * std::sin(th) * (kPi * u / kTheta) * (2.0 * kPi / kPhi);
+    for (int m = 0; m < kPhi; ++m) sum += *b.eval(i, spherical_direction(th, (m + 0.5) / kPhi * 2.0 * kPi)) * w;
+  }
+  return sum;
+}
+
+TEST(RglReal, LoadAndEvalFiniteNonNegativeIncludingGrazing) {
+  REQUIRE_RGL_DATA();
+  const double degrees[] = {0, 1, 5, 15, 30, 45, 60, 70, 80, 85, 88, 89, 89.9, 89.99};
+  for (const RealFile& f : kRealFiles) {
+    SCOPED_TRACE(f.name);
+    RglBsdf b = RglBsdf::read(real_path(f));
+    EXPECT_EQ(b.description().rfind(f.description_start, 0), 0u) << b.description();
+    EXPECT_TRUE(b.jacobian());
+    for (const auto mode : {RglBsdf::Slices::symmetric, RglBsdf::Slices::light, RglBsdf::Slices::view}) {
+      b.set_slices(mode);
+      for (const double ti : degrees)
+        for (const double to : degrees)
+          for (const double phi : {0.0, 0.5, 1.5, 2.5, kPi}) {
+            const Vec3 i = spherical_direction(ti * kPi / 180.0, 0.2), o = spherical_direction(to * kPi / 180.0, 0.2 + phi);
+            const auto v = b.eval(i, o);
+            ASSERT_TRUE(v.has_value());
+            for (int c = 0; c < 3; ++c)
+              ASSERT_TRUE(std::isfinite((*v)[c]) && (*v)[c] >= 0.0)
+                  << "f = " << (*v)[c] << " at theta_i " << ti << ", theta_o " << to << ", dphi " << phi;
+          }
+    }
+    EXPECT_EQ(*b.eval(Vec3(0, 0, 1), spherical_direction(1.6, 0.0)), Rgb(0.0));
+  }
+}
+
+TEST(RglReal, Reciprocity) {
+  REQUIRE_RGL_DATA();
+  for (const RealFile& f : kRealFiles) {
+    SCOPED_TRACE(f.name);
+    RglBsdf b = RglBsdf::read(real_path(f));
+    // The data's own reciprocity: light-sliced f(i, o) against view-sliced f(i, o) = light-sliced
+    // f(o, i), projected-solid-angle weighted, both directions within 80 degrees of the normal.
+    double diff = 0.0, mean = 0.0, worst_sym = 0.0;
+    for (int ti = 1; ti <= 80; ti += 3)
+      for (int to = 1; to <= 80; to += 3)
+        for (int p = 0; p < 24; ++p) {
+          const Vec3 i = spherical_direction(ti * kPi / 180.0, 0.0), o = spherical_direction(to * kPi / 180.0, p * kPi / 24.0);
+          b.set_slices(RglBsdf::Slices::light);
+          const double fl = luminance(*b.eval(i, o));
+          b.set_slices(RglBsdf::Slices::view);
+          const double fv = luminance(*b.eval(i, o));
+          const double w = i.z * o.z * std::sin(ti * kPi / 180.0) * std::sin(to * kPi / 180.0);
+          diff += w * std::abs(fl - fv);
+          mean += w * 0.5 * (fl + fv);
+          b.set_slices(RglBsdf::Slices::symmetric);
+          const double a = luminance(*b.eval(i, o)), r = luminance(*b.eval(o, i));
+          worst_sym = std::max(worst_sym, std::abs(a - r) / std::max(1e-300, a + r));
+        }
+    const double asym = diff / mean;
+    std::printf("[ reciprocity ] %-28s weighted |f(i,o) - f(o,i)| / f = %.3f\n", f.name, asym);
+    EXPECT_LT(worst_sym, 1e-12);  // by construction
+    // Glossy films: ~0.1-0.25 (sharp peaks, 8 theta_i slices); diffuse: ~0.02.
+    EXPECT_LT(asym, 0.35);
+    if (std::string(f.name) == "paper_white_rgb.bsdf" || std::string(f.name) == "acrylic_felt_green_rgb.bsdf") {
+      EXPECT_LT(asym, 0.05);
+    }
+  }
+}
+
+TEST(RglReal, MeasuredNdfIntegratesToOne) {
+  REQUIRE_RGL_DATA();
+  for (const RealFile& f : kRealFiles) {
+    SCOPED_TRACE(f.name);
+    const RglBsdf b = RglBsdf::read(real_path(f));
+    // Independent quadrature: midpoint rule in theta, much finer than the table.
+    constexpr int kSteps = 200000;
+    double sum = 0.0;
+    for (int k = 0; k < kSteps; ++k) {
+      const double th = (k + 0.5) / kSteps * 0.5 * kPi;
+      sum += b.measured_ndf(th) * std::cos(th) * std::sin(th);
+    }
+    const double integral = 2.0 * kPi * sum * (0.5 * kPi / kSteps);
+    std::printf("[ ndf ] %-28s integral D cos = %.6f (stored table %.4f), D(0) = %.4g /sr\n", f.name, integral,
+                b.measured_ndf_stored_integral(), b.measured_ndf(0.0));
+    EXPECT_NEAR(integral, 1.0, 1e-4);
+    EXPECT_NEAR(b.measured_ndf_stored_integral(), 1.0, 0.02);
+    EXPECT_GT(b.measured_ndf(0.0), 0.0);
+  }
+}
+
+TEST(RglReal, PhysicalMagnitudes) {
+  REQUIRE_RGL_DATA();
+  for (const RealFile& f : kRealFiles) {
+    SCOPED_TRACE(f.name);
+    const RglBsdf b = RglBsdf::read(real_path(f));
+    const Vec3 n(0, 0, 1);
+    const Rgb a = albedo(b, n), fn = *b.eval(n, n);
+    double peak = 0.0, peak_at = 0.0;
+    for (double t = 0.0; t <= 80.0; t += 0.5) {
+      const Vec3 k = spherical_direction(t * kPi / 180.0, 0.3);
+      const double v = luminance(*b.eval(k, k));
+      if (v > peak) peak = v, peak_at = t;
+    }
+    std::printf("[ sanity ] %-28s albedo(normal) %.3f %.3f %.3f | f(n,n) cos %.3f %.3f %.3f /sr | "
+                "backscatter peak f(k,k) %.3f /sr at %.1f deg\n",
+                f.name, a.r, a.g, a.b, fn.r, fn.g, fn.b, peak, peak_at);
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_GE(a[c], 0.0);
+      EXPECT_LT(a[c], 1.02) << "channel " << c << " reflects more than it receives";
+    }
+    EXPECT_GT(luminance(a), 0.05);
+  }
+  // White paper: near-Lambertian, albedo ~0.8, so f ~ 0.27/sr.
+  const RglBsdf paper = RglBsdf::read((rgl_dir() / "paper_white_rgb.bsdf").string());
+  EXPECT_NEAR(luminance(albedo(paper, Vec3(0, 0, 1))), 0.83, 0.08);
+  EXPECT_NEAR(luminance(*paper.eval(Vec3(0, 0, 1), spherical_direction(0.5, 1.0))), 0.27, 0.04);
+}
+
+TEST(RglReal, ConcurrentEvalMatchesSerial) {
+  REQUIRE_RGL_DATA();
+  const RglBsdf b = RglBsdf::read(real_path(kRealFiles[0]));
+  std::vector<std::pair<Vec3, Vec3>> pairs;
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> th(0.0, 0.5 * kPi), ph(-kPi, kPi);
+  for (int n = 0; n < 4000; ++n) pairs.emplace_back(spherical_direction(th(rng), ph(rng)), spherical_direction(th(rng), ph(rng)));
+  std::vector<Rgb> serial, parallel(pairs.size());
+  for (const auto& [i, o] : pairs) serial.push_back(*b.eval(i, o));
+  std::vector<std::thread> threads;
+  for (std::size_t t = 0; t < 4; ++t)
+    threads.emplace_back([&, t] {
+      for (std::size_t n = t; n < pairs.size(); n += 4) parallel[n] = *b.eval(pairs[n].first, pairs[n].second);
+    });
+  for (auto& t : threads) t.join();
+  EXPECT_EQ(serial, parallel);
+}
+
+// Corrupted copies of a real file.
+class RglRealCorrupt : public ScratchDir {
+ protected:
+  // Byte position of `name`'s table entry just past its name (at its rank), walking the real header.
+  static std::size_t entry(const std::vector<unsigned char>& b, const std::string& name) {
+    std::size_t p = 18;
+    const std::uint32_t n = b[14] | b[15] << 8 | b[16] << 16 | std::uint32_t(b[17]) << 24;
+    for (std::uint32_t k = 0; k < n; ++k) {
+      const std::size_t len = b[p] | b[p + 1] << 8;
+      const std::string field(reinterpret_cast<const char*>(&b[p + 2]), len);
+      p += 2 + len;
+      if (field == name) return p;
+      p += 2 + 1 + 8 + 8 * std::size_t(b[p] | b[p + 1] << 8);
+    }
+    ADD_FAILURE() << "no field " << name;
+    return 0;
+  }
+  static void put64(std::vector<unsigned char>& b, std::size_t at, std::uint64_t v) {
+    for (int k = 0; k < 8; ++k) b[at + k] = static_cast<unsigned char>(v >> (8 * k));
+  }
+};
+
+TEST_F(RglRealCorrupt, TruncatedMagicOffsetDims) {
+  REQUIRE_RGL_DATA();
+  const std::vector<unsigned char> good = read_bytes(rgl_dir() / "paper_white_rgb.bsdf");
+  ASSERT_GT(good.size(), 100000u);
+
+  expect_error(write("truncated.bsdf", {good.begin(), good.begin() + good.size() / 2}), "extends past the end of the file");
+  expect_error(write("header_only.bsdf", {good.begin(), good.begin() + 300}), "truncated header");
+  expect_error(write("preamble_only.bsdf", {good.begin(), good.begin() + 40}), "header claims 11 fields");
+
+  std::vector<unsigned char> bad = good;
+  std::memcpy(bad.data(), "tensor_fild", 11);
+  expect_error(write("magic.bsdf", bad), "not a tensor file");
+
+  bad = good;
+  put64(bad, entry(bad, "rgb") + 3, good.size() + 8);
+  expect_error(write("offset.bsdf", bad), "field 'rgb'");
+
+  bad = good;
+  put64(bad, entry(bad, "vndf") + 3 + 8 + 16, std::uint64_t(1) << 62);  // vndf rows
+  expect_error(write("dims.bsdf", bad), "field 'vndf' has impossible dimensions");
+
+  bad = good;
+  put64(bad, entry(bad, "phi_i") + 3 + 8, 1 << 20);
+  expect_error(write("phi.bsdf", bad), "field 'phi_i'");
+
+  EXPECT_NO_THROW(RglBsdf::read(write("copy.bsdf", good)));
+}
+
+}  // namespace
+}  // namespace facetfit
