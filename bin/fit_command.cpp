@@ -92,7 +92,7 @@ void run_fit(const FitArgs& args, int& status) {
       if (args.json)
         std::printf("%s\n", fit_json(source, result, seconds).dump().c_str());
       else
-        print_row(args.builtin || source.rfind(kBuiltinPrefix, 0) == 0 ? source_name(source) : source, result, seconds);
+        print_row(source_name(source), result, seconds);
       std::fflush(stdout);
     } catch (const Error& e) {
       report_error(e.what());

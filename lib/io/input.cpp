@@ -4,6 +4,7 @@
 #include <filesystem>
 
 #include "core/error.h"
+#include "io/rgl.h"
 #include "model/builtin.h"
 
 namespace facetfit {
@@ -14,7 +15,7 @@ namespace {
 
 bool starts_with(const std::string& s, const std::string& prefix) { return s.compare(0, prefix.size(), prefix) == 0; }
 
-bool is_supported_file(const fs::path& p) { return p.extension() == ".binary"; }
+bool is_supported_file(const fs::path& p) { return p.extension() == ".binary" || p.extension() == ".bsdf"; }
 
 }  // namespace
 
@@ -27,10 +28,11 @@ MerlTable load_table(const std::string& source) {
   }
   const fs::path path(source);
   if (path.extension() == ".binary") return MerlTable::read(source);
+  if (path.extension() == ".bsdf") return MerlTable::tabulate(RglBsdf::read(source));
   std::error_code ec;
   if (fs::is_directory(path, ec)) fail(source, "is a folder with no supported material file");
   if (!fs::exists(path, ec)) fail(source, "cannot open: no such file");
-  fail(source, "unsupported format '" + path.extension().string() + "' (supported: .binary, builtin:NAME)");
+  fail(source, "unsupported format '" + path.extension().string() + "' (supported: .binary, .bsdf, builtin:NAME)");
 }
 
 std::vector<std::string> expand_inputs(const std::vector<std::string>& args) {

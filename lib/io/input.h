@@ -1,6 +1,7 @@
 // Material inputs named on a command line, whatever their format, as MERL-layout tables.
 //
-// Sources: a MERL `.binary` file, or `builtin:NAME` (tabulated on the fly). Folders expand to the
+// Sources: a MERL `.binary` file, an RGL `.bsdf` file or `builtin:NAME` (the last two tabulated into
+// MERL layout on load). Folders expand to the
 // supported files they hold, sorted by name.
 #pragma once
 
