@@ -180,6 +180,17 @@ TEST_F(MerlBadFile, NanPayloadNamesTheOffset) {
   EXPECT_EQ(msg.find('\n'), std::string::npos);
 }
 
+TEST_F(MerlBadFile, InfPayloadInTheLastChannel) {
+  std::string bytes = header(90, 90, 180) + std::string(3 * MerlTable::kBins * 8, '\0');
+  const double inf = -std::numeric_limits<double>::infinity();
+  const std::size_t last = 3 * MerlTable::kBins - 1;
+  std::memcpy(bytes.data() + 12 + last * 8, &inf, 8);
+  const std::string msg = read_error(bytes);
+  EXPECT_NE(msg.find("Inf at byte offset " + std::to_string(12 + last * 8) + " (blue channel, bin theta_h 89, theta_d 89, phi_d 179)"),
+            std::string::npos)
+      << msg;
+}
+
 TEST_F(MerlBadFile, WriteIntoMissingFolderNamesTheTarget) {
   const std::string target = dir.file("no/such/folder/x.binary");
   const std::string msg = error_of([&] { MerlTable().write(target); });

@@ -7,6 +7,7 @@
 #pragma once
 
 #include <cstddef>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -59,7 +60,27 @@ class MerlTable final : public Brdf {
   std::optional<Rgb> eval_nearest(double x_h, double x_d, double x_p) const;
   std::optional<Rgb> eval_linear(double x_h, double x_d, double x_p) const;
 
-  std::vector<float> data_;  // 3 * kBins, channel-planar as in the file
+  // Leaves new elements uninitialized: the reader overwrites every one, and filling 17 MB first costs
+  // as much as the conversion itself.
+  template <class T>
+  struct UninitializedAllocator : std::allocator<T> {
+    template <class U>
+    struct rebind {
+      using other = UninitializedAllocator<U>;
+    };
+    template <class U, class... Args>
+    void construct(U* p, Args&&... args) {
+      if constexpr (sizeof...(Args) == 0) {
+        ::new (static_cast<void*>(p)) U;
+      } else {
+        ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+      }
+    }
+  };
+  struct Uninitialized {};
+  explicit MerlTable(Uninitialized);
+
+  std::vector<float, UninitializedAllocator<float>> data_;  // 3 * kBins, channel-planar as in the file
   Lookup lookup_ = Lookup::linear;
 };
 

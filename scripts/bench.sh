@@ -1,0 +1,11 @@
+#!/usr/bin/env bash
+# Runs the Google Benchmark suite and writes docs/benchmarks.md from its JSON (make bench).
+set -euo pipefail
+build="${1:-build/release}"
+root="$(cd "$(dirname "$0")/.." && pwd)"
+json="$(mktemp --suffix=.json)"
+trap 'rm -f "$json"' EXIT
+"$build/bench/facetfit_bench" --benchmark_repetitions=5 --benchmark_report_aggregates_only=true \
+  --benchmark_min_time=0.3 --benchmark_out="$json" --benchmark_out_format=json
+python3 "$root/scripts/bench_to_md.py" "$json" "$root/docs/benchmarks.md"
+echo "wrote docs/benchmarks.md"
