@@ -29,15 +29,10 @@ void gauss_legendre(int n, std::vector<double>& x, std::vector<double>& w) {
   }
 }
 
-namespace {
-
-// Integral over phi in [0, 2 pi) of max(0, a cos(phi) + b), for a >= 0 and b >= 0.
 double positive_phi_integral(double a, double b) {
   if (a <= b) return 2.0 * kPi * b;
   return 2.0 * (std::sqrt(a * a - b * b) + b * std::acos(-b / a));
 }
-
-}  // namespace
 
 Quadrature::Quadrature(int resolution, int points_per_interval) : grid_{resolution} {
   const int n = size();

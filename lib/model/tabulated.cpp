@@ -1,0 +1,175 @@
+#include "model/tabulated.h"
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "fit/quadrature.h"
+
+namespace facetfit {
+
+VisibleNormalTables VisibleNormalTables::build(const TabulatedNdf& ndf) {
+  const ThetaGrid& grid = ndf.grid;
+  const int r = grid.resolution, n = grid.size();
+  // D sin(theta) d(theta) at Gauss points of every interval: the slices only differ by the phi integral.
+  constexpr int kPoints = 8;
+  std::vector<double> gx, gw;
+  gauss_legendre(kPoints, gx, gw);
+  std::vector<double> sin_t(std::size_t(r) * kPoints), cos_t(sin_t.size()), mass(sin_t.size());
+  for (int j = 0; j < r; ++j)
+    for (int q = 0; q < kPoints; ++q) {
+      const double u = (j + gx[std::size_t(q)]) / r, theta = ThetaGrid::theta_of_u(u);
+      const std::size_t at = std::size_t(j) * kPoints + q;
+      sin_t[at] = std::sin(theta);
+      cos_t[at] = std::cos(theta);
+      mass[at] = ndf.D(theta) * sin_t[at] * gw[std::size_t(q)] / r * kPi * u;  // d(theta) = pi u du
+    }
+  VisibleNormalTables tables;
+  tables.resolution = r;
+  tables.cdf.assign(std::size_t(n) * n, 0.0);
+  tbb::parallel_for(0, n, [&](int s) {
+    const double sk = std::sin(grid.theta(s)), ck = std::cos(grid.theta(s));
+    double* row = tables.cdf.data() + std::size_t(s) * n;
+    double sum = 0.0;
+    for (int j = 0; j < r; ++j) {
+      for (int q = 0; q < kPoints; ++q) {
+        const std::size_t at = std::size_t(j) * kPoints + q;
+        sum += mass[at] * positive_phi_integral(sk * sin_t[at], ck * cos_t[at]);
+      }
+      row[j + 1] = sum;
+    }
+    if (sum > 0.0) {
+      for (int j = 1; j <= r; ++j) row[j] /= sum;
+    } else {  // no facet visible (an all-zero NDF): uniform in cos(theta), so sampling still terminates
+      for (int j = 1; j <= r; ++j) row[j] = 1.0 - std::cos(grid.theta(j));
+    }
+    row[r] = 1.0;
+  });
+  return tables;
+}
+
+TabulatedMicrofacet::TabulatedMicrofacet(MicrofacetTables tables)
+    : TabulatedMicrofacet(tables, VisibleNormalTables::build(tables.ndf)) {}
+
+TabulatedMicrofacet::TabulatedMicrofacet(MicrofacetTables tables, VisibleNormalTables sampling)
+    : tables_(std::move(tables)), sampling_(std::move(sampling)) {
+  for (int j = 0; j < tables_.ndf.grid.size(); ++j) cos_nodes_.push_back(std::cos(tables_.ndf.grid.theta(j)));
+}
+
+double TabulatedMicrofacet::D(const Vec3& h) const {
+  return h.z > 0.0 ? tables_.ndf.D(std::acos(std::min(h.z, 1.0))) : 0.0;
+}
+
+double TabulatedMicrofacet::g1(const Vec3& w) const { return tables_.ndf.g1(w.z); }
+
+Rgb TabulatedMicrofacet::fresnel(double cos_d) const { return tables_.fresnel.eval(std::acos(clamp(cos_d, 0.0, 1.0))); }
+
+std::optional<Rgb> TabulatedMicrofacet::eval(const Vec3& i, const Vec3& o) const {
+  if (i.z <= 0.0 || o.z <= 0.0) return Rgb(0.0);
+  const Vec3 h = glm::normalize(i + o);
+  const double g2 = smith_g2_from_g1(tables_.smith, g1(i), g1(o));
+  return fresnel(glm::dot(i, h)) * (D(h) * g2 / (4.0 * i.z * o.z));
+}
+
+namespace {
+
+// Where theta sits on the grid: interval j (0..R-1) and fraction t.
+struct GridPosition {
+  int j;
+  double t;
+};
+
+GridPosition locate(const ThetaGrid& grid, double cos_theta) {
+  int j;
+  double t;
+  grid.locate(std::acos(clamp(cos_theta, -1.0, 1.0)), &j, &t);
+  return {j, t};
+}
+
+// phi in (-pi, pi] with density proportional to max(0, a cos(phi) + b), a, b >= 0, from u in [0, 1).
+double sample_phi(double a, double b, double u) {
+  const double phi_max = a <= b ? kPi : std::acos(-b / a);
+  const double sign = u < 0.5 ? -1.0 : 1.0;
+  u = u < 0.5 ? 2.0 * u : 2.0 * u - 1.0;
+  const double total = a * std::sin(phi_max) + b * phi_max;  // CDF a sin(phi) + b phi on [0, phi_max]
+  if (!(total > 0.0)) return sign * u * kPi;
+  const double target = u * total;
+  // Newton on the monotone CDF, kept inside the bracket.
+  double lo = 0.0, hi = phi_max, phi = u * phi_max;
+  for (int it = 0; it < 40; ++it) {
+    const double f = a * std::sin(phi) + b * phi - target;
+    if (f > 0.0) hi = phi; else lo = phi;
+    const double df = a * std::cos(phi) + b;
+    double next = df > 0.0 ? phi - f / df : 0.5 * (lo + hi);
+    if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
+    if (std::abs(next - phi) < 1e-13) {
+      phi = next;
+      break;
+    }
+    phi = next;
+  }
+  return sign * phi;
+}
+
+}  // namespace
+
+double TabulatedMicrofacet::visible_normal_pdf(const Vec3& o, const Vec3& h) const {
+  const double oh = glm::dot(o, h);
+  if (o.z <= 0.0 || h.z <= 0.0 || oh <= 0.0 || sampling_.empty()) return 0.0;
+  const ThetaGrid& grid = tables_.ndf.grid;
+  const GridPosition view = locate(grid, o.z), normal = locate(grid, h.z);
+  const double band = cos_nodes_[std::size_t(normal.j)] - cos_nodes_[std::size_t(normal.j) + 1];
+  if (!(band > 0.0)) return 0.0;
+  // The two view slices around o, mixed linearly in u (sample() picks one with these weights).
+  const double mass = (1.0 - view.t) * sampling_.mass(view.j, normal.j) + view.t * sampling_.mass(view.j + 1, normal.j);
+  // Azimuth: exactly max(0, o.h) over its phi integral at this theta_h.
+  const double sin_o = std::sqrt(std::max(0.0, 1.0 - o.z * o.z)), sin_h = std::sqrt(std::max(0.0, 1.0 - h.z * h.z));
+  const double phi_total = positive_phi_integral(sin_o * sin_h, o.z * h.z);
+  if (!(phi_total > 0.0)) return 0.0;
+  return mass / band * oh / phi_total;  // d(omega) = d(cos theta) d(phi)
+}
+
+double TabulatedMicrofacet::pdf(const Vec3& o, const Vec3& i) const {
+  if (i.z <= 0.0 || o.z <= 0.0) return 0.0;
+  const Vec3 h = glm::normalize(o + i);
+  const double oh = glm::dot(o, h);
+  if (oh <= 0.0) return 0.0;
+  // Reflection about h: d(omega_i) = 4 (o.h) d(omega_h).
+  return visible_normal_pdf(o, h) / (4.0 * oh);
+}
+
+std::optional<TabulatedMicrofacet::Sample> TabulatedMicrofacet::sample(const Vec3& o, double u1, double u2) const {
+  if (o.z <= 0.0 || sampling_.empty()) return std::nullopt;
+  const ThetaGrid& grid = tables_.ndf.grid;
+  const int r = grid.resolution;
+  // Pick one of the two view slices around o with the weights of the mixture, reusing u1.
+  const GridPosition view = locate(grid, o.z);
+  int slice = view.j;
+  if (u1 < 1.0 - view.t) {
+    u1 /= 1.0 - view.t;
+  } else {
+    u1 = (u1 - (1.0 - view.t)) / view.t;
+    slice = view.j + 1;
+  }
+  u1 = clamp(u1, 0.0, 1.0 - 1e-16);
+  // The interval of theta_h: the last node whose CDF is <= u1 (zero-mass intervals are never chosen).
+  const double* cdf = sampling_.cdf.data() + std::size_t(slice) * (r + 1);
+  int j = int(std::upper_bound(cdf, cdf + r + 1, u1) - cdf) - 1;
+  j = std::clamp(j, 0, r - 1);
+  const double m = cdf[j + 1] - cdf[j];
+  const double frac = m > 0.0 ? clamp((u1 - cdf[j]) / m, 0.0, 1.0) : 0.5;
+  const double cos_h = cos_nodes_[std::size_t(j)] - frac * (cos_nodes_[std::size_t(j)] - cos_nodes_[std::size_t(j) + 1]);
+  const double sin_h = std::sqrt(std::max(0.0, 1.0 - cos_h * cos_h));
+  const double sin_o = std::sqrt(std::max(0.0, 1.0 - o.z * o.z));
+  const double phi = sample_phi(sin_o * sin_h, o.z * cos_h, u2) + (sin_o > 0.0 ? std::atan2(o.y, o.x) : 0.0);
+  const Vec3 h(sin_h * std::cos(phi), sin_h * std::sin(phi), cos_h);
+  const Vec3 i = 2.0 * glm::dot(o, h) * h - o;
+  if (i.z <= 0.0) return std::nullopt;
+  const double p = pdf(o, i);
+  if (!(p > 0.0)) return std::nullopt;
+  const auto f = eval(i, o);
+  return Sample{i, *f * (i.z / p), p};
+}
+
+}  // namespace facetfit

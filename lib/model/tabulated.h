@@ -1,0 +1,78 @@
+// The tabulated microfacet BRDF: the fitted tables evaluated, importance-sampled and given a pdf.
+//
+//   f(i, o) = F(theta_d) D(h) G2(i, o) / (4 cos(theta_i) cos(theta_o))
+//
+// with D and sigma (hence G1 = cos / sigma) splines on the theta grid, F the RGB Fresnel curve and G2
+// the Smith model the fit was made with. sample() draws the distribution of visible normals seen from
+// o, D_o(h) = max(0, o.h) D(h) / sigma(o), and reflects o about h; docs/sampling.md says why and how.
+#pragma once
+
+#include <optional>
+#include <vector>
+
+#include "core/brdf.h"
+#include "fit/fresnel_fit.h"
+#include "fit/tabulated_ndf.h"
+#include "model/smith.h"
+
+namespace facetfit {
+
+// What a LUT holds for evaluation.
+struct MicrofacetTables {
+  TabulatedNdf ndf;
+  Smith smith = Smith::correlated;
+  FresnelCurve fresnel;
+};
+
+// Tables for sampling visible normals. For each view slice s (theta_o at grid node s) and each u interval
+// j of the theta_h axis, the probability that h falls in the interval: mass(s, j), and its running sum
+// cdf(s, j) at node j (cdf(s, 0) = 0, cdf(s, R) = 1). Within an interval h is uniform in cos(theta_h).
+struct VisibleNormalTables {
+  int resolution = 0;
+  std::vector<double> cdf;  // (R + 1) slices x (R + 1) nodes
+
+  static VisibleNormalTables build(const TabulatedNdf& ndf);
+  double cdf_at(int slice, int node) const { return cdf[std::size_t(slice) * (resolution + 1) + node]; }
+  double mass(int slice, int interval) const { return cdf_at(slice, interval + 1) - cdf_at(slice, interval); }
+  bool empty() const { return cdf.empty(); }
+};
+
+class TabulatedMicrofacet final : public Brdf {
+ public:
+  // Builds the sampling tables from the NDF.
+  explicit TabulatedMicrofacet(MicrofacetTables tables);
+  // Uses given sampling tables (from a LUT); empty tables make sample() and pdf() unavailable.
+  TabulatedMicrofacet(MicrofacetTables tables, VisibleNormalTables sampling);
+
+  std::optional<Rgb> eval(const Vec3& i, const Vec3& o) const override;
+
+  struct Sample {
+    Vec3 i;
+    Rgb weight;  // f(i, o) cos(theta_i) / pdf
+    double pdf;  // per steradian of i
+  };
+  // Samples a light direction i for the view direction o from two uniform numbers in [0, 1). nullopt
+  // when the reflected direction falls below the horizon (the sample carries no energy), when o is at
+  // or below the horizon, or when the model has no sampling tables.
+  std::optional<Sample> sample(const Vec3& o, double u1, double u2) const;
+  // Density of sample() per steradian of i. Integrates over the upper hemisphere to the fraction of
+  // samples that land there.
+  double pdf(const Vec3& o, const Vec3& i) const;
+
+  double D(const Vec3& h) const;
+  double g1(const Vec3& w) const;
+  Rgb fresnel(double cos_d) const;
+  // Density of visible normals h seen from o, as sample() draws them, per steradian of h.
+  double visible_normal_pdf(const Vec3& o, const Vec3& h) const;
+
+  const MicrofacetTables& tables() const { return tables_; }
+  const VisibleNormalTables& sampling() const { return sampling_; }
+  bool can_sample() const { return !sampling_.empty(); }
+
+ private:
+  MicrofacetTables tables_;
+  VisibleNormalTables sampling_;
+  std::vector<double> cos_nodes_;  // cos(theta_j)
+};
+
+}  // namespace facetfit
