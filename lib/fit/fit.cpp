@@ -46,6 +46,7 @@ Fitter::Fitter(const FitOptions& options) : options_(options), quadrature_(check
 
 FitResult Fitter::fit(const MerlTable& table) const {
   FitResult result;
+  result.smith = options_.smith;
   result.extraction = extract_ndf(backscatter_of(table), quadrature_,
                                   {options_.smith, options_.tolerance, options_.max_iterations});
   if (!result.extraction.problem.empty()) {

@@ -25,6 +25,7 @@ struct FitResult {
   double alpha_beckmann = 0.0;
   Rgb f0{0.0};   // F(0)
   Rgb f82{0.0};  // F(acos(1/7)), for the F82-tint Fresnel model
+  Smith smith = Smith::correlated;  // the model the NDF is consistent with
   std::string problem;  // empty for a meaningful fit; otherwise why it is not one
 
   bool ok() const { return problem.empty(); }

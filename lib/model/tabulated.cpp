@@ -39,10 +39,11 @@ VisibleNormalTables VisibleNormalTables::build(const TabulatedNdf& ndf) {
       }
       row[j + 1] = sum;
     }
+    // Rounded to float, as a LUT stores them: the in-memory sampler and the baked one are then the same.
     if (sum > 0.0) {
-      for (int j = 1; j <= r; ++j) row[j] /= sum;
+      for (int j = 1; j <= r; ++j) row[j] = double(float(row[j] / sum));
     } else {  // no facet visible (an all-zero NDF): uniform in cos(theta), so sampling still terminates
-      for (int j = 1; j <= r; ++j) row[j] = 1.0 - std::cos(grid.theta(j));
+      for (int j = 1; j <= r; ++j) row[j] = double(float(1.0 - std::cos(grid.theta(j))));
     }
     row[r] = 1.0;
   });

@@ -1,0 +1,213 @@
+#include "lut/lut.h"
+
+#include <OpenImageIO/imageio.h>
+
+#include <cmath>
+
+#include "core/error.h"
+#include "fit/roughness.h"
+#include "io/atomic_file.h"
+
+namespace facetfit {
+
+namespace {
+
+using OIIO::ImageInput;
+using OIIO::ImageOutput;
+using OIIO::ImageSpec;
+using OIIO::TypeDesc;
+
+constexpr const char* kPrefix = "facetfit:";
+std::string key(const char* name) { return std::string(kPrefix) + name; }
+
+void set_color(ImageSpec& spec, const char* name, const Rgb& c) {
+  const float v[3] = {float(c.r), float(c.g), float(c.b)};
+  spec.attribute(key(name), OIIO::TypeColor, v);
+}
+
+// The named float[3] attribute, or nullopt.
+std::optional<Rgb> get_color(const ImageSpec& spec, const char* name) {
+  const OIIO::ParamValue* p = spec.find_attribute(key(name));
+  if (!p || p->type().basetype != TypeDesc::FLOAT || p->type().basevalues() != 3) return std::nullopt;
+  const float* v = static_cast<const float*>(p->data());
+  return Rgb(v[0], v[1], v[2]);
+}
+
+}  // namespace
+
+const char* to_string(Representation r) {
+  switch (r) {
+    case Representation::tabulated: return "tabulated";
+    case Representation::ggx: return "ggx";
+    case Representation::beckmann: return "beckmann";
+  }
+  return "?";
+}
+
+std::optional<Representation> parse_representation(const std::string& name) {
+  for (Representation r : {Representation::tabulated, Representation::ggx, Representation::beckmann})
+    if (name == to_string(r)) return r;
+  return std::nullopt;
+}
+
+LutLayout LutLayout::of(int resolution, bool sampling) {
+  return {std::max(resolution + 1, FresnelCurve::kSize), kSamplingRow + (sampling ? resolution + 1 : 0)};
+}
+
+Lut make_lut(const FitResult& fit, const Quadrature& quadrature, const std::string& source, const std::string& sha256,
+             double tolerance, bool with_sampling) {
+  if (!fit.ok()) fail(source, "no LUT for a meaningless fit: " + fit.problem);
+  Lut lut;
+  lut.tables = {fit.ndf(), fit.smith, fit.fresnel};
+  if (with_sampling) lut.sampling = VisibleNormalTables::build(fit.ndf());
+  LutMetadata& m = lut.meta;
+  m.source = source;
+  m.source_sha256 = sha256;
+  m.resolution = fit.ndf().grid.resolution;
+  m.smith = fit.smith;
+  m.iterations = fit.extraction.iterations;
+  m.residual = fit.extraction.residual;
+  m.alpha_ggx = fit.alpha_ggx;
+  m.alpha_beckmann = fit.alpha_beckmann;
+  m.f0 = fit.f0;
+  m.f82 = fit.f82;
+  m.ndf_error_ggx = ndf_distance(quadrature, fit.ndf(), Ndf::isotropic(NdfType::ggx, fit.alpha_ggx));
+  m.ndf_error_beckmann = ndf_distance(quadrature, fit.ndf(), Ndf::isotropic(NdfType::beckmann, fit.alpha_beckmann));
+  m.tolerance = tolerance;
+  const bool ggx_better = m.ndf_error_ggx <= m.ndf_error_beckmann;
+  const double best = ggx_better ? m.ndf_error_ggx : m.ndf_error_beckmann;
+  m.representation = best <= tolerance ? (ggx_better ? Representation::ggx : Representation::beckmann) : Representation::tabulated;
+  m.sampling = with_sampling;
+  return lut;
+}
+
+void write_lut(const std::string& path, const Lut& lut) {
+  const int r = lut.meta.resolution, nodes = r + 1;
+  const LutLayout layout = LutLayout::of(r, lut.meta.sampling);
+  std::vector<float> pixels(std::size_t(layout.width) * layout.height * 3, 0.0f);
+  const auto put = [&](int row, int x, const Rgb& v) {
+    float* p = pixels.data() + (std::size_t(row) * layout.width + x) * 3;
+    p[0] = float(v.r), p[1] = float(v.g), p[2] = float(v.b);
+  };
+  // Rows shorter than the image repeat their last value, so a clamped lookup past the end agrees.
+  for (int x = 0; x < layout.width; ++x) {
+    const int node = std::min(x, nodes - 1);
+    put(LutLayout::kNdfRow, x, Rgb(lut.tables.ndf.ndf[std::size_t(node)]));
+    put(LutLayout::kSigmaRow, x, Rgb(lut.tables.ndf.sigma[std::size_t(node)]));
+    put(LutLayout::kFresnelRow, x, lut.tables.fresnel.value[std::size_t(std::min(x, FresnelCurve::kSize - 1))]);
+    if (lut.meta.sampling)
+      for (int s = 0; s < nodes; ++s) put(LutLayout::kSamplingRow + s, x, Rgb(lut.sampling.cdf_at(s, node)));
+  }
+
+  ImageSpec spec(layout.width, layout.height, 3, TypeDesc::FLOAT);
+  spec.channelnames = {"R", "G", "B"};
+  spec.attribute("compression", "zip");
+  spec.attribute("oiio:ColorSpace", "Linear");  // data, not colour: no transfer function
+  const LutMetadata& m = lut.meta;
+  spec.attribute(key("format_version"), m.format_version);
+  spec.attribute(key("facetfit_version"), m.facetfit_version);
+  spec.attribute(key("source"), m.source);
+  spec.attribute(key("source_sha256"), m.source_sha256);
+  spec.attribute(key("resolution"), m.resolution);
+  spec.attribute(key("smith"), to_string(m.smith));
+  spec.attribute(key("iterations"), m.iterations);
+  spec.attribute(key("residual"), float(m.residual));
+  spec.attribute(key("alpha_ggx"), float(m.alpha_ggx));
+  spec.attribute(key("alpha_beckmann"), float(m.alpha_beckmann));
+  set_color(spec, "f0", m.f0);
+  set_color(spec, "f82", m.f82);
+  spec.attribute(key("ndf_error_ggx"), float(m.ndf_error_ggx));
+  spec.attribute(key("ndf_error_beckmann"), float(m.ndf_error_beckmann));
+  spec.attribute(key("representation"), to_string(m.representation));
+  spec.attribute(key("tolerance"), float(m.tolerance));
+  spec.attribute(key("sampling"), m.sampling ? 1 : 0);
+
+  AtomicFile out(path);
+  auto image = ImageOutput::create(out.temp_path());
+  if (!image) fail(path, "cannot write: " + OIIO::geterror());
+  if (!image->open(out.temp_path(), spec) || !image->write_image(TypeDesc::FLOAT, pixels.data()) || !image->close())
+    fail(path, "cannot write: " + image->geterror());
+  image.reset();
+  out.commit();
+}
+
+Lut read_lut(const std::string& path) {
+  auto image = ImageInput::open(path);
+  if (!image) {
+    std::string why = OIIO::geterror();
+    if (why.empty()) why = "cannot open";
+    fail(path, why.substr(0, why.find('\n')));
+  }
+  const ImageSpec& spec = image->spec();
+  const int version = spec.get_int_attribute(key("format_version"), -1);
+  if (version < 0) fail(path, "not a facetfit LUT (no facetfit:format_version attribute)");
+  if (version != kLutFormatVersion)
+    fail(path, "LUT format version " + std::to_string(version) + "; this facetfit reads version " + std::to_string(kLutFormatVersion));
+
+  Lut lut;
+  LutMetadata& m = lut.meta;
+  m.format_version = version;
+  m.facetfit_version = spec.get_string_attribute(key("facetfit_version"));
+  m.source = spec.get_string_attribute(key("source"));
+  m.source_sha256 = spec.get_string_attribute(key("source_sha256"));
+  m.resolution = spec.get_int_attribute(key("resolution"), -1);
+  const auto smith = parse_smith(spec.get_string_attribute(key("smith")));
+  const auto representation = parse_representation(spec.get_string_attribute(key("representation")));
+  const auto f0 = get_color(spec, "f0"), f82 = get_color(spec, "f82");
+  if (!smith || !representation || !f0 || !f82 || m.resolution < 4 || m.resolution > 4096)
+    fail(path, "facetfit LUT with missing or invalid metadata");
+  m.smith = *smith;
+  m.representation = *representation;
+  m.f0 = *f0;
+  m.f82 = *f82;
+  m.iterations = spec.get_int_attribute(key("iterations"));
+  m.residual = spec.get_float_attribute(key("residual"));
+  m.alpha_ggx = spec.get_float_attribute(key("alpha_ggx"));
+  m.alpha_beckmann = spec.get_float_attribute(key("alpha_beckmann"));
+  m.ndf_error_ggx = spec.get_float_attribute(key("ndf_error_ggx"));
+  m.ndf_error_beckmann = spec.get_float_attribute(key("ndf_error_beckmann"));
+  m.tolerance = spec.get_float_attribute(key("tolerance"));
+  m.sampling = spec.get_int_attribute(key("sampling")) != 0;
+
+  const LutLayout layout = LutLayout::of(m.resolution, m.sampling);
+  if (spec.width != layout.width || spec.height != layout.height)
+    fail(path, "image is " + std::to_string(spec.width) + " x " + std::to_string(spec.height) + ", expected " +
+                   std::to_string(layout.width) + " x " + std::to_string(layout.height) + " for resolution " +
+                   std::to_string(m.resolution));
+  // EXR stores channels sorted by name: find R, G, B by name, not by position.
+  int channel[3];
+  const char* names[3] = {"R", "G", "B"};
+  for (int c = 0; c < 3; ++c) {
+    channel[c] = spec.channelindex(names[c]);
+    if (channel[c] < 0) fail(path, std::string("no channel ") + names[c]);
+  }
+  std::vector<float> pixels(std::size_t(spec.width) * spec.height * spec.nchannels);
+  if (!image->read_image(0, 0, 0, spec.nchannels, TypeDesc::FLOAT, pixels.data()))
+    fail(path, "cannot read pixels: " + image->geterror());
+  const auto get = [&](int row, int x, int c) {
+    const float v = pixels[(std::size_t(row) * spec.width + x) * spec.nchannels + channel[c]];
+    if (!std::isfinite(v)) fail(path, "non-finite value in row " + std::to_string(row) + ", column " + std::to_string(x));
+    return double(v);
+  };
+
+  const int nodes = m.resolution + 1;
+  TabulatedNdf& ndf = lut.tables.ndf;
+  ndf.grid = ThetaGrid{m.resolution};
+  for (int x = 0; x < nodes; ++x) {
+    ndf.ndf.push_back(get(LutLayout::kNdfRow, x, 0));
+    ndf.sigma.push_back(get(LutLayout::kSigmaRow, x, 0));
+  }
+  for (int x = 0; x < FresnelCurve::kSize; ++x)
+    lut.tables.fresnel.value[std::size_t(x)] = Rgb(get(LutLayout::kFresnelRow, x, 0), get(LutLayout::kFresnelRow, x, 1),
+                                                   get(LutLayout::kFresnelRow, x, 2));
+  lut.tables.smith = m.smith;
+  if (m.sampling) {
+    lut.sampling.resolution = m.resolution;
+    lut.sampling.cdf.resize(std::size_t(nodes) * nodes);
+    for (int s = 0; s < nodes; ++s)
+      for (int x = 0; x < nodes; ++x) lut.sampling.cdf[std::size_t(s) * nodes + x] = get(LutLayout::kSamplingRow + s, x, 0);
+  }
+  return lut;
+}
+
+}  // namespace facetfit

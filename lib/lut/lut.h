@@ -1,0 +1,66 @@
+// The LUT texture: one OpenEXR per material with everything a renderer or an OSL shader needs to
+// evaluate and sample the fitted material with plain texture lookups. Layout: docs/lut-format.md.
+#pragma once
+
+#include <optional>
+#include <string>
+
+#include "fit/fit.h"
+#include "model/tabulated.h"
+
+namespace facetfit {
+
+constexpr int kLutFormatVersion = 1;
+
+// Which model a renderer should use for this material.
+enum class Representation { tabulated, ggx, beckmann };
+const char* to_string(Representation r);
+std::optional<Representation> parse_representation(const std::string& name);
+
+struct LutMetadata {
+  int format_version = kLutFormatVersion;
+  std::string facetfit_version = FACETFIT_VERSION;
+  std::string source;         // as named on the command line (file path or builtin:NAME)
+  std::string source_sha256;  // of the source file's bytes (of the name, for built-ins)
+  int resolution = 90;
+  Smith smith = Smith::correlated;
+  int iterations = 0;
+  double residual = 0.0;
+  double alpha_ggx = 0.0, alpha_beckmann = 0.0;
+  Rgb f0{0.0}, f82{0.0};
+  // Relative L1 distance (projected-area weighted) of each parametric NDF from the tabulated one.
+  double ndf_error_ggx = 0.0, ndf_error_beckmann = 0.0;
+  Representation representation = Representation::tabulated;
+  double tolerance = 0.0;  // the NDF error a parametric fit was allowed when choosing the representation
+  bool sampling = true;    // sampling tables present (absent with --eval-only)
+};
+
+// Row layout of the texture; texel x of row y is at s = (x + 0.5) / width, t = (y + 0.5) / height.
+struct LutLayout {
+  static constexpr int kNdfRow = 0;       // D at grid node x (x = 0..R), in every channel
+  static constexpr int kSigmaRow = 1;     // sigma at grid node x
+  static constexpr int kFresnelRow = 2;   // RGB Fresnel at theta_d = x pi/180 (x = 0..89)
+  static constexpr int kSamplingRow = 3;  // + s: CDF of visible normals of view slice s at node x
+  int width = 0, height = 0;
+  static LutLayout of(int resolution, bool sampling);
+};
+
+struct Lut {
+  MicrofacetTables tables;
+  VisibleNormalTables sampling;  // empty when baked with --eval-only
+  LutMetadata meta;
+
+  TabulatedMicrofacet model() const { return TabulatedMicrofacet(tables, sampling); }
+};
+
+// Builds the LUT of a fit and chooses its representation: the parametric NDF with the smaller error
+// when that error is within `tolerance`, the tabulated one otherwise.
+Lut make_lut(const FitResult& fit, const Quadrature& quadrature, const std::string& source, const std::string& sha256,
+             double tolerance, bool with_sampling);
+
+// Writes through a temporary file renamed into place. Throws Error naming `path`.
+void write_lut(const std::string& path, const Lut& lut);
+// Throws Error("<path>: <problem>") for anything that is not a complete facetfit LUT this version reads.
+Lut read_lut(const std::string& path);
+
+}  // namespace facetfit

@@ -1,0 +1,145 @@
+// LUT textures: bake -> write -> read gives back the same model; metadata round trip; bad files.
+#include <gtest/gtest.h>
+
+#include <OpenImageIO/imageio.h>
+
+#include <random>
+
+#include "core/error.h"
+#include "fit/fit.h"
+#include "lut/lut.h"
+#include "model/analytic.h"
+#include "test_util.h"
+
+namespace facetfit {
+namespace {
+
+using test::TempDir;
+
+struct Baked {
+  Fitter fitter{FitOptions{}};
+  FitResult fit;
+};
+
+Baked fit_of(const Brdf& brdf, Smith smith = Smith::correlated) {
+  FitOptions options;
+  options.smith = smith;
+  Baked b{Fitter(options), {}};
+  b.fit = b.fitter.fit(MerlTable::tabulate(brdf));
+  return b;
+}
+
+TEST(Lut, RoundTripEvaluatesAsTheInMemoryModel) {
+  const Baked b = fit_of(MicrofacetBrdf(Ndf::isotropic(NdfType::ggx, 0.25), Smith::separable,
+                                        Fresnel::conductor({0.2, 0.9, 1.1}, {3.9, 2.4, 2.1})),
+                         Smith::separable);
+  const Lut lut = make_lut(b.fit, b.fitter.quadrature(), "builtin:test", "abc", 0.02, true);
+  TempDir dir;
+  write_lut(dir.file("m.exr"), lut);
+  const Lut back = read_lut(dir.file("m.exr"));
+  const TabulatedMicrofacet a = lut.model(), c = back.model();
+  EXPECT_EQ(back.tables.smith, Smith::separable);
+  std::mt19937 rng(1);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (int n = 0; n < 2000; ++n) {
+    const Vec3 i = spherical_direction(std::acos(u(rng)), 2 * kPi * u(rng));
+    const Vec3 o = spherical_direction(std::acos(u(rng)), 2 * kPi * u(rng));
+    const Rgb fa = *a.eval(i, o), fc = *c.eval(i, o);
+    for (int ch = 0; ch < 3; ++ch) EXPECT_NEAR(fc[ch], fa[ch], 1e-6 * std::max(fa[ch], 1e-6));
+    const double pa = a.pdf(o, i), pc = c.pdf(o, i);
+    EXPECT_NEAR(pc, pa, 1e-6 * std::max(pa, 1e-6));
+  }
+  // Same samples from the same numbers.
+  for (int n = 0; n < 200; ++n) {
+    const Vec3 o = spherical_direction(std::acos(u(rng)), 2 * kPi * u(rng));
+    const double u1 = u(rng), u2 = u(rng);
+    const auto sa = a.sample(o, u1, u2), sc = c.sample(o, u1, u2);
+    ASSERT_EQ(sa.has_value(), sc.has_value());
+    if (sa) {
+      EXPECT_NEAR(glm::length(sa->i - sc->i), 0.0, 1e-5);
+    }
+  }
+}
+
+TEST(Lut, MetadataRoundTrip) {
+  const Baked b = fit_of(MicrofacetBrdf(Ndf::isotropic(NdfType::beckmann, 0.3), Smith::correlated, Fresnel::schlick(Rgb(0.9, 0.6, 0.3))));
+  const Lut lut = make_lut(b.fit, b.fitter.quadrature(), "/data/copper.binary", std::string(64, 'f'), 0.02, true);
+  TempDir dir;
+  write_lut(dir.file("copper.exr"), lut);
+  const LutMetadata m = read_lut(dir.file("copper.exr")).meta;
+  EXPECT_EQ(m.format_version, kLutFormatVersion);
+  EXPECT_EQ(m.facetfit_version, FACETFIT_VERSION);
+  EXPECT_EQ(m.source, "/data/copper.binary");
+  EXPECT_EQ(m.source_sha256, std::string(64, 'f'));
+  EXPECT_EQ(m.resolution, 90);
+  EXPECT_EQ(m.smith, Smith::correlated);
+  EXPECT_EQ(m.iterations, b.fit.extraction.iterations);
+  EXPECT_FLOAT_EQ(float(m.alpha_beckmann), float(b.fit.alpha_beckmann));
+  EXPECT_FLOAT_EQ(float(m.alpha_ggx), float(b.fit.alpha_ggx));
+  EXPECT_FLOAT_EQ(float(m.f0.g), float(b.fit.f0.g));
+  EXPECT_FLOAT_EQ(float(m.f82.b), float(b.fit.f82.b));
+  EXPECT_FLOAT_EQ(float(m.ndf_error_ggx), float(lut.meta.ndf_error_ggx));
+  // A Beckmann material: its Beckmann fit is within tolerance, its GGX fit is not.
+  EXPECT_LT(m.ndf_error_beckmann, 0.002);
+  EXPECT_GT(m.ndf_error_ggx, 0.05);
+  EXPECT_EQ(m.representation, Representation::beckmann);
+  EXPECT_TRUE(m.sampling);
+}
+
+TEST(Lut, ToleranceChoosesTheRepresentation) {
+  const Baked two_lobes = fit_of(SumBrdf({std::make_shared<MicrofacetBrdf>(Ndf::isotropic(NdfType::ggx, 0.05), Smith::correlated, Fresnel::one()),
+                                          std::make_shared<MicrofacetBrdf>(Ndf::isotropic(NdfType::ggx, 0.5), Smith::correlated, Fresnel::one())}));
+  EXPECT_EQ(make_lut(two_lobes.fit, two_lobes.fitter.quadrature(), "x", "", 0.02, true).meta.representation, Representation::tabulated);
+  EXPECT_EQ(make_lut(two_lobes.fit, two_lobes.fitter.quadrature(), "x", "", 10.0, true).meta.representation, Representation::ggx);
+  const Baked ggx = fit_of(MicrofacetBrdf(Ndf::isotropic(NdfType::ggx, 0.2), Smith::correlated, Fresnel::one()));
+  EXPECT_EQ(make_lut(ggx.fit, ggx.fitter.quadrature(), "x", "", 0.02, true).meta.representation, Representation::ggx);
+}
+
+TEST(Lut, EvalOnlyLeavesOutTheSamplingTables) {
+  const Baked b = fit_of(MicrofacetBrdf(Ndf::isotropic(NdfType::ggx, 0.2), Smith::correlated, Fresnel::one()));
+  TempDir dir;
+  write_lut(dir.file("full.exr"), make_lut(b.fit, b.fitter.quadrature(), "x", "", 0.02, true));
+  write_lut(dir.file("eval.exr"), make_lut(b.fit, b.fitter.quadrature(), "x", "", 0.02, false));
+  const Lut full = read_lut(dir.file("full.exr")), eval = read_lut(dir.file("eval.exr"));
+  EXPECT_TRUE(full.model().can_sample());
+  EXPECT_FALSE(eval.model().can_sample());
+  EXPECT_LT(std::filesystem::file_size(dir.file("eval.exr")), std::filesystem::file_size(dir.file("full.exr")));
+  const Vec3 i = spherical_direction(0.3, 0.0), o = spherical_direction(0.5, 2.0);
+  EXPECT_EQ(full.model().eval(i, o)->r, eval.model().eval(i, o)->r);
+}
+
+template <class F>
+std::string error_of(F f) {
+  try {
+    f();
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(Lut, BadFilesGetOneClearLine) {
+  TempDir dir;
+  test::write_bytes(dir.file("garbage.exr"), "not an image at all");
+  EXPECT_NE(error_of([&] { read_lut(dir.file("garbage.exr")); }).find("garbage.exr: "), std::string::npos);
+  EXPECT_NE(error_of([&] { read_lut(dir.file("missing.exr")); }).find("missing.exr: "), std::string::npos);
+  // A valid EXR that is not a LUT.
+  {
+    OIIO::ImageSpec spec(4, 4, 3, OIIO::TypeDesc::FLOAT);
+    auto out = OIIO::ImageOutput::create(dir.file("plain.exr"));
+    std::vector<float> px(48, 0.5f);
+    ASSERT_TRUE(out->open(dir.file("plain.exr"), spec) && out->write_image(OIIO::TypeDesc::FLOAT, px.data()) && out->close());
+  }
+  EXPECT_NE(error_of([&] { read_lut(dir.file("plain.exr")); }).find("not a facetfit LUT"), std::string::npos);
+  // A truncated LUT.
+  const Baked b = fit_of(MicrofacetBrdf(Ndf::isotropic(NdfType::ggx, 0.2), Smith::correlated, Fresnel::one()));
+  write_lut(dir.file("good.exr"), make_lut(b.fit, b.fitter.quadrature(), "x", "", 0.02, true));
+  const std::string bytes = test::read_bytes(dir.file("good.exr"));
+  test::write_bytes(dir.file("cut.exr"), bytes.substr(0, bytes.size() / 2));
+  const std::string cut = error_of([&] { read_lut(dir.file("cut.exr")); });
+  EXPECT_NE(cut.find("cut.exr: "), std::string::npos) << cut;
+  EXPECT_EQ(cut.find('\n'), std::string::npos) << cut;
+}
+
+}  // namespace
+}  // namespace facetfit
