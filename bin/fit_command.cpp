@@ -8,6 +8,7 @@
 #include "core/error.h"
 #include "fit/fit.h"
 #include "io/input.h"
+#include "lut/record.h"
 
 namespace facetfit::cli {
 
@@ -23,25 +24,6 @@ struct FitArgs {
   bool refine = false;
   bool json = false;
 };
-
-nlohmann::json rgb_json(const Rgb& c) { return {c.r, c.g, c.b}; }
-
-nlohmann::json fit_json(const std::string& source, const FitResult& r, double seconds) {
-  nlohmann::json j;
-  j["source"] = source;
-  if (r.ok()) {
-    j["alpha_ggx"] = r.alpha_ggx;
-    j["alpha_beckmann"] = r.alpha_beckmann;
-    j["f0"] = rgb_json(r.f0);
-    j["f82"] = rgb_json(r.f82);
-  } else {  // JSON has no NaN: a meaningless fit has null parameters
-    for (const char* key : {"alpha_ggx", "alpha_beckmann", "f0", "f82"}) j[key] = nullptr;
-  }
-  j["iterations"] = r.extraction.iterations;
-  j["residual"] = r.extraction.residual;
-  j["seconds"] = seconds;
-  return j;
-}
 
 void print_row(const std::string& source, const FitResult& r, double seconds) {
   if (!r.ok()) {
@@ -90,7 +72,7 @@ void run_fit(const FitArgs& args, int& status) {
         ++failures;
       }
       if (args.json)
-        std::printf("%s\n", fit_json(source, result, seconds).dump().c_str());
+        std::printf("%s\n", fit_record(source, result, seconds).dump().c_str());
       else
         print_row(source_name(source), result, seconds);
       std::fflush(stdout);

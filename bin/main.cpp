@@ -17,6 +17,8 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", FACETFIT_VERSION);
   int status = 0;
   add_fit_command(app, status);
+  add_bake_command(app, status);
+  add_info_command(app, status);
   add_convert_command(app, status);
   add_builtins_command(app, status);
   try {

@@ -1,6 +1,5 @@
 // The facetfit command as users run it: bad inputs, batches, JSON output.
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 
 #include <cstdint>
 #include <cstring>
@@ -15,22 +14,8 @@ namespace {
 
 using test::TempDir;
 
-struct RunResult {
-  int status = -1;
-  std::string out, err;
-};
-
-// Runs the facetfit command with `args` (shell words), capturing stdout and stderr.
-RunResult facetfit(const std::string& args) {
-  TempDir dir;
-  const std::string cmd = std::string(FACETFIT_CLI) + " " + args + " >" + dir.file("out") + " 2>" + dir.file("err");
-  RunResult r;
-  const int raw = std::system(cmd.c_str());
-  r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-  r.out = test::read_bytes(dir.file("out"));
-  r.err = test::read_bytes(dir.file("err"));
-  return r;
-}
+using test::facetfit;
+using test::RunResult;
 
 int lines(const std::string& s) { return int(std::count(s.begin(), s.end(), '\n')); }
 

@@ -1,6 +1,7 @@
 // Small helpers shared by the tests.
 #pragma once
 
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <cstdio>
@@ -40,5 +41,27 @@ inline std::string read_bytes(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   return std::string(std::istreambuf_iterator<char>(in), {});
 }
+
+struct RunResult {
+  int status = -1;
+  std::string out, err;
+};
+
+// Runs a shell command line, capturing stdout and stderr.
+inline RunResult run_command(const std::string& command) {
+  TempDir dir;
+  const std::string cmd = command + " >" + dir.file("out") + " 2>" + dir.file("err");
+  RunResult r;
+  const int raw = std::system(cmd.c_str());
+  r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+  r.out = read_bytes(dir.file("out"));
+  r.err = read_bytes(dir.file("err"));
+  return r;
+}
+
+#ifdef FACETFIT_CLI
+// Runs the facetfit command with `args` (shell words).
+inline RunResult facetfit(const std::string& args) { return run_command(std::string(FACETFIT_CLI) + " " + args); }
+#endif
 
 }  // namespace facetfit::test

@@ -1,5 +1,7 @@
 #include "io/input.h"
 
+#include <glob.h>
+
 #include <algorithm>
 #include <filesystem>
 
@@ -48,6 +50,15 @@ std::vector<std::string> expand_inputs(const std::vector<std::string>& args) {
       std::sort(files.begin(), files.end());
       if (files.empty()) out.push_back(arg);  // reported when loaded
       out.insert(out.end(), files.begin(), files.end());
+    } else if (arg.find_first_of("*?[") != std::string::npos && !fs::exists(arg, ec)) {
+      // A glob the shell did not expand (quoted, or from a script).
+      glob_t g{};
+      if (::glob(arg.c_str(), 0, nullptr, &g) == 0) {
+        for (std::size_t k = 0; k < g.gl_pathc; ++k) out.push_back(g.gl_pathv[k]);
+      } else {
+        out.push_back(arg);  // matches nothing: reported when loaded
+      }
+      ::globfree(&g);
     } else {
       out.push_back(arg);
     }

@@ -17,7 +17,8 @@ constexpr const char* kBuiltinPrefix = "builtin:";
 // Loads one source. Throws Error("<source>: <problem>").
 MerlTable load_table(const std::string& source);
 
-// Folders become the supported files inside them; `builtin:` alone becomes every built-in material.
+// Folders become the supported files inside them, globs their matches; `builtin:` alone becomes every
+// built-in material.
 // Anything else is passed through (and fails later, with its own message, if it is not loadable).
 std::vector<std::string> expand_inputs(const std::vector<std::string>& args);
 

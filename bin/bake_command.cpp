@@ -1,0 +1,197 @@
+// facetfit bake INPUT... -o DIR : LUT textures and JSON sidecars for the pipeline, cached, in parallel.
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <mutex>
+#include <thread>
+
+#include "commands.h"
+#include "core/error.h"
+#include "io/atomic_file.h"
+#include "io/input.h"
+#include "lut/bake.h"
+
+namespace facetfit::cli {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct BakeArgs {
+  std::vector<std::string> inputs;
+  std::string out_dir;
+  int jobs = 0;
+  bool force = false;
+  std::string scene;
+  double tolerance = 0.02;
+  bool eval_only = false;
+  std::string smith = "correlated";
+  int resolution = 90;
+  bool refine = false;
+};
+
+// One line per material, or a progress bar when stderr is a terminal.
+class Progress {
+ public:
+  explicit Progress(std::size_t total) : total_(total), tty_(::isatty(STDERR_FILENO) == 1) {}
+  void report(const BakeOutcome& o) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    ++done_;
+    failed_ += o.status == BakeOutcome::Status::failed;
+    if (tty_) {
+      constexpr int kWidth = 30;
+      const int filled = int(kWidth * done_ / std::max<std::size_t>(total_, 1));
+      std::fprintf(stderr, "\r[%-*s] %zu/%zu %s%-30.30s", kWidth, std::string(std::size_t(filled), '=').c_str(), done_, total_,
+                   failed_ ? ("(" + std::to_string(failed_) + " failed) ").c_str() : "", o.name.c_str());
+      if (o.status == BakeOutcome::Status::failed) std::fprintf(stderr, "\rfacetfit: error: %s\n", o.error.c_str());
+      if (done_ == total_) std::fprintf(stderr, "\n");
+    } else if (o.status == BakeOutcome::Status::failed) {
+      std::fprintf(stderr, "facetfit: error: %s\n", o.error.c_str());
+    } else {
+      std::fprintf(stderr, "%s %s (%.0f ms)\n", o.status == BakeOutcome::Status::cached ? "cached" : "baked ", o.name.c_str(),
+                   o.seconds * 1e3);
+    }
+    std::fflush(stderr);
+  }
+
+ private:
+  std::mutex mutex_;
+  std::size_t total_, done_ = 0, failed_ = 0;
+  bool tty_;
+};
+
+std::string canonical(const std::string& source) {
+  if (source.rfind(kBuiltinPrefix, 0) == 0) return source;
+  std::error_code ec;
+  const fs::path p = fs::weakly_canonical(source, ec);
+  return ec ? source : p.string();
+}
+
+void run_bake(const BakeArgs& args, int& status) {
+  const auto smith = parse_smith(args.smith);
+  if (!smith) {
+    report_error("--smith " + args.smith + ": must be masking, correlated or separable");
+    status = 2;
+    return;
+  }
+  std::vector<std::string> inputs = expand_inputs(args.inputs);
+  if (!args.scene.empty()) {
+    // Only what the scene references: its list, or the inputs that are in it.
+    const std::vector<std::string> wanted = scene_materials(args.scene);
+    if (inputs.empty()) {
+      inputs = wanted;
+    } else {
+      std::vector<std::string> kept;
+      for (const auto& in : inputs)
+        for (const auto& w : wanted)
+          if (canonical(in) == canonical(w)) kept.push_back(in);
+      std::fprintf(stderr, "facetfit: the scene references %zu of %zu inputs\n", kept.size(), inputs.size());
+      inputs = kept;
+    }
+  }
+  if (inputs.empty()) {
+    report_error("no input (give files, folders, globs, builtin:NAME or builtin:, or --scene)");
+    status = 2;
+    return;
+  }
+  std::error_code ec;
+  fs::create_directories(args.out_dir, ec);
+  if (!fs::is_directory(args.out_dir)) {
+    report_error(args.out_dir + ": cannot create output folder" + (ec ? ": " + ec.message() : ""));
+    status = 1;
+    return;
+  }
+  remove_stale_temporaries(args.out_dir);
+
+  BakeOptions options;
+  options.fit.smith = *smith;
+  options.fit.resolution = args.resolution;
+  options.fit.refine = args.refine;
+  options.tolerance = args.tolerance;
+  options.with_sampling = !args.eval_only;
+  options.force = args.force;
+  const Fitter fitter(options.fit);
+
+  // Output names must be unique: a second input with the same stem is an error, not an overwrite.
+  std::vector<BakeOutcome> outcomes(inputs.size());
+  std::map<std::string, std::string> owner;
+  std::vector<std::size_t> todo;
+  for (std::size_t k = 0; k < inputs.size(); ++k) {
+    const std::string name = source_name(inputs[k]);
+    const auto [it, fresh] = owner.emplace(name, inputs[k]);
+    if (fresh) {
+      todo.push_back(k);
+    } else {
+      outcomes[k].source = inputs[k];
+      outcomes[k].name = name;
+      outcomes[k].error = inputs[k] + ": output name " + name + " is already taken by " + it->second;
+    }
+  }
+  Progress progress(inputs.size());
+  for (const auto& o : outcomes)
+    if (!o.error.empty()) progress.report(o);
+  const int jobs = args.jobs > 0 ? args.jobs : int(std::thread::hardware_concurrency());
+  tbb::task_arena arena(std::max(1, jobs));
+  arena.execute([&] {
+    tbb::parallel_for(std::size_t(0), todo.size(), [&](std::size_t t) {
+      const std::size_t k = todo[t];
+      outcomes[k] = bake_material(inputs[k], source_name(inputs[k]), args.out_dir, options, fitter);
+      progress.report(outcomes[k]);
+    }, tbb::simple_partitioner());
+  });
+
+  nlohmann::json index;
+  index["facetfit_version"] = FACETFIT_VERSION;
+  index["materials"] = nlohmann::json::array();
+  index["failures"] = nlohmann::json::array();
+  int baked = 0, cached = 0, failed = 0;
+  for (const auto& o : outcomes) {
+    if (o.status == BakeOutcome::Status::failed) {
+      index["failures"].push_back({{"source", o.source}, {"error", o.error}});
+      ++failed;
+    } else {
+      index["materials"].push_back(o.record);
+      (o.status == BakeOutcome::Status::cached ? cached : baked)++;
+    }
+  }
+  try {
+    write_file_atomic((fs::path(args.out_dir) / "index.json").string(), index.dump(2) + "\n");
+  } catch (const Error& e) {
+    report_error(e.what());
+    status = 1;
+    return;
+  }
+  std::printf("baked %d, cached %d, failed %d: %s\n", baked, cached, failed, (fs::path(args.out_dir) / "index.json").c_str());
+  if (failed > 0) {
+    std::fprintf(stderr, "facetfit: %d of %zu inputs failed:\n", failed, inputs.size());
+    for (const auto& o : outcomes)
+      if (o.status == BakeOutcome::Status::failed) std::fprintf(stderr, "  %s\n", o.error.c_str());
+    status = 1;
+  }
+}
+
+}  // namespace
+
+void add_bake_command(CLI::App& app, int& status) {
+  auto args = std::make_shared<BakeArgs>();
+  CLI::App* cmd = app.add_subcommand("bake", "Bake LUT textures (DIR/NAME.exr) and sidecars (DIR/NAME.json, DIR/index.json)");
+  cmd->add_option("inputs", args->inputs, "Material files, folders, globs, builtin:NAME (builtin: for all)");
+  cmd->add_option("-o,--output", args->out_dir, "Output folder (created if missing)")->required();
+  cmd->add_option("-j,--jobs", args->jobs, "Materials baked at once (default: all cores)");
+  cmd->add_flag("--force", args->force, "Bake even where the cache says the outputs are current");
+  cmd->add_option("--scene", args->scene, "Bake only the materials this scene references");
+  cmd->add_option("--tolerance", args->tolerance,
+                  "NDF error (relative L1) within which the parametric fit is the recommended representation")
+      ->capture_default_str();
+  cmd->add_flag("--eval-only", args->eval_only, "Leave out the sampling tables");
+  cmd->add_option("--smith", args->smith, "masking, correlated or separable")->capture_default_str();
+  cmd->add_option("--resolution", args->resolution, "Intervals of the theta grid")->capture_default_str();
+  cmd->add_flag("--refine", args->refine, "Least-squares refinement of both alphas");
+  cmd->callback([args, &status] { run_bake(*args, status); });
+}
+
+}  // namespace facetfit::cli

@@ -1,0 +1,86 @@
+// facetfit info LUT.exr : the metadata and the tables of a LUT, to read or to plot.
+#include <cstdio>
+#include <nlohmann/json.hpp>
+
+#include "commands.h"
+#include "core/error.h"
+#include "lut/lut.h"
+
+namespace facetfit::cli {
+
+namespace {
+
+nlohmann::json info_json(const Lut& lut) {
+  const LutMetadata& m = lut.meta;
+  const auto rgb = [](const Rgb& c) { return nlohmann::json{c.r, c.g, c.b}; };
+  nlohmann::json j;
+  j["metadata"] = {{"format_version", m.format_version}, {"facetfit_version", m.facetfit_version}, {"source", m.source},
+                   {"source_sha256", m.source_sha256}, {"resolution", m.resolution}, {"smith", to_string(m.smith)},
+                   {"iterations", m.iterations}, {"residual", m.residual}, {"alpha_ggx", m.alpha_ggx},
+                   {"alpha_beckmann", m.alpha_beckmann}, {"f0", rgb(m.f0)}, {"f82", rgb(m.f82)},
+                   {"ndf_error_ggx", m.ndf_error_ggx}, {"ndf_error_beckmann", m.ndf_error_beckmann},
+                   {"representation", to_string(m.representation)}, {"tolerance", m.tolerance}, {"sampling", m.sampling}};
+  const TabulatedNdf& ndf = lut.tables.ndf;
+  nlohmann::json& t = j["ndf"];
+  for (int k = 0; k < ndf.grid.size(); ++k) {
+    const double theta = ndf.grid.theta(k);
+    t["u"].push_back(ndf.grid.u(k));
+    t["theta"].push_back(theta);
+    t["ndf"].push_back(ndf.ndf[std::size_t(k)]);
+    t["slope_pdf"].push_back(ndf.slope_pdf(theta));
+    t["sigma"].push_back(ndf.sigma[std::size_t(k)]);
+  }
+  for (int k = 0; k < FresnelCurve::kSize; ++k) {
+    j["fresnel"]["theta_d"].push_back(FresnelCurve::theta_d(k));
+    j["fresnel"]["rgb"].push_back(rgb(lut.tables.fresnel.value[std::size_t(k)]));
+  }
+  return j;
+}
+
+void print_info(const Lut& lut) {
+  const LutMetadata& m = lut.meta;
+  std::printf("source          %s\nsource_sha256   %s\nfacetfit        %s (LUT format %d)\n", m.source.c_str(),
+              m.source_sha256.c_str(), m.facetfit_version.c_str(), m.format_version);
+  std::printf("fit             resolution %d, smith %s, %d iterations, residual %.2e\n", m.resolution, to_string(m.smith),
+              m.iterations, m.residual);
+  std::printf("alpha_ggx       %.5f   (NDF error %.4f)\nalpha_beckmann  %.5f   (NDF error %.4f)\n", m.alpha_ggx,
+              m.ndf_error_ggx, m.alpha_beckmann, m.ndf_error_beckmann);
+  std::printf("f0              %.4f %.4f %.4f\nf82             %.4f %.4f %.4f\n", m.f0.r, m.f0.g, m.f0.b, m.f82.r, m.f82.g,
+              m.f82.b);
+  std::printf("representation  %s (tolerance %.4f)\nsampling tables %s\n\n", to_string(m.representation), m.tolerance,
+              m.sampling ? "yes" : "no (--eval-only)");
+  std::printf("%4s %8s %10s %14s %14s %10s\n", "node", "u", "theta_deg", "ndf", "slope_pdf", "sigma");
+  const TabulatedNdf& ndf = lut.tables.ndf;
+  for (int k = 0; k < ndf.grid.size(); ++k) {
+    const double theta = ndf.grid.theta(k);
+    std::printf("%4d %8.5f %10.5f %14.6g %14.6g %10.6f\n", k, ndf.grid.u(k), theta * 180 / kPi, ndf.ndf[std::size_t(k)],
+                ndf.slope_pdf(theta), ndf.sigma[std::size_t(k)]);
+  }
+  std::printf("\n%10s %9s %9s %9s\n", "theta_d", "F_r", "F_g", "F_b");
+  for (int k = 0; k < FresnelCurve::kSize; ++k) {
+    const Rgb& f = lut.tables.fresnel.value[std::size_t(k)];
+    std::printf("%10.1f %9.5f %9.5f %9.5f\n", FresnelCurve::theta_d(k) * 180 / kPi, f.r, f.g, f.b);
+  }
+}
+
+}  // namespace
+
+void add_info_command(CLI::App& app, int& status) {
+  auto path = std::make_shared<std::string>();
+  auto json = std::make_shared<bool>(false);
+  CLI::App* cmd = app.add_subcommand("info", "Print the metadata and tables of a LUT");
+  cmd->add_option("lut", *path, "LUT .exr written by facetfit bake")->required();
+  cmd->add_flag("--json", *json, "As one JSON object");
+  cmd->callback([path, json, &status] {
+    try {
+      const Lut lut = read_lut(*path);
+      if (*json) std::printf("%s\n", info_json(lut).dump().c_str());
+      else print_info(lut);
+    } catch (const Error& e) {
+      report_error(e.what());
+      status = 1;
+    }
+  });
+}
+
+}  // namespace facetfit::cli

@@ -1,0 +1,146 @@
+#include "lut/bake.h"
+
+#include <signal.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+
+#include "core/error.h"
+#include "io/atomic_file.h"
+#include "io/input.h"
+#include "io/sha256.h"
+#include "lut/lut.h"
+#include "lut/record.h"
+
+namespace facetfit {
+
+namespace fs = std::filesystem;
+
+std::string bake_cache_key(const std::string& source_sha256, const BakeOptions& o) {
+  nlohmann::json k;
+  k["facetfit_version"] = FACETFIT_VERSION;
+  k["lut_format_version"] = kLutFormatVersion;
+  k["source_sha256"] = source_sha256;
+  k["resolution"] = o.fit.resolution;
+  k["smith"] = to_string(o.fit.smith);
+  k["iteration_tolerance"] = o.fit.tolerance;
+  k["max_iterations"] = o.fit.max_iterations;
+  k["refine"] = o.fit.refine;
+  k["tolerance"] = o.tolerance;
+  k["sampling"] = o.with_sampling;
+  const std::string text = k.dump();
+  return sha256_hex(text.data(), text.size());
+}
+
+namespace {
+
+std::string source_hash(const std::string& source) {
+  if (source.rfind(kBuiltinPrefix, 0) == 0) {
+    // A built-in is defined by its name and the code that makes it: the version is in the cache key.
+    return sha256_hex(source.data(), source.size());
+  }
+  return sha256_file(source);
+}
+
+// The cached sidecar, if it is complete and was made from the same content with the same settings.
+std::optional<nlohmann::json> cached_record(const fs::path& json_path, const fs::path& lut_path, const std::string& key) {
+  std::error_code ec;
+  if (!fs::is_regular_file(json_path, ec) || !fs::is_regular_file(lut_path, ec)) return std::nullopt;
+  std::ifstream in(json_path);
+  const nlohmann::json j = nlohmann::json::parse(in, nullptr, false);
+  if (j.is_discarded() || !j.is_object() || j.value("cache_key", "") != key) return std::nullopt;
+  return j;
+}
+
+}  // namespace
+
+BakeOutcome bake_material(const std::string& source, const std::string& name, const std::string& out_dir,
+                          const BakeOptions& options, const Fitter& fitter) {
+  BakeOutcome out;
+  out.source = source;
+  out.name = name;
+  const auto start = std::chrono::steady_clock::now();
+  const fs::path lut_path = fs::path(out_dir) / (name + ".exr"), json_path = fs::path(out_dir) / (name + ".json");
+  try {
+    const std::string sha = source_hash(source);
+    const std::string key = bake_cache_key(sha, options);
+    if (!options.force) {
+      if (auto cached = cached_record(json_path, lut_path, key)) {
+        out.status = BakeOutcome::Status::cached;
+        out.record = std::move(*cached);
+        return out;
+      }
+    }
+    const MerlTable table = load_table(source);
+    const FitResult fit = fitter.fit(table);
+    if (!fit.ok()) fail(source, "meaningless fit: " + fit.problem);
+    const Lut lut = make_lut(fit, fitter.quadrature(), source, sha, options.tolerance, options.with_sampling);
+    write_lut(lut_path.string(), lut);
+    out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+
+    nlohmann::json& r = out.record;
+    r = fit_record(source, fit, out.seconds);
+    r["lut"] = lut_path.filename().string();
+    r["representation"] = to_string(lut.meta.representation);
+    r["ndf_error_ggx"] = lut.meta.ndf_error_ggx;
+    r["ndf_error_beckmann"] = lut.meta.ndf_error_beckmann;
+    r["smith"] = to_string(lut.meta.smith);
+    r["resolution"] = lut.meta.resolution;
+    r["tolerance"] = options.tolerance;
+    r["sampling"] = options.with_sampling;
+    r["source_sha256"] = sha;
+    r["facetfit_version"] = FACETFIT_VERSION;
+    r["cache_key"] = key;
+    // The sidecar goes last: its presence with this key is what marks the bake complete.
+    write_file_atomic(json_path.string(), r.dump(2) + "\n");
+    out.status = BakeOutcome::Status::baked;
+  } catch (const Error& e) {
+    out.status = BakeOutcome::Status::failed;
+    out.error = e.what();
+  } catch (const std::exception& e) {
+    out.status = BakeOutcome::Status::failed;
+    out.error = source + ": " + e.what();
+  }
+  out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return out;
+}
+
+int remove_stale_temporaries(const std::string& dir) {
+  // AtomicFile names: .<stem>.tmp-<pid>-<hex><ext>
+  static const std::regex pattern(R"(^\..*\.tmp-(\d+)-[0-9a-f]{8}(\.[A-Za-z0-9]+)?$)");
+  int removed = 0;
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(dir, ec)) {
+    std::smatch m;
+    const std::string file = entry.path().filename().string();
+    if (!std::regex_match(file, m, pattern)) continue;
+    const long pid = std::stol(m[1].str());
+    if (pid > 0 && ::kill(pid_t(pid), 0) == 0) continue;  // its writer is still running
+    if (fs::remove(entry.path(), ec)) ++removed;
+  }
+  return removed;
+}
+
+std::vector<std::string> scene_materials(const std::string& scene_path) {
+  std::ifstream in(scene_path);
+  if (!in) fail(scene_path, "cannot open scene");
+  const nlohmann::json scene = nlohmann::json::parse(in, nullptr, false);
+  if (scene.is_discarded()) fail(scene_path, "not valid JSON");
+  const nlohmann::json& list = scene.is_object() ? scene.value("materials", nlohmann::json()) : scene;
+  if (!list.is_array()) fail(scene_path, "a scene is a list of material paths or an object with a \"materials\" list");
+  const fs::path base = fs::path(scene_path).parent_path();
+  std::vector<std::string> out;
+  for (const auto& item : list) {
+    std::string file;
+    if (item.is_string()) file = item.get<std::string>();
+    else if (item.is_object() && item.contains("file") && item["file"].is_string()) file = item["file"].get<std::string>();
+    else fail(scene_path, "material entry " + item.dump() + " is neither a path nor an object with \"file\"");
+    if (file.rfind(kBuiltinPrefix, 0) != 0 && fs::path(file).is_relative()) file = (base / file).lexically_normal().string();
+    if (std::find(out.begin(), out.end(), file) == out.end()) out.push_back(file);
+  }
+  return out;
+}
+
+}  // namespace facetfit

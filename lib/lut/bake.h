@@ -1,0 +1,43 @@
+// Baking: measured materials to LUT textures and JSON sidecars, cached by content.
+#pragma once
+
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "fit/fit.h"
+
+namespace facetfit {
+
+struct BakeOptions {
+  FitOptions fit;
+  double tolerance = 0.02;  // NDF error a parametric fit may have and still be the recommended representation
+  bool with_sampling = true;
+  bool force = false;  // bake even when the cache says the outputs are current
+};
+
+struct BakeOutcome {
+  enum class Status { baked, cached, failed };
+  Status status = Status::failed;
+  std::string source;
+  std::string name;   // output stem: DIR/NAME.exr, DIR/NAME.json
+  std::string error;  // one line, for failed
+  nlohmann::json record;  // the sidecar's content (baked or cached)
+  double seconds = 0.0;
+};
+
+// The key under which a bake of `source_sha256` with these settings is cached.
+std::string bake_cache_key(const std::string& source_sha256, const BakeOptions& options);
+
+// Bakes one source into out_dir (which must exist). Never throws for a bad input: the outcome says why.
+BakeOutcome bake_material(const std::string& source, const std::string& name, const std::string& out_dir,
+                          const BakeOptions& options, const Fitter& fitter);
+
+// Removes temporaries left in `dir` by facetfit runs that no longer exist (a kill mid-write).
+int remove_stale_temporaries(const std::string& dir);
+
+// The materials a scene references, resolved against the scene's folder. A scene is a JSON list of
+// material paths or an object with a "materials" list (of paths, or of objects with a "file" key).
+std::vector<std::string> scene_materials(const std::string& scene_path);
+
+}  // namespace facetfit

@@ -1,0 +1,66 @@
+// Nothing is lost: a writer killed between writing and committing leaves the previous file whole.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdio>
+
+#include "io/atomic_file.h"
+#include "lut/bake.h"
+#include "test_util.h"
+
+namespace facetfit {
+namespace {
+
+using test::TempDir;
+
+// Forks a child that starts replacing `target` with `bytes`, writes half of them and is killed.
+void killed_half_way(const std::string& target, const std::string& bytes) {
+  const pid_t pid = ::fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    AtomicFile out(target);
+    std::FILE* f = std::fopen(out.temp_path().c_str(), "wb");
+    std::fwrite(bytes.data(), 1, bytes.size() / 2, f);
+    std::fflush(f);
+    ::kill(::getpid(), SIGKILL);
+    ::_exit(0);  // not reached
+  }
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  ASSERT_TRUE(WIFSIGNALED(status));
+}
+
+TEST(AtomicFile, KilledWriterLeavesThePreviousFileWhole) {
+  TempDir dir;
+  const std::string target = dir.file("gold.exr");
+  const std::string old_bytes(100000, 'o'), new_bytes(200000, 'n');
+  write_file_atomic(target, old_bytes);
+  killed_half_way(target, new_bytes);
+  EXPECT_EQ(test::read_bytes(target), old_bytes);
+  // The half-written bytes sit under a hidden temporary name, which the next bake removes.
+  int hidden = 0;
+  for (const auto& e : std::filesystem::directory_iterator(dir.path())) hidden += e.path().filename().string()[0] == '.';
+  EXPECT_EQ(hidden, 1);
+  EXPECT_EQ(remove_stale_temporaries(dir.path().string()), 1);
+  EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir.path()), {}), 1);
+}
+
+TEST(AtomicFile, KilledWriterLeavesNoNewFile) {
+  TempDir dir;
+  killed_half_way(dir.file("new.json"), std::string(5000, 'x'));
+  EXPECT_FALSE(std::filesystem::exists(dir.file("new.json")));
+}
+
+TEST(AtomicFile, TemporariesOfLiveWritersAreKept) {
+  TempDir dir;
+  AtomicFile out(dir.file("busy.exr"));
+  test::write_bytes(out.temp_path(), "in progress");
+  EXPECT_EQ(remove_stale_temporaries(dir.path().string()), 0);  // this process is alive
+  EXPECT_TRUE(std::filesystem::exists(out.temp_path()));
+  EXPECT_EQ(std::filesystem::path(out.temp_path()).extension(), ".exr");  // image writers pick the format by it
+}
+
+}  // namespace
+}  // namespace facetfit

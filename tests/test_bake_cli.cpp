@@ -1,0 +1,179 @@
+// facetfit bake and info, end to end: batches with bad files, read-only folders, kills mid-write, the
+// cache, scenes, metadata.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <thread>
+
+#include "lut/lut.h"
+#include "test_util.h"
+
+namespace facetfit {
+namespace {
+
+using test::facetfit;
+using test::RunResult;
+using test::TempDir;
+
+nlohmann::json read_json(const std::string& path) {
+  std::ifstream in(path);
+  return nlohmann::json::parse(in);
+}
+
+TEST(Bake, BatchGoesOnPastACorruptedFile) {
+  TempDir in, out;
+  ASSERT_EQ(facetfit("convert builtin:gold-ggx-0.15 -o " + in.file("gold.binary")).status, 0);
+  ASSERT_EQ(facetfit("convert builtin:silver-ggx-0.60 -o " + in.file("silver.binary")).status, 0);
+  std::string bytes = test::read_bytes(in.file("gold.binary"));
+  test::write_bytes(in.file("broken.binary"), bytes.substr(0, 1000));
+  const RunResult r = facetfit("bake " + in.path().string() + " -o " + out.path().string());
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("broken.binary: size is 1000 bytes"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("1 of 3 inputs failed"), std::string::npos) << r.err;
+  EXPECT_NE(r.out.find("baked 2, cached 0, failed 1"), std::string::npos) << r.out;
+  EXPECT_TRUE(std::filesystem::exists(out.file("gold.exr")));
+  EXPECT_TRUE(std::filesystem::exists(out.file("silver.exr")));
+  EXPECT_FALSE(std::filesystem::exists(out.file("broken.exr")));
+  const auto index = read_json(out.file("index.json"));
+  EXPECT_EQ(index["materials"].size(), 2u);
+  ASSERT_EQ(index["failures"].size(), 1u);
+  EXPECT_NE(index["failures"][0]["error"].get<std::string>().find("truncated"), std::string::npos);
+}
+
+TEST(Bake, ReadOnlyOutputFolderFailsEveryMaterialCleanly) {
+  TempDir out;
+  const std::string dir = out.file("locked");
+  std::filesystem::create_directory(dir);
+  // Root ignores permission bits but not the immutable attribute.
+  const bool root = ::geteuid() == 0;
+  if (root && test::run_command("chattr +i " + dir).status != 0) GTEST_SKIP() << "chattr +i not available to root here";
+  if (!root) std::filesystem::permissions(dir, std::filesystem::perms::owner_read | std::filesystem::perms::owner_exec);
+  const RunResult r = facetfit("bake builtin:gold-ggx-0.15 builtin:aluminium-ggx-0.05 -o " + dir);
+  if (root) test::run_command("chattr -i " + dir);
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("cannot write"), std::string::npos) << r.err;
+  EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir), {}), 0);
+}
+
+TEST(Bake, KilledMidRunLeavesOnlyWholeFiles) {
+  TempDir out;
+  const std::string dir = out.path().string();
+  // Kill a forced rebake at different moments; after each kill, every visible output must be whole.
+  // (A kill rarely lands inside one write, which takes microseconds: test_atomic.cpp kills a writer
+  // deterministically between writing and committing. This test checks the command as a whole.)
+  for (int delay_ms : {60, 150, 250, 400, 550, 700}) {
+    const pid_t pid = ::fork();
+    ASSERT_GE(pid, 0);
+    if (pid == 0) {
+      ::setpgid(0, 0);  // its own group, so that one kill reaches the shell and facetfit
+      ::execl("/bin/sh", "sh", "-c", (std::string(FACETFIT_CLI) + " bake builtin: --force -j 2 -o " + dir + " >/dev/null 2>&1").c_str(),
+              static_cast<char*>(nullptr));
+      ::_exit(127);
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(delay_ms));
+    ::kill(-pid, SIGKILL);
+    int st = 0;
+    ::waitpid(pid, &st, 0);
+    for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+      const std::string name = entry.path().filename().string();
+      if (name[0] == '.') continue;  // a writer's temporary, never a finished name
+      if (entry.path().extension() == ".exr") {
+        EXPECT_NO_THROW(read_lut(entry.path().string())) << name << " after " << delay_ms << " ms";
+      }
+      if (entry.path().extension() == ".json") {
+        EXPECT_NO_THROW(read_json(entry.path().string())) << name << " after " << delay_ms << " ms";
+      }
+    }
+  }
+  // The next run finishes the job and clears the dead runs' temporaries.
+  const RunResult r = facetfit("bake builtin: -o " + dir);
+  EXPECT_EQ(r.status, 0) << r.err;
+  for (const auto& entry : std::filesystem::directory_iterator(dir))
+    EXPECT_NE(entry.path().filename().string()[0], '.') << entry.path();
+}
+
+TEST(Bake, CacheHitsAndMisses) {
+  TempDir in, out;
+  const std::string src = in.file("copper.binary"), dir = out.path().string();
+  ASSERT_EQ(facetfit("convert builtin:copper-beckmann-0.30 -o " + src).status, 0);
+  EXPECT_NE(facetfit("bake " + src + " -o " + dir).out.find("baked 1, cached 0"), std::string::npos);
+  const auto first_write = std::filesystem::last_write_time(out.file("copper.exr"));
+  EXPECT_NE(facetfit("bake " + src + " -o " + dir).out.find("baked 0, cached 1"), std::string::npos);
+  EXPECT_EQ(std::filesystem::last_write_time(out.file("copper.exr")), first_write);
+  // Other settings, --force, other content: each a miss.
+  EXPECT_NE(facetfit("bake " + src + " --tolerance 0.1 -o " + dir).out.find("baked 1, cached 0"), std::string::npos);
+  EXPECT_NE(facetfit("bake " + src + " --tolerance 0.1 --force -o " + dir).out.find("baked 1, cached 0"), std::string::npos);
+  ASSERT_EQ(facetfit("convert builtin:gold-ggx-0.15 -o " + src).status, 0);
+  EXPECT_NE(facetfit("bake " + src + " --tolerance 0.1 -o " + dir).out.find("baked 1, cached 0"), std::string::npos);
+  // A deleted LUT is rebaked even though its sidecar is current.
+  std::filesystem::remove(out.file("copper.exr"));
+  EXPECT_NE(facetfit("bake " + src + " --tolerance 0.1 -o " + dir).out.find("baked 1, cached 0"), std::string::npos);
+}
+
+TEST(Bake, MetadataRoundTripThroughInfo) {
+  TempDir out;
+  ASSERT_EQ(facetfit("bake builtin:copper-beckmann-0.30 --smith separable -o " + out.path().string()).status, 0);
+  const auto sidecar = read_json(out.file("copper-beckmann-0.30.json"));
+  const RunResult info = facetfit("info --json " + out.file("copper-beckmann-0.30.exr"));
+  ASSERT_EQ(info.status, 0) << info.err;
+  const auto j = nlohmann::json::parse(info.out);
+  const auto& m = j["metadata"];
+  EXPECT_EQ(m["source"], "builtin:copper-beckmann-0.30");
+  EXPECT_EQ(m["smith"], "separable");
+  EXPECT_EQ(m["source_sha256"], sidecar["source_sha256"]);
+  EXPECT_EQ(m["representation"], sidecar["representation"]);
+  EXPECT_EQ(m["representation"], "beckmann");
+  EXPECT_NEAR(m["alpha_beckmann"].get<double>(), sidecar["alpha_beckmann"].get<double>(), 1e-6);
+  EXPECT_NEAR(m["f82"][1].get<double>(), sidecar["f82"][1].get<double>(), 1e-6);
+  EXPECT_EQ(j["ndf"]["slope_pdf"].size(), 91u);
+  EXPECT_EQ(j["fresnel"]["rgb"].size(), 90u);
+  // The human form names the same things.
+  const RunResult text = facetfit("info " + out.file("copper-beckmann-0.30.exr"));
+  EXPECT_NE(text.out.find("representation  beckmann"), std::string::npos) << text.out;
+}
+
+TEST(Bake, SceneBakesOnlyWhatItReferences) {
+  TempDir in, out;
+  ASSERT_EQ(facetfit("convert builtin:gold-ggx-0.15 -o " + in.file("gold.binary")).status, 0);
+  ASSERT_EQ(facetfit("convert builtin:silver-ggx-0.60 -o " + in.file("silver.binary")).status, 0);
+  test::write_bytes(in.file("scene.json"), R"({"materials": ["gold.binary", {"file": "builtin:red-plastic"}]})");
+  // Inputs the scene does not reference are skipped.
+  RunResult r = facetfit("bake " + in.path().string() + " --scene " + in.file("scene.json") + " -o " + out.path().string());
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(std::filesystem::exists(out.file("gold.exr")));
+  EXPECT_FALSE(std::filesystem::exists(out.file("silver.exr")));
+  // Without inputs, the scene's own list.
+  r = facetfit("bake --scene " + in.file("scene.json") + " -o " + out.file("all"));
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(std::filesystem::exists(out.file("all/gold.exr")));
+  EXPECT_TRUE(std::filesystem::exists(out.file("all/red-plastic.exr")));
+  test::write_bytes(in.file("bad.json"), "{not json");
+  EXPECT_NE(facetfit("bake --scene " + in.file("bad.json") + " -o " + out.file("x")).status, 0);
+}
+
+TEST(Bake, EvalOnlyAndDuplicateNames) {
+  TempDir a, b, out;
+  ASSERT_EQ(facetfit("convert builtin:gold-ggx-0.15 -o " + a.file("m.binary")).status, 0);
+  ASSERT_EQ(facetfit("convert builtin:silver-ggx-0.60 -o " + b.file("m.binary")).status, 0);
+  const RunResult r = facetfit("bake " + a.file("m.binary") + " " + b.file("m.binary") + " --eval-only -o " + out.path().string());
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("output name m is already taken by " + a.file("m.binary")), std::string::npos) << r.err;
+  EXPECT_FALSE(read_lut(out.file("m.exr")).meta.sampling);
+  EXPECT_NEAR(read_lut(out.file("m.exr")).meta.alpha_ggx, 0.15, 0.001);  // the first input's
+}
+
+TEST(Bake, GlobsAndQuotedGlobs) {
+  TempDir in, out;
+  ASSERT_EQ(facetfit("convert builtin:gold-ggx-0.15 -o " + in.file("a1.binary")).status, 0);
+  ASSERT_EQ(facetfit("convert builtin:silver-ggx-0.60 -o " + in.file("a2.binary")).status, 0);
+  const RunResult r = facetfit("bake '" + in.path().string() + "/a*.binary' -o " + out.path().string());
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("baked 2"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace facetfit
