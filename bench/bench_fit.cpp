@@ -1,6 +1,7 @@
 // Speed of the fit pipeline (Google Benchmark). `make bench` runs this and writes docs/benchmarks.md.
 #include <benchmark/benchmark.h>
 #include <tbb/global_control.h>
+#include <tbb/parallel_for.h>
 
 #include <filesystem>
 #include <memory>
@@ -8,6 +9,9 @@
 #include "fit/fit.h"
 #include "fit/roughness.h"
 #include "io/merl.h"
+#include "io/sha256.h"
+#include "lut/bake.h"
+#include "lut/lut.h"
 #include "model/analytic.h"
 
 namespace facetfit {
@@ -82,6 +86,72 @@ void BM_TabulateAnalytic(benchmark::State& state) {
   for (auto _ : state) benchmark::DoNotOptimize(MerlTable::tabulate(brdf));
 }
 BENCHMARK(BM_TabulateAnalytic)->Unit(benchmark::kMillisecond);
+
+// A MERL file on disk for the bake benchmarks, written once.
+const std::string& gold_file() {
+  static const std::string path = [] {
+    const std::string p = (std::filesystem::temp_directory_path() / "facetfit-bench-gold-bake.binary").string();
+    gold().write(p);
+    return p;
+  }();
+  return path;
+}
+
+// The whole bake of one MERL file: SHA-256, read, fit, sampling tables, EXR and sidecar.
+void BM_Bake(benchmark::State& state) {
+  gold_file();  // made once, outside the timing
+  const auto threads = limit_threads(state);
+  const std::string dir = (std::filesystem::temp_directory_path() / "facetfit-bench-bake").string();
+  std::filesystem::create_directories(dir);
+  BakeOptions options;
+  options.force = true;
+  const Fitter fitter(options.fit);
+  for (auto _ : state) benchmark::DoNotOptimize(bake_material(gold_file(), "gold", dir, options, fitter));
+  std::filesystem::remove_all(dir);
+}
+BENCHMARK(BM_Bake)->ArgName("threads")->Arg(1)->Arg(0)->Unit(benchmark::kMillisecond);
+
+void BM_Sha256File(benchmark::State& state) {
+  gold_file();
+  for (auto _ : state) benchmark::DoNotOptimize(sha256_file(gold_file()));
+  state.SetBytesProcessed(int64_t(state.iterations()) * int64_t(MerlTable::kFileBytes));
+}
+BENCHMARK(BM_Sha256File)->Unit(benchmark::kMillisecond);
+
+void BM_VisibleNormalTables(benchmark::State& state) {
+  const auto threads = limit_threads(state);
+  const FitResult fit = Fitter(FitOptions{}).fit(gold());
+  for (auto _ : state) benchmark::DoNotOptimize(VisibleNormalTables::build(fit.ndf()));
+}
+BENCHMARK(BM_VisibleNormalTables)->ArgName("threads")->Arg(1)->Unit(benchmark::kMillisecond);
+
+void BM_WriteLut(benchmark::State& state) {
+  const Fitter fitter(FitOptions{});
+  const Lut lut = make_lut(fitter.fit(gold()), fitter.quadrature(), "gold", "", 0.02, true);
+  const std::string path = (std::filesystem::temp_directory_path() / "facetfit-bench-lut.exr").string();
+  for (auto _ : state) write_lut(path, lut);
+  std::filesystem::remove(path);
+}
+BENCHMARK(BM_WriteLut)->Unit(benchmark::kMillisecond);
+
+// A batch: 8 materials baked at once (bake --jobs), one core or both.
+void BM_BakeBatch(benchmark::State& state) {
+  const int jobs = int(state.range(0));
+  gold_file();
+  tbb::global_control limit(tbb::global_control::max_allowed_parallelism, std::size_t(jobs));
+  const std::string dir = (std::filesystem::temp_directory_path() / "facetfit-bench-batch").string();
+  std::filesystem::create_directories(dir);
+  BakeOptions options;
+  options.force = true;
+  const Fitter fitter(options.fit);
+  for (auto _ : state) {
+    tbb::parallel_for(0, 8, [&](int k) { bake_material(gold_file(), "m" + std::to_string(k), dir, options, fitter); },
+                      tbb::simple_partitioner());
+  }
+  state.counters["materials_per_second"] = benchmark::Counter(8.0 * double(state.iterations()), benchmark::Counter::kIsRate);
+  std::filesystem::remove_all(dir);
+}
+BENCHMARK(BM_BakeBatch)->ArgName("jobs")->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace
 }  // namespace facetfit
