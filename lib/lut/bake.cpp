@@ -6,7 +6,7 @@
 #include <chrono>
 #include <filesystem>
 #include <fstream>
-#include <regex>
+#include <cctype>
 
 #include "core/error.h"
 #include "io/atomic_file.h"
@@ -127,17 +127,31 @@ BakeOutcome bake_material(const std::string& source, const std::string& name, co
   return out;
 }
 
+namespace {
+
+// The writer's pid if `file` is an AtomicFile temporary, .<stem>.tmp-<pid>-<8 hex digits>[.<ext>]; else 0.
+long temporary_owner(const std::string& file) {
+  const std::size_t at = file.rfind(".tmp-");
+  if (file.empty() || file[0] != '.' || at == std::string::npos || at == 0) return 0;
+  std::size_t k = at + 5, digits = 0;
+  long pid = 0;
+  for (; k < file.size() && std::isdigit(static_cast<unsigned char>(file[k])) && digits < 10; ++k, ++digits) pid = pid * 10 + (file[k] - '0');
+  if (digits == 0 || k >= file.size() || file[k] != '-') return 0;
+  std::size_t hex = 0;
+  for (++k; k < file.size() && std::isxdigit(static_cast<unsigned char>(file[k])); ++k) ++hex;
+  if (hex != 8 || (k < file.size() && file[k] != '.')) return 0;
+  return pid;
+}
+
+}  // namespace
+
 int remove_stale_temporaries(const std::string& dir) {
-  // AtomicFile names: .<stem>.tmp-<pid>-<hex><ext>
-  static const std::regex pattern(R"(^\..*\.tmp-(\d+)-[0-9a-f]{8}(\.[A-Za-z0-9]+)?$)");
   int removed = 0;
   std::error_code ec;
   for (const auto& entry : fs::directory_iterator(dir, ec)) {
-    std::smatch m;
-    const std::string file = entry.path().filename().string();
-    if (!std::regex_match(file, m, pattern)) continue;
-    const long pid = std::stol(m[1].str());
-    if (pid > 0 && ::kill(pid_t(pid), 0) == 0) continue;  // its writer is still running
+    const long pid = temporary_owner(entry.path().filename().string());
+    if (pid <= 0) continue;
+    if (::kill(pid_t(pid), 0) == 0) continue;  // its writer is still running
     if (fs::remove(entry.path(), ec)) ++removed;
   }
   return removed;
