@@ -39,7 +39,7 @@ bench: build
 
 # Regenerates docs/accuracy.md (ground-truth fits).
 accuracy: build
-	$(BUILD)/bench/facetfit_accuracy docs/accuracy.md
+	$(BUILD)/bench/facetfit_accuracy docs/accuracy.md ../shared/data/rgl
 
 clean:
 	rm -rf build

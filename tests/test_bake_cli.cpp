@@ -177,3 +177,47 @@ TEST(Bake, GlobsAndQuotedGlobs) {
 
 }  // namespace
 }  // namespace facetfit
+
+namespace facetfit {
+namespace {
+
+// Real measurements through every command that takes an input.
+class RglPipeline : public testing::Test {
+ protected:
+  void SetUp() override {
+    if (!std::filesystem::is_directory(test::rgl_dir()))
+      GTEST_SKIP() << "RGL data folder " << test::rgl_dir().string() << " is absent (set FACETFIT_RGL_DIR)";
+  }
+  std::string file(const char* name) const { return (test::rgl_dir() / name).string(); }
+};
+
+TEST_F(RglPipeline, ConvertWritesARealMerlFileThatFitsTheSame) {
+  TempDir out;
+  const std::string merl = out.file("metallic.binary");
+  ASSERT_EQ(facetfit("convert " + file("ilm_l3_37_metallic_rgb.bsdf") + " -o " + merl).status, 0);
+  EXPECT_EQ(std::filesystem::file_size(merl), 34992012u);
+  const RunResult a = facetfit("fit " + file("ilm_l3_37_metallic_rgb.bsdf") + " --json");
+  const RunResult b = facetfit("fit " + merl + " --json");
+  ASSERT_EQ(a.status, 0) << a.err;
+  ASSERT_EQ(b.status, 0) << b.err;
+  const auto ja = nlohmann::json::parse(a.out), jb = nlohmann::json::parse(b.out);
+  // The MERL file holds the same table at float precision: the same fit.
+  EXPECT_NEAR(jb["alpha_ggx"].get<double>(), ja["alpha_ggx"].get<double>(), 1e-5);
+  EXPECT_NEAR(jb["f0"][0].get<double>(), ja["f0"][0].get<double>(), 1e-5);
+}
+
+TEST_F(RglPipeline, BakeTheWholeDatabase) {
+  TempDir out;
+  const RunResult r = facetfit("bake " + test::rgl_dir().string() + " -o " + out.path().string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("baked 6, cached 0, failed 0"), std::string::npos) << r.out;
+  for (const auto& m : read_json(out.file("index.json"))["materials"]) {
+    EXPECT_GT(m["alpha_ggx"].get<double>(), 0.01);
+    EXPECT_LT(m["alpha_ggx"].get<double>(), 1.0);
+    const Lut lut = read_lut(out.file(m["lut"].get<std::string>()));
+    EXPECT_EQ(lut.meta.source_sha256.size(), 64u);
+  }
+}
+
+}  // namespace
+}  // namespace facetfit

@@ -18,6 +18,7 @@
 
 #include "core/error.h"
 #include "io/rgl.h"
+#include "test_util.h"
 
 namespace facetfit {
 namespace {
@@ -30,15 +31,7 @@ static_assert(std::is_move_assignable_v<RglBsdf>);
 // ---------------------------------------------------------------------------------------------
 // Data location and scratch files
 
-// FACETFIT_RGL_DIR overrides; otherwise ../shared/data/rgl next to the source tree.
-fs::path rgl_dir() {
-  if (const char* env = std::getenv("FACETFIT_RGL_DIR"); env && *env) return env;
-#ifdef FACETFIT_SOURCE_DIR
-  return fs::path(FACETFIT_SOURCE_DIR) / ".." / "shared" / "data" / "rgl";
-#else
-  return fs::path(__FILE__).parent_path().parent_path() / ".." / "shared" / "data" / "rgl";
-#endif
-}
+using test::rgl_dir;
 
 struct RealFile {
   const char* name;

@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -40,6 +41,12 @@ inline void write_bytes(const std::string& path, const std::string& bytes) {
 inline std::string read_bytes(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+// The RGL material database: FACETFIT_RGL_DIR, or ../shared/data/rgl beside the source tree.
+inline std::filesystem::path rgl_dir() {
+  if (const char* env = std::getenv("FACETFIT_RGL_DIR"); env && *env) return env;
+  return std::filesystem::path(FACETFIT_SOURCE_DIR) / ".." / "shared" / "data" / "rgl";
 }
 
 struct RunResult {
