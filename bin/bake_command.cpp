@@ -29,9 +29,7 @@ struct BakeArgs {
   std::string scene;
   double tolerance = 0.02;
   bool eval_only = false;
-  std::string smith = "correlated";
-  int resolution = 90;
-  bool refine = false;
+  FitSettings settings;
 };
 
 // One line per material, or a progress bar when stderr is a terminal.
@@ -72,12 +70,8 @@ std::string canonical(const std::string& source) {
 }
 
 void run_bake(const BakeArgs& args, int& status) {
-  const auto smith = parse_smith(args.smith);
-  if (!smith) {
-    report_error("--smith " + args.smith + ": must be masking, correlated or separable");
-    status = 2;
-    return;
-  }
+  const auto fit = fit_options(args.settings, status);
+  if (!fit) return;
   std::vector<std::string> inputs = expand_inputs(args.inputs);
   if (!args.scene.empty()) {
     // Only what the scene references: its list, or the inputs that are in it.
@@ -108,9 +102,7 @@ void run_bake(const BakeArgs& args, int& status) {
   remove_stale_temporaries(args.out_dir);
 
   BakeOptions options;
-  options.fit.smith = *smith;
-  options.fit.resolution = args.resolution;
-  options.fit.refine = args.refine;
+  options.fit = *fit;
   options.tolerance = args.tolerance;
   options.with_sampling = !args.eval_only;
   options.force = args.force;
@@ -188,9 +180,7 @@ void add_bake_command(CLI::App& app, int& status) {
                   "NDF error (relative L1) within which the parametric fit is the recommended representation")
       ->capture_default_str();
   cmd->add_flag("--eval-only", args->eval_only, "Leave out the sampling tables");
-  cmd->add_option("--smith", args->smith, "masking, correlated or separable")->capture_default_str();
-  cmd->add_option("--resolution", args->resolution, "Intervals of the theta grid")->capture_default_str();
-  cmd->add_flag("--refine", args->refine, "Least-squares refinement of both alphas");
+  add_fit_settings(cmd, args->settings);
   cmd->callback([args, &status] { run_bake(*args, status); });
 }
 

@@ -3,8 +3,24 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
+#include <optional>
+#include <string>
+
+#include "fit/fit.h"
 
 namespace facetfit::cli {
+
+// The fit settings every command that fits takes, as given on the command line.
+struct FitSettings {
+  std::string smith = "correlated";
+  int resolution = 90;
+  double iteration_tolerance = 1e-10;
+  int max_iterations = 1000;
+  bool refine = false;
+};
+void add_fit_settings(CLI::App* cmd, FitSettings& settings);
+// The FitOptions they name, or nullopt after reporting a usage error (status 2).
+std::optional<FitOptions> fit_options(const FitSettings& settings, int& status);
 
 void add_fit_command(CLI::App& app, int& status);
 void add_convert_command(CLI::App& app, int& status);

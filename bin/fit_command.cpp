@@ -17,11 +17,7 @@ namespace {
 struct FitArgs {
   std::vector<std::string> inputs;
   bool builtin = false;
-  std::string smith = "correlated";
-  int resolution = 90;
-  double tolerance = 1e-10;
-  int max_iterations = 1000;
-  bool refine = false;
+  FitSettings settings;
   bool json = false;
 };
 
@@ -36,12 +32,8 @@ void print_row(const std::string& source, const FitResult& r, double seconds) {
 }
 
 void run_fit(const FitArgs& args, int& status) {
-  const auto smith = parse_smith(args.smith);
-  if (!smith) {
-    report_error("--smith " + args.smith + ": must be masking, correlated or separable");
-    status = 2;
-    return;
-  }
+  const auto options = fit_options(args.settings, status);
+  if (!options) return;
   std::vector<std::string> raw = args.inputs;
   if (args.builtin) raw.push_back(kBuiltinPrefix);
   const std::vector<std::string> inputs = expand_inputs(raw);
@@ -50,13 +42,7 @@ void run_fit(const FitArgs& args, int& status) {
     status = 2;
     return;
   }
-  FitOptions options;
-  options.resolution = args.resolution;
-  options.smith = *smith;
-  options.tolerance = args.tolerance;
-  options.max_iterations = args.max_iterations;
-  options.refine = args.refine;
-  const Fitter fitter(options);
+  const Fitter fitter(*options);
 
   if (!args.json)
     std::printf("%-28s  %9s  %9s  %-17s  %-17s  %5s  %8s  %7s\n", "material", "alpha_ggx", "alpha_bkm", "f0 (r g b)",
@@ -94,15 +80,7 @@ void add_fit_command(CLI::App& app, int& status) {
   CLI::App* cmd = app.add_subcommand("fit", "Fit microfacet components to measured materials");
   cmd->add_option("inputs", args->inputs, "MERL .binary files, folders, or builtin:NAME (builtin: for all)");
   cmd->add_flag("--builtin", args->builtin, "Fit every built-in synthetic material");
-  cmd->add_option("--smith", args->smith,
-                  "Masking-shadowing model the fit is consistent with: masking (the paper), correlated "
-                  "(height-correlated, as pbrt-v4 and Cycles render), separable")
-      ->capture_default_str();
-  cmd->add_option("--resolution", args->resolution, "Intervals of the theta = u^2 pi/2 grid (90: MERL's own bins)")
-      ->capture_default_str();
-  cmd->add_option("--tolerance", args->tolerance, "Power-iteration stop: relative L1 change of the NDF")->capture_default_str();
-  cmd->add_option("--max-iterations", args->max_iterations, "Power-iteration limit")->capture_default_str();
-  cmd->add_flag("--refine", args->refine, "Refine both alphas by least squares against the tabulated NDF");
+  add_fit_settings(cmd, args->settings);
   cmd->add_flag("--json", args->json, "One JSON object per material on stdout");
   cmd->callback([args, &status] { run_fit(*args, status); });
 }

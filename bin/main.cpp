@@ -8,6 +8,35 @@ namespace facetfit::cli {
 
 void report_error(const std::string& message) { std::fprintf(stderr, "facetfit: error: %s\n", message.c_str()); }
 
+void add_fit_settings(CLI::App* cmd, FitSettings& s) {
+  cmd->add_option("--smith", s.smith,
+                  "Masking-shadowing model the fit is consistent with: masking (the paper), correlated "
+                  "(height-correlated, as pbrt-v4 and Cycles render), separable")
+      ->capture_default_str();
+  cmd->add_option("--resolution", s.resolution, "Intervals of the theta = u^2 pi/2 grid (90: MERL's own bins)")
+      ->capture_default_str();
+  cmd->add_option("--iteration-tolerance", s.iteration_tolerance, "Power-iteration stop: relative L1 change of the NDF")
+      ->capture_default_str();
+  cmd->add_option("--max-iterations", s.max_iterations, "Power-iteration limit")->capture_default_str();
+  cmd->add_flag("--refine", s.refine, "Refine both alphas by least squares against the tabulated NDF");
+}
+
+std::optional<FitOptions> fit_options(const FitSettings& s, int& status) {
+  const auto smith = parse_smith(s.smith);
+  if (!smith) {
+    report_error("--smith " + s.smith + ": must be masking, correlated or separable");
+    status = 2;
+    return std::nullopt;
+  }
+  FitOptions options;
+  options.smith = *smith;
+  options.resolution = s.resolution;
+  options.tolerance = s.iteration_tolerance;
+  options.max_iterations = s.max_iterations;
+  options.refine = s.refine;
+  return options;
+}
+
 }  // namespace facetfit::cli
 
 int main(int argc, char** argv) {

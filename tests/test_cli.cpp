@@ -19,14 +19,6 @@ using test::RunResult;
 
 int lines(const std::string& s) { return int(std::count(s.begin(), s.end(), '\n')); }
 
-std::string merl_header(std::int32_t a, std::int32_t b, std::int32_t c) {
-  std::string s(12, '\0');
-  std::memcpy(s.data(), &a, 4);
-  std::memcpy(s.data() + 4, &b, 4);
-  std::memcpy(s.data() + 8, &c, 4);
-  return s;
-}
-
 class CliBadFile : public testing::TestWithParam<std::pair<std::string, std::string>> {};
 
 // Each bad file: exactly one error line naming the file and the problem, exit status 1, no crash.
@@ -35,11 +27,11 @@ TEST_P(CliBadFile, OneClearLine) {
   const auto& [name, expected] = GetParam();
   const std::string path = dir.file(name);
   if (name == "empty.binary") test::write_bytes(path, "");
-  if (name == "truncated.binary") test::write_bytes(path, merl_header(90, 90, 180) + std::string(4096, '\0'));
-  if (name == "dims.binary") test::write_bytes(path, merl_header(90, 90, 90) + std::string(4096, '\0'));
-  if (name == "huge.binary") test::write_bytes(path, merl_header(1000, 1000, 1000));
+  if (name == "truncated.binary") test::write_bytes(path, test::merl_header(90, 90, 180) + std::string(4096, '\0'));
+  if (name == "dims.binary") test::write_bytes(path, test::merl_header(90, 90, 90) + std::string(4096, '\0'));
+  if (name == "huge.binary") test::write_bytes(path, test::merl_header(1000, 1000, 1000));
   if (name == "nan.binary") {
-    std::string bytes = merl_header(90, 90, 180) + std::string(3 * MerlTable::kBins * 8, '\0');
+    std::string bytes = test::merl_header(90, 90, 180) + std::string(3 * MerlTable::kBins * 8, '\0');
     std::memset(bytes.data() + 12 + 8 * 1000, 0xff, 8);  // all ones: a NaN
     test::write_bytes(path, bytes);
   }

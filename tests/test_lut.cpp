@@ -14,6 +14,7 @@
 namespace facetfit {
 namespace {
 
+using test::error_of;
 using test::TempDir;
 
 struct Baked {
@@ -42,8 +43,7 @@ TEST(Lut, RoundTripEvaluatesAsTheInMemoryModel) {
   std::mt19937 rng(1);
   std::uniform_real_distribution<double> u(0.0, 1.0);
   for (int n = 0; n < 2000; ++n) {
-    const Vec3 i = spherical_direction(std::acos(u(rng)), 2 * kPi * u(rng));
-    const Vec3 o = spherical_direction(std::acos(u(rng)), 2 * kPi * u(rng));
+    const Vec3 i = test::random_direction(rng), o = test::random_direction(rng);
     const Rgb fa = *a.eval(i, o), fc = *c.eval(i, o);
     for (int ch = 0; ch < 3; ++ch) EXPECT_NEAR(fc[ch], fa[ch], 1e-6 * std::max(fa[ch], 1e-6));
     const double pa = a.pdf(o, i), pc = c.pdf(o, i);
@@ -51,7 +51,7 @@ TEST(Lut, RoundTripEvaluatesAsTheInMemoryModel) {
   }
   // Same samples from the same numbers.
   for (int n = 0; n < 200; ++n) {
-    const Vec3 o = spherical_direction(std::acos(u(rng)), 2 * kPi * u(rng));
+    const Vec3 o = test::random_direction(rng);
     const double u1 = u(rng), u2 = u(rng);
     const auto sa = a.sample(o, u1, u2), sc = c.sample(o, u1, u2);
     ASSERT_EQ(sa.has_value(), sc.has_value());
@@ -106,16 +106,6 @@ TEST(Lut, EvalOnlyLeavesOutTheSamplingTables) {
   EXPECT_LT(std::filesystem::file_size(dir.file("eval.exr")), std::filesystem::file_size(dir.file("full.exr")));
   const Vec3 i = spherical_direction(0.3, 0.0), o = spherical_direction(0.5, 2.0);
   EXPECT_EQ(full.model().eval(i, o)->r, eval.model().eval(i, o)->r);
-}
-
-template <class F>
-std::string error_of(F f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
 }
 
 TEST(Lut, BadFilesGetOneClearLine) {

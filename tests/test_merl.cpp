@@ -15,22 +15,12 @@
 namespace facetfit {
 namespace {
 
+using test::error_of;
 using test::TempDir;
 
 MerlTable gold_table() {
   return MerlTable::tabulate(MicrofacetBrdf(Ndf::isotropic(NdfType::ggx, 0.3), Smith::correlated,
                                             Fresnel::conductor({0.143, 0.374, 1.442}, {3.983, 2.385, 1.603})));
-}
-
-// The message of the Error that `f` throws, or "" if it throws none.
-template <class F>
-std::string error_of(F f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
 }
 
 TEST(Merl, WriteReadRoundTripIsExactToFloat) {
@@ -119,13 +109,6 @@ TEST(Merl, NegativeEntriesAreMissing) {
 
 class MerlBadFile : public testing::Test {
  protected:
-  std::string header(std::int32_t a, std::int32_t b, std::int32_t c) {
-    std::string s(12, '\0');
-    std::memcpy(s.data(), &a, 4);
-    std::memcpy(s.data() + 4, &b, 4);
-    std::memcpy(s.data() + 8, &c, 4);
-    return s;
-  }
   // Reads `bytes` as a MERL file and returns the error message.
   std::string read_error(const std::string& bytes) {
     const std::string path = dir.file("bad.binary");
@@ -150,27 +133,27 @@ TEST_F(MerlBadFile, Empty) { EXPECT_NE(read_error("").find("bad.binary: file is 
 TEST_F(MerlBadFile, TruncatedHeader) { EXPECT_NE(read_error("abcde").find("truncated header"), std::string::npos); }
 
 TEST_F(MerlBadFile, WrongDimensions) {
-  EXPECT_NE(read_error(header(90, 90, 360) + std::string(64, '\0')).find("90 x 90 x 360"), std::string::npos);
+  EXPECT_NE(read_error(test::merl_header(90, 90, 360) + std::string(64, '\0')).find("90 x 90 x 360"), std::string::npos);
 }
 
 TEST_F(MerlBadFile, HugeHeaderAllocatesNothing) {
   // 10^9 entries claimed: rejected from the header alone.
-  const std::string msg = read_error(header(1000, 1000, 1000));
+  const std::string msg = read_error(test::merl_header(1000, 1000, 1000));
   EXPECT_NE(msg.find("1000 x 1000 x 1000"), std::string::npos) << msg;
 }
 
 TEST_F(MerlBadFile, Truncated) {
-  const std::string msg = read_error(header(90, 90, 180) + std::string(1000, '\0'));
+  const std::string msg = read_error(test::merl_header(90, 90, 180) + std::string(1000, '\0'));
   EXPECT_NE(msg.find("(truncated)"), std::string::npos) << msg;
 }
 
 TEST_F(MerlBadFile, TrailingData) {
-  const std::string msg = read_error(header(90, 90, 180) + std::string(3 * MerlTable::kBins * 8 + 8, '\0'));
+  const std::string msg = read_error(test::merl_header(90, 90, 180) + std::string(3 * MerlTable::kBins * 8 + 8, '\0'));
   EXPECT_NE(msg.find("(trailing data)"), std::string::npos) << msg;
 }
 
 TEST_F(MerlBadFile, NanPayloadNamesTheOffset) {
-  std::string bytes = header(90, 90, 180) + std::string(3 * MerlTable::kBins * 8, '\0');
+  std::string bytes = test::merl_header(90, 90, 180) + std::string(3 * MerlTable::kBins * 8, '\0');
   const double nan = std::numeric_limits<double>::quiet_NaN();
   const std::size_t bin = MerlTable::index(3, 4, 5);
   std::memcpy(bytes.data() + 12 + (MerlTable::kBins + bin) * 8, &nan, 8);
@@ -181,7 +164,7 @@ TEST_F(MerlBadFile, NanPayloadNamesTheOffset) {
 }
 
 TEST_F(MerlBadFile, InfPayloadInTheLastChannel) {
-  std::string bytes = header(90, 90, 180) + std::string(3 * MerlTable::kBins * 8, '\0');
+  std::string bytes = test::merl_header(90, 90, 180) + std::string(3 * MerlTable::kBins * 8, '\0');
   const double inf = -std::numeric_limits<double>::infinity();
   const std::size_t last = 3 * MerlTable::kBins - 1;
   std::memcpy(bytes.data() + 12 + last * 8, &inf, 8);

@@ -4,11 +4,17 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <random>
 #include <string>
+
+#include "core/error.h"
+#include "core/vec.h"
 
 namespace facetfit::test {
 
@@ -41,6 +47,33 @@ inline void write_bytes(const std::string& path, const std::string& bytes) {
 inline std::string read_bytes(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+// The message of the facetfit::Error that `f` throws, or "" if it throws none.
+template <class F>
+std::string error_of(F f) {
+  try {
+    f();
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// The 12-byte header of a MERL file claiming these dimensions.
+inline std::string merl_header(std::int32_t a, std::int32_t b, std::int32_t c) {
+  std::string s(12, '\0');
+  std::memcpy(s.data(), &a, 4);
+  std::memcpy(s.data() + 4, &b, 4);
+  std::memcpy(s.data() + 8, &c, 4);
+  return s;
+}
+
+// A direction uniformly distributed over the upper hemisphere.
+inline Vec3 random_direction(std::mt19937& rng) {
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const double cos_theta = u(rng);
+  return spherical_direction(std::acos(cos_theta), 2.0 * kPi * u(rng));
 }
 
 // The RGL material database: FACETFIT_RGL_DIR, or ../shared/data/rgl beside the source tree.
