@@ -48,6 +48,7 @@ int main(int argc, char** argv) {
   add_fit_command(app, status);
   add_bake_command(app, status);
   add_info_command(app, status);
+  add_render_command(app, status);
   add_convert_command(app, status);
   add_builtins_command(app, status);
   try {

@@ -11,6 +11,7 @@ endif()
 find_package(OpenSSL REQUIRED)  # SHA-256 of sources (LUT metadata, bake cache)
 find_package(Imath CONFIG REQUIRED)
 find_package(OpenImageIO CONFIG REQUIRED)
+find_package(embree 3 CONFIG REQUIRED)
 
 # Debian's imported targets list include folders that do not exist (/usr/include/opencv4), which CMake
 # rejects: keep only the folders that are there.

@@ -99,12 +99,13 @@ double sample_phi(double a, double b, double u) {
   // Newton on the monotone CDF, kept inside the bracket.
   double lo = 0.0, hi = phi_max, phi = u * phi_max;
   for (int it = 0; it < 40; ++it) {
-    const double f = a * std::sin(phi) + b * phi - target;
+    const double s = std::sin(phi), c = std::cos(phi);  // one sincos
+    const double f = a * s + b * phi - target;
     if (f > 0.0) hi = phi; else lo = phi;
-    const double df = a * std::cos(phi) + b;
+    const double df = a * c + b;
     double next = df > 0.0 ? phi - f / df : 0.5 * (lo + hi);
     if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
-    if (std::abs(next - phi) < 1e-13) {
+    if (std::abs(next - phi) < 1e-10) {
       phi = next;
       break;
     }
@@ -141,6 +142,14 @@ double TabulatedMicrofacet::pdf(const Vec3& o, const Vec3& i) const {
 }
 
 std::optional<TabulatedMicrofacet::Sample> TabulatedMicrofacet::sample(const Vec3& o, double u1, double u2) const {
+  const auto i = sample_direction(o, u1, u2);
+  if (!i) return std::nullopt;
+  const double p = pdf(o, *i);
+  if (!(p > 0.0)) return std::nullopt;
+  return Sample{*i, *eval(*i, o) * (i->z / p), p};
+}
+
+std::optional<Vec3> TabulatedMicrofacet::sample_direction(const Vec3& o, double u1, double u2) const {
   if (o.z <= 0.0 || sampling_.empty()) return std::nullopt;
   const ThetaGrid& grid = tables_.ndf.grid;
   const int r = grid.resolution;
@@ -167,10 +176,7 @@ std::optional<TabulatedMicrofacet::Sample> TabulatedMicrofacet::sample(const Vec
   const Vec3 h(sin_h * std::cos(phi), sin_h * std::sin(phi), cos_h);
   const Vec3 i = 2.0 * glm::dot(o, h) * h - o;
   if (i.z <= 0.0) return std::nullopt;
-  const double p = pdf(o, i);
-  if (!(p > 0.0)) return std::nullopt;
-  const auto f = eval(i, o);
-  return Sample{i, *f * (i.z / p), p};
+  return i;
 }
 
 }  // namespace facetfit

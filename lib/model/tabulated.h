@@ -55,6 +55,8 @@ class TabulatedMicrofacet final : public Brdf {
   // when the reflected direction falls below the horizon (the sample carries no energy), when o is at
   // or below the horizon, or when the model has no sampling tables.
   std::optional<Sample> sample(const Vec3& o, double u1, double u2) const;
+  // The direction sample() would draw, without its pdf and weight (for callers that mix proposals).
+  std::optional<Vec3> sample_direction(const Vec3& o, double u1, double u2) const;
   // Density of sample() per steradian of i. Integrates over the upper hemisphere to the fraction of
   // samples that land there.
   double pdf(const Vec3& o, const Vec3& i) const;

@@ -1,0 +1,72 @@
+// facetfit render [SCENE.json] -o OUT.exr : the reference renderer.
+#include <unistd.h>
+
+#include <cstdio>
+
+#include "commands.h"
+#include "core/error.h"
+#include "render/renderer.h"
+
+namespace facetfit::cli {
+
+namespace {
+
+struct RenderArgs {
+  std::string scene;
+  std::string output;
+  int spp = 0;
+  std::uint64_t seed = 0;
+  std::string material = "builtin:gold-ggx-0.15";
+  std::string material_type = "measured";
+  int width = 0, height = 0;
+};
+
+void run_render(const RenderArgs& args, int& status) {
+  try {
+    SceneDesc scene;
+    if (args.scene.empty()) {
+      MaterialDesc subject;
+      subject.type = args.material_type;
+      subject.file = args.material;
+      scene = default_scene(subject);
+    } else {
+      scene = parse_scene(args.scene);
+    }
+    if (args.width > 0) scene.camera.width = args.width;
+    if (args.height > 0) scene.camera.height = args.height;
+    RenderSettings settings;
+    settings.spp = args.spp;
+    settings.seed = args.seed;
+    const bool tty = ::isatty(STDERR_FILENO) == 1;
+    settings.progress = [tty](int done, int total) {
+      if (tty) std::fprintf(stderr, "\rrendering: pass %d/%d%s", done, total, done == total ? "\n" : "");
+    };
+    const RenderedImage image = render(scene, settings);
+    write_exr(args.output, image,
+              {{"scene", args.scene.empty() ? "default" : args.scene}, {"spp", std::to_string(image.spp)},
+               {"seconds", std::to_string(image.seconds)}});
+    std::printf("%s (%dx%d, %d spp, %.2f s)\n", args.output.c_str(), image.width, image.height, image.spp, image.seconds);
+  } catch (const Error& e) {
+    report_error(e.what());
+    status = 1;
+  }
+}
+
+}  // namespace
+
+void add_render_command(CLI::App& app, int& status) {
+  auto args = std::make_shared<RenderArgs>();
+  CLI::App* cmd = app.add_subcommand("render", "Render a scene (or the embedded default) with the reference renderer");
+  cmd->add_option("scene", args->scene, "Scene JSON (docs/scene-format.md); omitted: a sphere under the built-in sky");
+  cmd->add_option("-o,--output", args->output, "Linear EXR to write")->required();
+  cmd->add_option("--spp", args->spp, "Samples per pixel (default: the scene's)");
+  cmd->add_option("--seed", args->seed, "Random seed (default: the scene's)");
+  cmd->add_option("--width", args->width, "Image width (default: the scene's)");
+  cmd->add_option("--height", args->height, "Image height (default: the scene's)");
+  cmd->add_option("--material", args->material, "Default scene only: the sphere's material file")->capture_default_str();
+  cmd->add_option("--material-type", args->material_type, "Default scene only: measured, lut, ggx or beckmann")
+      ->capture_default_str();
+  cmd->callback([args, &status] { run_render(*args, status); });
+}
+
+}  // namespace facetfit::cli

@@ -1,0 +1,157 @@
+#include "render/environment.h"
+
+#include <OpenImageIO/imageio.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/error.h"
+
+namespace facetfit {
+
+namespace {
+
+Vec3 direction_of(double u, double v) {
+  const double phi = u * 2.0 * kPi - kPi, theta = v * kPi;
+  const double s = std::sin(theta);
+  return {s * std::sin(phi), std::cos(theta), -s * std::cos(phi)};
+}
+
+}  // namespace
+
+Vec3 builtin_sun_direction() { return glm::normalize(Vec3(0.45, 0.55, 0.70)); }
+
+Environment Environment::constant(const Rgb& radiance) {
+  Environment env;
+  env.constant_ = radiance;
+  return env;
+}
+
+Environment Environment::from_pixels(int width, int height, std::vector<float> rgb) {
+  if (width < 1 || height < 1 || rgb.size() != std::size_t(width) * height * 3) throw Error("environment: bad image size");
+  Environment env;
+  env.width_ = width;
+  env.height_ = height;
+  env.rgb_ = std::move(rgb);
+  for (float& v : env.rgb_)
+    if (!std::isfinite(v) || v < 0.0f) v = 0.0f;
+  env.build_distribution();
+  return env;
+}
+
+Environment Environment::load(const std::string& path) {
+  auto in = OIIO::ImageInput::open(path);
+  if (!in) {
+    const std::string why = OIIO::geterror();
+    fail(path, why.empty() ? "cannot open environment map" : why.substr(0, why.find('\n')));
+  }
+  const OIIO::ImageSpec& spec = in->spec();
+  if (spec.width < 2 || spec.height < 1 || spec.width > 65536 || spec.height > 32768) fail(path, "unusable environment map size");
+  int channel[3];
+  const char* names[3] = {"R", "G", "B"};
+  for (int c = 0; c < 3; ++c) {
+    channel[c] = spec.channelindex(names[c]);
+    if (channel[c] < 0) channel[c] = std::min(c, spec.nchannels - 1);  // grey maps
+  }
+  std::vector<float> all(std::size_t(spec.width) * spec.height * spec.nchannels);
+  if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, all.data())) fail(path, "cannot read: " + in->geterror());
+  std::vector<float> rgb(std::size_t(spec.width) * spec.height * 3);
+  for (std::size_t p = 0; p < std::size_t(spec.width) * spec.height; ++p)
+    for (int c = 0; c < 3; ++c) rgb[p * 3 + c] = all[p * spec.nchannels + channel[c]];
+  return from_pixels(spec.width, spec.height, std::move(rgb));
+}
+
+Environment Environment::sky(int width) {
+  const int height = width / 2;
+  std::vector<float> rgb(std::size_t(width) * height * 3);
+  const Vec3 sun = builtin_sun_direction();
+  const double sun_cos = std::cos(2.5 * kPi / 180.0);  // a 5-degree disc: small, bright, still resolvable
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) {
+      const Vec3 d = direction_of((x + 0.5) / width, (y + 0.5) / height);
+      Rgb c;
+      if (d.y >= 0.0) {
+        const double t = std::pow(1.0 - d.y, 3.0);  // whiter toward the horizon
+        c = glm::mix(Rgb(0.25, 0.45, 0.95), Rgb(0.9, 0.92, 1.0), t);
+      } else {
+        c = Rgb(0.18, 0.16, 0.14) * (0.6 + 0.4 * (1.0 + d.y));
+      }
+      if (glm::dot(d, sun) > sun_cos) c += Rgb(40.0, 36.0, 30.0);
+      for (int k = 0; k < 3; ++k) rgb[(std::size_t(y) * width + x) * 3 + k] = float(c[k]);
+    }
+  return from_pixels(width, height, std::move(rgb));
+}
+
+void Environment::build_distribution() {
+  const int w = width_, h = height_;
+  col_cdf_.assign(std::size_t(h) * (w + 1), 0.0);
+  row_cdf_.assign(std::size_t(h) + 1, 0.0);
+  density_.assign(std::size_t(w) * h, 0.0);
+  std::vector<double> weight(std::size_t(w) * h);
+  double total = 0.0;
+  for (int y = 0; y < h; ++y) {
+    const double s = std::sin((y + 0.5) / h * kPi);
+    double* cdf = col_cdf_.data() + std::size_t(y) * (w + 1);
+    for (int x = 0; x < w; ++x) {
+      const float* p = rgb_.data() + (std::size_t(y) * w + x) * 3;
+      // A floor keeps every direction samplable, so light sampling alone is unbiased too.
+      const double lum = luminance(Rgb(p[0], p[1], p[2])) + 1e-4;
+      weight[std::size_t(y) * w + x] = lum * s;
+      cdf[x + 1] = cdf[x] + lum * s;
+    }
+    row_cdf_[std::size_t(y) + 1] = row_cdf_[std::size_t(y)] + cdf[w];
+    total += cdf[w];
+  }
+  for (int y = 0; y < h; ++y) {
+    double* cdf = col_cdf_.data() + std::size_t(y) * (w + 1);
+    const double row = cdf[w];
+    for (int x = 0; x <= w; ++x) cdf[x] = row > 0.0 ? cdf[x] / row : double(x) / w;
+  }
+  for (double& v : row_cdf_) v /= total;
+  for (std::size_t k = 0; k < weight.size(); ++k) density_[k] = weight[k] / total * double(w) * double(h);
+}
+
+int Environment::pixel_of(const Vec3& d, int* x, int* y) const {
+  const double theta = std::acos(clamp(d.y, -1.0, 1.0)), phi = std::atan2(d.x, -d.z);
+  *x = std::clamp(int((phi + kPi) / (2.0 * kPi) * width_), 0, width_ - 1);
+  *y = std::clamp(int(theta / kPi * height_), 0, height_ - 1);
+  return *y * width_ + *x;
+}
+
+Rgb Environment::radiance(const Vec3& d) const {
+  if (is_constant()) return constant_;
+  int x, y;
+  const float* p = rgb_.data() + std::size_t(pixel_of(d, &x, &y)) * 3;
+  return {p[0], p[1], p[2]};
+}
+
+Environment::Sample Environment::sample(double u1, double u2) const {
+  if (is_constant()) {  // uniform sphere
+    const double z = 1.0 - 2.0 * u1, r = std::sqrt(std::max(0.0, 1.0 - z * z)), phi = 2.0 * kPi * u2;
+    return {Vec3(r * std::cos(phi), z, r * std::sin(phi)), constant_, 1.0 / (4.0 * kPi)};
+  }
+  const auto pick = [](const double* cdf, int n, double u, double* t) {
+    int k = int(std::upper_bound(cdf, cdf + n + 1, u) - cdf) - 1;
+    k = std::clamp(k, 0, n - 1);
+    const double m = cdf[k + 1] - cdf[k];
+    *t = m > 0.0 ? clamp((u - cdf[k]) / m, 0.0, 1.0) : 0.5;
+    return k;
+  };
+  double tv, tu;
+  const int y = pick(row_cdf_.data(), height_, u1, &tv);
+  const int x = pick(col_cdf_.data() + std::size_t(y) * (width_ + 1), width_, u2, &tu);
+  const double u = (x + tu) / width_, v = (y + tv) / height_;
+  const Vec3 d = direction_of(u, v);
+  return {d, radiance(d), pdf(d)};
+}
+
+double Environment::pdf(const Vec3& d) const {
+  if (is_constant()) return 1.0 / (4.0 * kPi);
+  const double s = std::sqrt(std::max(0.0, 1.0 - d.y * d.y));
+  if (s <= 0.0) return 0.0;
+  int x, y;
+  // Density over [0,1]^2 to solid angle: d(omega) = 2 pi^2 sin(theta) du dv.
+  return density_[std::size_t(pixel_of(d, &x, &y))] / (2.0 * kPi * kPi * s);
+}
+
+}  // namespace facetfit

@@ -1,0 +1,54 @@
+// A distant environment light: a lat-long radiance image, importance-sampled.
+//
+// World frame: +y is up. Direction d has theta = acos(d.y) from the zenith and phi = atan2(d.x, -d.z);
+// pixel (x, y) covers u = (phi + pi) / (2 pi) in [x/W, (x+1)/W) and v = theta / pi in [y/H, (y+1)/H).
+// Radiance is constant over a pixel, so the sampling density (proportional to luminance x sin(theta)
+// per pixel) and radiance() agree exactly, as multiple importance sampling needs.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "core/vec.h"
+
+namespace facetfit {
+
+class Environment {
+ public:
+  static Environment constant(const Rgb& radiance);
+  // `rgb` holds width x height interleaved linear Rec.709 values, row 0 at the zenith.
+  static Environment from_pixels(int width, int height, std::vector<float> rgb);
+  // Any image OpenImageIO reads (EXR, HDR); throws Error naming the file.
+  static Environment load(const std::string& path);
+  // The built-in sky: a zenith-to-horizon gradient, a darker ground, and a small bright sun. Needs no file.
+  static Environment sky(int width = 512);
+
+  Rgb radiance(const Vec3& d) const;
+  struct Sample {
+    Vec3 d;
+    Rgb radiance;
+    double pdf;  // per steradian
+  };
+  Sample sample(double u1, double u2) const;
+  double pdf(const Vec3& d) const;
+  bool is_constant() const { return width_ == 0; }
+  const std::vector<float>& pixels() const { return rgb_; }
+  int width() const { return width_; }
+  int height() const { return height_; }
+
+ private:
+  void build_distribution();
+  int pixel_of(const Vec3& d, int* x, int* y) const;
+
+  int width_ = 0, height_ = 0;  // 0: constant
+  Rgb constant_{0.0};
+  std::vector<float> rgb_;
+  std::vector<double> row_cdf_;   // height + 1
+  std::vector<double> col_cdf_;   // height x (width + 1)
+  std::vector<double> density_;   // per pixel, over [0,1]^2
+};
+
+// Direction of the built-in sky's sun (toward the sun).
+Vec3 builtin_sun_direction();
+
+}  // namespace facetfit

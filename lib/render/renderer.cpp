@@ -1,0 +1,303 @@
+#include "render/renderer.h"
+
+#include <OpenImageIO/imageio.h>
+#include <embree3/rtcore.h>
+#include <tbb/blocked_range2d.h>
+#include <tbb/parallel_for.h>
+
+#include <chrono>
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <sstream>
+
+#include "core/error.h"
+#include "io/atomic_file.h"
+#include "render/environment.h"
+
+namespace facetfit {
+
+namespace {
+
+// SplitMix64: a counter-based generator, so each pixel's sequence depends on (seed, pixel) only.
+struct Random {
+  std::uint64_t state;
+  double next() {
+    std::uint64_t z = (state += 0x9E3779B97F4A7C15ull);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    z ^= z >> 31;
+    return double(z >> 11) * 0x1.0p-53;
+  }
+};
+
+struct Frame {  // orthonormal basis around n (Duff et al. 2017)
+  Vec3 t, b, n;
+  explicit Frame(const Vec3& normal) : n(normal) {
+    const double sign = std::copysign(1.0, n.z), a = -1.0 / (sign + n.z), c = n.x * n.y * a;
+    t = Vec3(1.0 + sign * n.x * n.x * a, sign * c, -sign * n.x);
+    b = Vec3(c, sign + n.y * n.y * a, -n.y);
+  }
+  Vec3 to_local(const Vec3& v) const { return {glm::dot(v, t), glm::dot(v, b), glm::dot(v, n)}; }
+  Vec3 to_world(const Vec3& v) const { return v.x * t + v.y * b + v.z * n; }
+};
+
+double power_heuristic(double a, double b) { return a * a / (a * a + b * b); }
+
+struct EmbreeScene {
+  RTCDevice device = nullptr;
+  RTCScene scene = nullptr;
+  ~EmbreeScene() {
+    if (scene) rtcReleaseScene(scene);
+    if (device) rtcReleaseDevice(device);
+  }
+};
+
+struct Geometry {
+  const ObjectDesc* object;
+  int material;
+};
+
+}  // namespace
+
+void read_obj(const std::string& path, std::vector<float>& positions, std::vector<unsigned>& indices) {
+  std::ifstream in(path);
+  if (!in) fail(path, "cannot open mesh");
+  std::string line;
+  std::size_t line_no = 0;
+  while (std::getline(in, line)) {
+    ++line_no;
+    std::istringstream ls(line);
+    std::string tag;
+    ls >> tag;
+    if (tag == "v") {
+      double x, y, z;
+      if (!(ls >> x >> y >> z)) fail(path, "line " + std::to_string(line_no) + ": bad vertex");
+      positions.insert(positions.end(), {float(x), float(y), float(z)});
+    } else if (tag == "f") {
+      std::vector<unsigned> face;
+      std::string corner;
+      while (ls >> corner) {
+        long k = std::strtol(corner.c_str(), nullptr, 10);  // "v", "v/t", "v/t/n", "v//n"
+        const long count = long(positions.size() / 3);
+        if (k < 0) k += count + 1;  // relative indices
+        if (k < 1 || k > count) fail(path, "line " + std::to_string(line_no) + ": vertex index out of range");
+        face.push_back(unsigned(k - 1));
+      }
+      if (face.size() < 3) fail(path, "line " + std::to_string(line_no) + ": face with fewer than 3 vertices");
+      for (std::size_t c = 1; c + 1 < face.size(); ++c) indices.insert(indices.end(), {face[0], face[c], face[c + 1]});
+    }
+  }
+  if (indices.empty()) fail(path, "no faces");
+}
+
+RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
+  const auto start = std::chrono::steady_clock::now();
+  // Only what the scene uses is loaded.
+  std::vector<std::shared_ptr<const ShadingModel>> materials;
+  std::map<std::string, int> material_index;
+  for (const ObjectDesc& o : desc.objects) {
+    if (material_index.count(o.material)) continue;
+    material_index[o.material] = int(materials.size());
+    materials.push_back(load_material(desc, desc.materials.at(o.material)));
+  }
+  std::optional<Environment> env;
+  switch (desc.environment.kind) {
+    case EnvironmentDesc::Kind::none: break;
+    case EnvironmentDesc::Kind::builtin_sky: env = Environment::sky(); break;
+    case EnvironmentDesc::Kind::constant: env = Environment::constant(desc.environment.constant * desc.environment.scale); break;
+    case EnvironmentDesc::Kind::file: {
+      Environment loaded = Environment::load(resolve(desc, desc.environment.file));
+      if (desc.environment.scale != 1.0) {
+        std::vector<float> px = loaded.pixels();
+        for (float& v : px) v *= float(desc.environment.scale);
+        loaded = Environment::from_pixels(loaded.width(), loaded.height(), std::move(px));
+      }
+      env = std::move(loaded);
+      break;
+    }
+  }
+
+  EmbreeScene es;
+  es.device = rtcNewDevice("threads=0");
+  if (!es.device) throw Error("embree: cannot create a device");
+  es.scene = rtcNewScene(es.device);
+  std::vector<Geometry> geometries;
+  for (const ObjectDesc& o : desc.objects) {
+    RTCGeometry g = nullptr;
+    if (o.kind == ObjectDesc::Kind::sphere) {
+      g = rtcNewGeometry(es.device, RTC_GEOMETRY_TYPE_SPHERE_POINT);
+      auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4, 4 * sizeof(float), 1));
+      v[0] = float(o.center.x), v[1] = float(o.center.y), v[2] = float(o.center.z), v[3] = float(o.radius);
+    } else {
+      std::vector<float> p;
+      std::vector<unsigned> idx;
+      if (o.kind == ObjectDesc::Kind::plane) {
+        const Frame f(o.normal);
+        const double h = 0.5 * o.size;
+        for (const auto& [a, b] : {std::pair{-h, -h}, {h, -h}, {h, h}, {-h, h}}) {
+          const Vec3 q = o.point + a * f.t + b * f.b;
+          p.insert(p.end(), {float(q.x), float(q.y), float(q.z)});
+        }
+        idx = {0, 1, 2, 0, 2, 3};
+      } else {
+        read_obj(resolve(desc, o.file), p, idx);
+      }
+      g = rtcNewGeometry(es.device, RTC_GEOMETRY_TYPE_TRIANGLE);
+      auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), p.size() / 3));
+      std::copy(p.begin(), p.end(), vb);
+      auto* ib = static_cast<unsigned*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), idx.size() / 3));
+      std::copy(idx.begin(), idx.end(), ib);
+    }
+    rtcCommitGeometry(g);
+    rtcAttachGeometryByID(es.scene, g, unsigned(geometries.size()));
+    rtcReleaseGeometry(g);
+    geometries.push_back({&o, material_index.at(o.material)});
+  }
+  rtcCommitScene(es.scene);
+
+  const CameraDesc& cam = desc.camera;
+  const int width = cam.width, height = cam.height;
+  const int spp = settings.spp > 0 ? settings.spp : desc.spp;
+  const std::uint64_t seed = settings.seed > 0 ? settings.seed : desc.seed;
+  const Vec3 forward = glm::normalize(cam.look_at - cam.position);
+  const Vec3 right = glm::normalize(glm::cross(forward, cam.up));
+  const Vec3 up = glm::cross(right, forward);
+  const double tan_half = std::tan(0.5 * cam.fov_degrees * kPi / 180.0), aspect = double(width) / height;
+  double scene_scale = 1.0;
+  for (const ObjectDesc& o : desc.objects) scene_scale = std::max({scene_scale, glm::length(o.center) + o.radius, o.size});
+  const double eps = 1e-5 * scene_scale;
+
+  const auto occluded = [&](const Vec3& origin, const Vec3& dir, double tfar) {
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    RTCRay ray{};
+    ray.org_x = float(origin.x), ray.org_y = float(origin.y), ray.org_z = float(origin.z);
+    ray.dir_x = float(dir.x), ray.dir_y = float(dir.y), ray.dir_z = float(dir.z);
+    ray.tnear = 0.0f;
+    ray.tfar = float(tfar);
+    ray.mask = 0xFFFFFFFFu;
+    rtcOccluded1(es.scene, &ctx, &ray);
+    return ray.tfar < 0.0f;
+  };
+
+  // One sample of pixel (x, y): radiance and coverage.
+  const auto sample_pixel = [&](int x, int y, Random& rng, Rgb& radiance, double& alpha) {
+    const double sx = (2.0 * (x + rng.next()) / width - 1.0) * tan_half * aspect;
+    const double sy = (1.0 - 2.0 * (y + rng.next()) / height) * tan_half;
+    const Vec3 dir = glm::normalize(forward + sx * right + sy * up);
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    RTCRayHit rh{};
+    rh.ray.org_x = float(cam.position.x), rh.ray.org_y = float(cam.position.y), rh.ray.org_z = float(cam.position.z);
+    rh.ray.dir_x = float(dir.x), rh.ray.dir_y = float(dir.y), rh.ray.dir_z = float(dir.z);
+    rh.ray.tnear = 0.0f;
+    rh.ray.tfar = std::numeric_limits<float>::infinity();
+    rh.ray.mask = 0xFFFFFFFFu;
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(es.scene, &ctx, &rh);
+    // Five numbers per sample whatever happens, so that pixels never share or shift their sequences.
+    const double u[5] = {rng.next(), rng.next(), rng.next(), rng.next(), rng.next()};
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) {
+      radiance = env ? env->radiance(dir) : Rgb(0.0);
+      alpha = 0.0;
+      return;
+    }
+    alpha = 1.0;
+    const Geometry& geo = geometries[rh.hit.geomID];
+    const Vec3 p = cam.position + double(rh.ray.tfar) * dir;
+    Vec3 n = geo.object->kind == ObjectDesc::Kind::sphere ? glm::normalize(p - geo.object->center)
+                                                          : glm::normalize(Vec3(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z));
+    if (glm::dot(n, dir) > 0.0) n = -n;  // shade the side the camera sees
+    const Frame frame(n);
+    const Vec3 o = frame.to_local(-dir);
+    const ShadingModel& model = *materials[std::size_t(geo.material)];
+    const Vec3 origin = p + eps * n;
+    Rgb sum(0.0);
+    if (env && o.z > 0.0) {
+      // Light sampling, weighted against the BRDF's proposal.
+      const Environment::Sample ls = env->sample(u[0], u[1]);
+      const Vec3 il = frame.to_local(ls.d);
+      if (il.z > 0.0 && ls.pdf > 0.0 && !occluded(origin, ls.d, std::numeric_limits<float>::infinity())) {
+        const double w = power_heuristic(ls.pdf, model.pdf(o, il));
+        sum += model.f(il, o) * ls.radiance * (il.z * w / ls.pdf);
+      }
+      // BRDF sampling, weighted against the environment's.
+      if (const auto bs = model.sample(o, u[2], u[3], u[4])) {
+        const Vec3 d = frame.to_world(bs->i);
+        if (!occluded(origin, d, std::numeric_limits<float>::infinity())) {
+          const double w = power_heuristic(bs->pdf, env->pdf(d));
+          sum += bs->weight * env->radiance(d) * w;
+        }
+      }
+    }
+    for (const LightDesc& light : desc.lights) {
+      Vec3 d;
+      double dist = std::numeric_limits<float>::infinity();
+      Rgb e = light.value;
+      if (light.kind == LightDesc::Kind::directional) {
+        d = light.vector;
+      } else {
+        const Vec3 to = light.vector - p;
+        dist = glm::length(to);
+        d = to / dist;
+        e /= dist * dist;
+        dist *= 1.0 - 1e-6;
+      }
+      const Vec3 il = frame.to_local(d);
+      if (il.z > 0.0 && o.z > 0.0 && !occluded(origin, d, dist)) sum += model.f(il, o) * e * il.z;
+    }
+    radiance = sum;
+  };
+
+  RenderedImage image;
+  image.width = width;
+  image.height = height;
+  image.spp = spp;
+  image.rgba.assign(std::size_t(width) * height * 4, 0.0f);
+  std::vector<double> accum(std::size_t(width) * height * 4, 0.0);
+  const int passes = std::max(1, std::min(settings.passes, spp));
+  int done = 0;
+  for (int pass = 0; pass < passes; ++pass) {
+    const int first = spp * pass / passes, last = spp * (pass + 1) / passes;
+    tbb::parallel_for(tbb::blocked_range2d<int>(0, height, 16, 0, width, 16), [&](const tbb::blocked_range2d<int>& tile) {
+      for (int y = tile.rows().begin(); y < tile.rows().end(); ++y)
+        for (int x = tile.cols().begin(); x < tile.cols().end(); ++x) {
+          double* acc = accum.data() + (std::size_t(y) * width + x) * 4;
+          for (int s = first; s < last; ++s) {
+            // The sequence of sample s of this pixel: independent of passes, tiles and threads.
+            Random rng{seed * 0x100000001B3ull ^ (std::uint64_t(y) * 73856093u + std::uint64_t(x) * 19349663u) * 0x9E3779B97F4A7C15ull ^
+                       std::uint64_t(s) << 40};
+            Rgb radiance;
+            double alpha;
+            sample_pixel(x, y, rng, radiance, alpha);
+            if (!std::isfinite(radiance.r) || !std::isfinite(radiance.g) || !std::isfinite(radiance.b)) radiance = Rgb(0.0);
+            acc[0] += radiance.r, acc[1] += radiance.g, acc[2] += radiance.b, acc[3] += alpha;
+          }
+        }
+    });
+    done = last;
+    for (std::size_t k = 0; k < accum.size(); ++k) image.rgba[k] = float(accum[k] / done);
+    if (settings.progress) settings.progress(pass + 1, passes);
+  }
+  image.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return image;
+}
+
+void write_exr(const std::string& path, const RenderedImage& image, const std::vector<std::pair<std::string, std::string>>& metadata) {
+  OIIO::ImageSpec spec(image.width, image.height, 4, OIIO::TypeDesc::FLOAT);
+  spec.channelnames = {"R", "G", "B", "A"};
+  spec.alpha_channel = 3;
+  spec.attribute("compression", "zip");
+  spec.attribute("oiio:ColorSpace", "Linear");
+  for (const auto& [k, v] : metadata) spec.attribute("facetfit:" + k, v);
+  AtomicFile out(path);
+  auto img = OIIO::ImageOutput::create(out.temp_path());
+  if (!img) fail(path, "cannot write: " + OIIO::geterror());
+  if (!img->open(out.temp_path(), spec) || !img->write_image(OIIO::TypeDesc::FLOAT, image.rgba.data()) || !img->close())
+    fail(path, "cannot write: " + img->geterror());
+  img.reset();
+  out.commit();
+}
+
+}  // namespace facetfit

@@ -1,0 +1,38 @@
+// The reference renderer: Embree 3 for visibility, direct lighting from the environment and the
+// scene's lights with multiple importance sampling, oneTBB over tiles, a fixed random sequence per
+// pixel (the same scene and settings give the same image on any number of threads).
+#pragma once
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "render/scene.h"
+
+namespace facetfit {
+
+struct RenderSettings {
+  int spp = 0;                // 0: the scene's
+  std::uint64_t seed = 0;     // 0: the scene's
+  int passes = 4;             // samples are added in passes (progressive), each over the whole image
+  std::function<void(int done_passes, int passes)> progress;  // optional
+};
+
+struct RenderedImage {
+  int width = 0, height = 0;
+  std::vector<float> rgba;  // linear Rec.709, alpha = coverage of the objects
+  int spp = 0;
+  double seconds = 0.0;
+};
+
+// Loads what the scene needs (its environment, and only the materials its objects use) and renders.
+// Throws Error for anything it cannot load.
+RenderedImage render(const SceneDesc& scene, const RenderSettings& settings = {});
+
+// Linear EXR (R, G, B, A, float) with the given string metadata, through a temporary file.
+void write_exr(const std::string& path, const RenderedImage& image, const std::vector<std::pair<std::string, std::string>>& metadata);
+
+// Reads the triangles of a Wavefront OBJ (v and f records; polygons fanned). Throws Error naming the file.
+void read_obj(const std::string& path, std::vector<float>& positions, std::vector<unsigned>& indices);
+
+}  // namespace facetfit

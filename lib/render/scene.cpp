@@ -1,0 +1,207 @@
+#include "render/scene.h"
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "core/error.h"
+#include "fit/fit.h"
+#include "io/input.h"
+#include "lut/lut.h"
+#include "model/analytic.h"
+#include "model/parametric.h"
+
+namespace facetfit {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+Vec3 vec3(const json& j, const std::string& what, const std::string& path) {
+  if (!j.is_array() || j.size() != 3 || !j[0].is_number() || !j[1].is_number() || !j[2].is_number())
+    fail(path, what + " must be an array of three numbers");
+  return {j[0].get<double>(), j[1].get<double>(), j[2].get<double>()};
+}
+
+template <class T>
+T get(const json& j, const char* key, T fallback, const std::string& path) {
+  if (!j.contains(key)) return fallback;
+  try {
+    return j.at(key).get<T>();
+  } catch (const json::exception&) {
+    fail(path, std::string("\"") + key + "\" has the wrong type");
+  }
+}
+
+MaterialDesc parse_material(const std::string& name, const json& j, const std::string& path) {
+  if (!j.is_object()) fail(path, "material " + name + " must be an object");
+  MaterialDesc m;
+  m.type = get<std::string>(j, "type", "", path);
+  if (m.type != "measured" && m.type != "lut" && m.type != "ggx" && m.type != "beckmann" && m.type != "lambert")
+    fail(path, "material " + name + ": type must be measured, lut, ggx, beckmann or lambert");
+  m.file = get<std::string>(j, "file", "", path);
+  if ((m.type == "measured" || m.type == "lut") && m.file.empty()) fail(path, "material " + name + " needs a \"file\"");
+  m.alpha = get<double>(j, "alpha", 0.0, path);
+  if ((m.type == "ggx" || m.type == "beckmann") && m.file.empty() && !(m.alpha > 0.0))
+    fail(path, "material " + name + " needs \"alpha\" > 0 or a LUT \"file\"");
+  if (j.contains("f0")) m.f0 = vec3(j["f0"], "f0", path);
+  m.f82 = j.contains("f82") ? vec3(j["f82"], "f82", path) : m.f0;
+  m.fresnel = get<std::string>(j, "fresnel", m.file.empty() ? "f82" : "curve", path);
+  if (m.fresnel != "curve" && m.fresnel != "f82") fail(path, "material " + name + ": fresnel must be curve or f82");
+  const auto smith = parse_smith(get<std::string>(j, "smith", "correlated", path));
+  if (!smith) fail(path, "material " + name + ": smith must be masking, correlated or separable");
+  m.smith = *smith;
+  if (j.contains("albedo")) m.albedo = vec3(j["albedo"], "albedo", path);
+  return m;
+}
+
+}  // namespace
+
+SceneDesc parse_scene(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) fail(path, "cannot open scene");
+  const json j = json::parse(in, nullptr, false);
+  if (j.is_discarded() || !j.is_object()) fail(path, "not a JSON object");
+  SceneDesc s;
+  s.base_dir = fs::path(path).parent_path().string();
+  if (s.base_dir.empty()) s.base_dir = ".";
+  if (j.contains("camera")) {
+    const json& c = j["camera"];
+    if (c.contains("position")) s.camera.position = vec3(c["position"], "camera.position", path);
+    if (c.contains("look_at")) s.camera.look_at = vec3(c["look_at"], "camera.look_at", path);
+    if (c.contains("up")) s.camera.up = vec3(c["up"], "camera.up", path);
+    s.camera.fov_degrees = get<double>(c, "fov", s.camera.fov_degrees, path);
+    s.camera.width = get<int>(c, "width", s.camera.width, path);
+    s.camera.height = get<int>(c, "height", s.camera.height, path);
+    if (s.camera.width < 1 || s.camera.height < 1 || s.camera.width > 16384 || s.camera.height > 16384)
+      fail(path, "camera width and height must be between 1 and 16384");
+    if (!(s.camera.fov_degrees > 0.0 && s.camera.fov_degrees < 180.0)) fail(path, "camera fov must be in (0, 180) degrees");
+  }
+  if (j.contains("render")) {
+    s.spp = get<int>(j["render"], "spp", s.spp, path);
+    s.seed = get<std::uint64_t>(j["render"], "seed", s.seed, path);
+    if (s.spp < 1 || s.spp > 1 << 20) fail(path, "render.spp must be between 1 and 1048576");
+  }
+  if (j.contains("environment")) {
+    const json& e = j["environment"];
+    s.environment.scale = get<double>(e, "scale", 1.0, path);
+    if (e.contains("file")) {
+      s.environment.kind = EnvironmentDesc::Kind::file;
+      s.environment.file = get<std::string>(e, "file", "", path);
+    } else if (e.contains("constant")) {
+      s.environment.kind = EnvironmentDesc::Kind::constant;
+      s.environment.constant = vec3(e["constant"], "environment.constant", path);
+    } else if (get<std::string>(e, "builtin", "", path) == "sky") {
+      s.environment.kind = EnvironmentDesc::Kind::builtin_sky;
+    } else {
+      fail(path, "environment needs \"file\", \"constant\" or \"builtin\": \"sky\"");
+    }
+  }
+  // Named copies, not temporaries: GCC 12 warns (wrongly) about iterating those.
+  const json lights = j.contains("lights") ? j["lights"] : json::array();
+  const json materials = j.contains("materials") ? j["materials"] : json::object();
+  const json objects = j.contains("objects") ? j["objects"] : json::array();
+  if (!lights.is_array() || !materials.is_object() || !objects.is_array())
+    fail(path, "lights and objects must be lists, materials an object");
+  for (const json& l : lights) {
+    LightDesc d;
+    const std::string type = get<std::string>(l, "type", "", path);
+    if (type == "directional") {
+      d.kind = LightDesc::Kind::directional;
+      d.vector = glm::normalize(vec3(l.value("direction", json()), "directional light direction", path));
+      d.value = vec3(l.value("irradiance", json()), "directional light irradiance", path);
+    } else if (type == "point") {
+      d.kind = LightDesc::Kind::point;
+      d.vector = vec3(l.value("position", json()), "point light position", path);
+      d.value = vec3(l.value("intensity", json()), "point light intensity", path);
+    } else {
+      fail(path, "light type must be directional or point");
+    }
+    s.lights.push_back(d);
+  }
+  for (const auto& [name, m] : materials.items()) s.materials[name] = parse_material(name, m, path);
+  for (const json& o : objects) {
+    ObjectDesc d;
+    const std::string type = get<std::string>(o, "type", "", path);
+    if (type == "sphere") {
+      d.kind = ObjectDesc::Kind::sphere;
+      d.center = vec3(o.value("center", json::array({0, 0, 0})), "sphere center", path);
+      d.radius = get<double>(o, "radius", 1.0, path);
+      if (!(d.radius > 0.0)) fail(path, "sphere radius must be positive");
+    } else if (type == "plane") {
+      d.kind = ObjectDesc::Kind::plane;
+      d.point = vec3(o.value("point", json::array({0, 0, 0})), "plane point", path);
+      d.normal = glm::normalize(vec3(o.value("normal", json::array({0, 1, 0})), "plane normal", path));
+      d.size = get<double>(o, "size", 10.0, path);
+    } else if (type == "mesh") {
+      d.kind = ObjectDesc::Kind::mesh;
+      d.file = get<std::string>(o, "file", "", path);
+      if (d.file.empty()) fail(path, "mesh needs a \"file\"");
+    } else {
+      fail(path, "object type must be sphere, plane or mesh");
+    }
+    d.material = get<std::string>(o, "material", "", path);
+    if (!s.materials.count(d.material)) fail(path, "object references undefined material \"" + d.material + "\"");
+    s.objects.push_back(d);
+  }
+  if (s.objects.empty()) fail(path, "no objects");
+  return s;
+}
+
+SceneDesc default_scene(const MaterialDesc& subject) {
+  SceneDesc s;
+  s.camera.position = Vec3(0, 0.6, 4.0);
+  s.camera.look_at = Vec3(0, 0, 0);
+  s.camera.fov_degrees = 30.0;
+  s.environment.kind = EnvironmentDesc::Kind::builtin_sky;
+  s.materials["subject"] = subject;
+  ObjectDesc sphere;
+  sphere.material = "subject";
+  s.objects.push_back(sphere);
+  return s;
+}
+
+std::string resolve(const SceneDesc& scene, const std::string& file) {
+  if (file.rfind(kBuiltinPrefix, 0) == 0 || fs::path(file).is_absolute()) return file;
+  return (fs::path(scene.base_dir) / file).lexically_normal().string();
+}
+
+std::shared_ptr<const ShadingModel> load_material(const SceneDesc& scene, const MaterialDesc& m) {
+  if (m.type == "lambert") return std::make_shared<ShadingModel>(std::make_shared<LambertBrdf>(m.albedo), nullptr);
+  if (m.type == "measured") {
+    // The measurement is what is rendered; its fit only proposes directions.
+    auto table = std::make_shared<MerlTable>(load_table(resolve(scene, m.file)));
+    const Fitter fitter{FitOptions{}};
+    const FitResult fit = fitter.fit(*table);
+    std::shared_ptr<const TabulatedMicrofacet> proposal;
+    if (fit.ok()) proposal = std::make_shared<TabulatedMicrofacet>(MicrofacetTables{fit.ndf(), fit.smith, fit.fresnel});
+    return std::make_shared<ShadingModel>(table, proposal);
+  }
+  if (m.type == "lut") {
+    auto model = std::make_shared<TabulatedMicrofacet>(read_lut(resolve(scene, m.file)).model());
+    std::shared_ptr<const TabulatedMicrofacet> proposal = model;
+    if (!model->can_sample())  // an --eval-only LUT: sample its NDF with freshly built tables
+      proposal = std::make_shared<TabulatedMicrofacet>(model->tables());
+    return std::make_shared<ShadingModel>(model, proposal);
+  }
+  // ggx | beckmann
+  const NdfType type = m.type == "ggx" ? NdfType::ggx : NdfType::beckmann;
+  std::shared_ptr<const Brdf> brdf;
+  Ndf ndf;
+  if (!m.file.empty()) {
+    const Lut lut = read_lut(resolve(scene, m.file));
+    ndf = Ndf::isotropic(type, type == NdfType::ggx ? lut.meta.alpha_ggx : lut.meta.alpha_beckmann);
+    brdf = m.fresnel == "curve" ? std::make_shared<ParametricBrdf>(ndf, m.smith, lut.tables.fresnel)
+                                : std::make_shared<ParametricBrdf>(ndf, m.smith, lut.meta.f0, lut.meta.f82);
+  } else {
+    ndf = Ndf::isotropic(type, m.alpha);
+    brdf = std::make_shared<ParametricBrdf>(ndf, m.smith, m.f0, m.f82);
+  }
+  MicrofacetTables tables;
+  tables.ndf = tabulate_ndf(ndf);
+  tables.smith = m.smith;
+  return std::make_shared<ShadingModel>(brdf, std::make_shared<TabulatedMicrofacet>(tables));
+}
+
+}  // namespace facetfit

@@ -1,0 +1,79 @@
+// Scenes for the reference renderer (docs/scene-format.md): a JSON description, parsed without loading
+// anything, and the materials it references, loaded on demand.
+#pragma once
+
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/vec.h"
+#include "model/smith.h"
+#include "render/shading.h"
+
+namespace facetfit {
+
+struct CameraDesc {
+  Vec3 position{0, 0, 4}, look_at{0, 0, 0}, up{0, 1, 0};
+  double fov_degrees = 30.0;  // vertical
+  int width = 256, height = 256;
+};
+
+struct EnvironmentDesc {
+  enum class Kind { none, builtin_sky, constant, file } kind = Kind::none;
+  Rgb constant{1.0};
+  std::string file;
+  double scale = 1.0;
+};
+
+struct LightDesc {
+  enum class Kind { directional, point } kind = Kind::directional;
+  Vec3 vector{0, 1, 0};  // directional: toward the light; point: position
+  Rgb value{1.0};        // directional: irradiance (W/m^2 per unit area facing it); point: intensity
+};
+
+struct MaterialDesc {
+  // measured | lut | ggx | beckmann | lambert
+  std::string type = "lambert";
+  std::string file;       // measured: any facetfit input; lut: the LUT; ggx/beckmann: optional LUT to take alpha and Fresnel from
+  double alpha = 0.0;     // ggx/beckmann without a LUT
+  Rgb f0{0.04}, f82{0.04};
+  std::string fresnel = "curve";  // ggx/beckmann with a LUT: "curve" (the LUT's RGB curve) or "f82" (F82-tint from f0, f82)
+  Smith smith = Smith::correlated;
+  Rgb albedo{0.8};
+};
+
+struct ObjectDesc {
+  enum class Kind { sphere, plane, mesh } kind = Kind::sphere;
+  Vec3 center{0.0};
+  double radius = 1.0;
+  Vec3 point{0.0}, normal{0, 1, 0};
+  double size = 10.0;  // plane: side of the square
+  std::string file;    // mesh: Wavefront OBJ
+  std::string material;
+};
+
+struct SceneDesc {
+  CameraDesc camera;
+  int spp = 64;
+  std::uint64_t seed = 1;
+  EnvironmentDesc environment;
+  std::vector<LightDesc> lights;
+  std::map<std::string, MaterialDesc> materials;
+  std::vector<ObjectDesc> objects;
+  std::string base_dir = ".";  // where relative file names resolve
+};
+
+// Throws Error("<path>: <problem>") for unreadable or inconsistent scenes.
+SceneDesc parse_scene(const std::string& path);
+// The embedded default: a sphere of `subject` under the built-in sky. Needs no asset.
+SceneDesc default_scene(const MaterialDesc& subject);
+
+// Resolves a file name of the scene: relative names against the scene's folder, builtin: as is.
+std::string resolve(const SceneDesc& scene, const std::string& file);
+
+// The shading model of a material: loads its file (and fits or tabulates what sampling needs).
+std::shared_ptr<const ShadingModel> load_material(const SceneDesc& scene, const MaterialDesc& m);
+
+}  // namespace facetfit

@@ -1,0 +1,61 @@
+#include "render/shading.h"
+
+#include <cmath>
+
+#include "model/ndf.h"
+
+namespace facetfit {
+
+ShadingModel::ShadingModel(std::shared_ptr<const Brdf> brdf, std::shared_ptr<const TabulatedMicrofacet> proposal)
+    : brdf_(std::move(brdf)), proposal_(std::move(proposal)), lobe_weight_(proposal_ && proposal_->can_sample() ? 0.85 : 0.0) {}
+
+Rgb ShadingModel::f(const Vec3& i, const Vec3& o) const {
+  const auto v = brdf_->eval(i, o);
+  return v ? glm::max(*v, Rgb(0.0)) : Rgb(0.0);
+}
+
+double ShadingModel::pdf(const Vec3& o, const Vec3& i) const {
+  if (i.z <= 0.0 || o.z <= 0.0) return 0.0;
+  const double cosine = i.z * kInvPi;
+  return lobe_weight_ > 0.0 ? lobe_weight_ * proposal_->pdf(o, i) + (1.0 - lobe_weight_) * cosine : cosine;
+}
+
+std::optional<ShadingModel::Sample> ShadingModel::sample(const Vec3& o, double u1, double u2, double u3) const {
+  if (o.z <= 0.0) return std::nullopt;
+  Vec3 i;
+  if (u3 < lobe_weight_) {
+    const auto d = proposal_->sample_direction(o, u1, u2);
+    if (!d) return std::nullopt;
+    i = *d;
+  } else {  // cosine-weighted hemisphere (concentric disc)
+    const double a = 2.0 * u1 - 1.0, b = 2.0 * u2 - 1.0;
+    double r = 0.0, phi = 0.0;
+    if (a != 0.0 || b != 0.0) {
+      if (std::abs(a) > std::abs(b)) {
+        r = a;
+        phi = 0.25 * kPi * (b / a);
+      } else {
+        r = b;
+        phi = 0.5 * kPi - 0.25 * kPi * (a / b);
+      }
+    }
+    const double x = r * std::cos(phi), y = r * std::sin(phi);
+    i = Vec3(x, y, std::sqrt(std::max(0.0, 1.0 - x * x - y * y)));
+  }
+  const double p = pdf(o, i);
+  if (!(p > 0.0)) return std::nullopt;
+  return Sample{i, f(i, o) * (i.z / p), p};
+}
+
+TabulatedNdf tabulate_ndf(const Ndf& ndf, int resolution) {
+  TabulatedNdf t;
+  t.grid = ThetaGrid{resolution};
+  for (int j = 0; j < t.grid.size(); ++j) {
+    const Vec3 w = spherical_direction(t.grid.theta(j), 0.0);
+    t.ndf.push_back(ndf.D(w));
+    t.sigma.push_back(ndf.sigma(w));
+  }
+  return t;
+}
+
+}  // namespace facetfit

@@ -1,0 +1,45 @@
+// What the renderer shades with: a BRDF to evaluate, and a proposal to sample it.
+//
+// Every material, measured, tabulated or parametric, is sampled the same way: the visible normals of
+// a tabulated microfacet model (the fitted LUT for a measured material, the material itself for a LUT,
+// the analytic NDF tabulated on the grid for GGX and Beckmann), mixed with cosine sampling so that
+// whatever a single lobe does not explain (diffuse reflection) is still found. pdf() is that mixture.
+#pragma once
+
+#include <memory>
+#include <optional>
+
+#include "core/brdf.h"
+#include "model/ndf.h"
+#include "model/tabulated.h"
+
+namespace facetfit {
+
+class ShadingModel {
+ public:
+  // `proposal` may be null: cosine sampling alone (a Lambertian surface).
+  ShadingModel(std::shared_ptr<const Brdf> brdf, std::shared_ptr<const TabulatedMicrofacet> proposal);
+
+  // f(i, o) in the local frame (missing measurements count as zero).
+  Rgb f(const Vec3& i, const Vec3& o) const;
+
+  struct Sample {
+    Vec3 i;
+    Rgb weight;  // f cos(theta_i) / pdf
+    double pdf;
+  };
+  std::optional<Sample> sample(const Vec3& o, double u1, double u2, double u3) const;
+  double pdf(const Vec3& o, const Vec3& i) const;
+
+  const Brdf& brdf() const { return *brdf_; }
+
+ private:
+  std::shared_ptr<const Brdf> brdf_;
+  std::shared_ptr<const TabulatedMicrofacet> proposal_;
+  double lobe_weight_;  // probability of sampling the microfacet proposal
+};
+
+// The tabulated twin of an analytic NDF: its node values and projected areas, for sampling.
+TabulatedNdf tabulate_ndf(const Ndf& ndf, int resolution = 90);
+
+}  // namespace facetfit
