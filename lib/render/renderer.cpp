@@ -166,7 +166,9 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
   const double tan_half = std::tan(0.5 * cam.fov_degrees * kPi / 180.0), aspect = double(width) / height;
   double scene_scale = 1.0;
   for (const ObjectDesc& o : desc.objects) scene_scale = std::max({scene_scale, glm::length(o.center) + o.radius, o.size});
-  const double eps = 1e-5 * scene_scale;
+  // Shadow rays start off the surface and ignore hits closer than this: Embree intersects in float, and
+  // a ray leaving a sphere at a grazing angle can otherwise find the sphere it starts on.
+  const double eps = 2e-4 * scene_scale;
 
   const auto occluded = [&](const Vec3& origin, const Vec3& dir, double tfar) {
     RTCIntersectContext ctx;
@@ -174,7 +176,7 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
     RTCRay ray{};
     ray.org_x = float(origin.x), ray.org_y = float(origin.y), ray.org_z = float(origin.z);
     ray.dir_x = float(dir.x), ray.dir_y = float(dir.y), ray.dir_z = float(dir.z);
-    ray.tnear = 0.0f;
+    ray.tnear = float(eps);
     ray.tfar = float(tfar);
     ray.mask = 0xFFFFFFFFu;
     rtcOccluded1(es.scene, &ctx, &ray);

@@ -1,0 +1,303 @@
+// facetfit deltae and facetfit diff as users run them.
+#include <gtest/gtest.h>
+
+#include <OpenImageIO/imageio.h>
+
+#include <algorithm>
+#include <cmath>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <vector>
+
+#include "color/ciede2000.h"
+#include "color/display.h"
+#include "test_util.h"
+
+namespace facetfit {
+namespace {
+
+using test::facetfit;
+using test::RunResult;
+using test::TempDir;
+
+std::vector<std::string> lines_of(const std::string& s) {
+  std::vector<std::string> out;
+  std::istringstream in(s);
+  for (std::string line; std::getline(in, line);) out.push_back(line);
+  return out;
+}
+
+// A float image with these channels (in this order in memory; EXR sorts them by name on disk).
+struct TestImage {
+  int width, height;
+  std::vector<std::string> channels;
+  std::vector<float> pixels;
+
+  TestImage(int w, int h, std::vector<std::string> names)
+      : width(w), height(h), channels(std::move(names)), pixels(std::size_t(w) * h * channels.size(), 0.0f) {}
+  float* at(int x, int y) { return pixels.data() + (std::size_t(y) * width + x) * channels.size(); }
+  // Every pixel in [x0, x1) set to `values`.
+  TestImage& fill(const std::vector<float>& values, int x0 = 0, int x1 = -1) {
+    if (x1 < 0) x1 = width;
+    for (int y = 0; y < height; ++y)
+      for (int x = x0; x < x1; ++x) std::copy(values.begin(), values.end(), at(x, y));
+    return *this;
+  }
+  void write(const std::string& path) const {
+    OIIO::ImageSpec spec(width, height, int(channels.size()), OIIO::TypeDesc::FLOAT);
+    spec.channelnames = channels;
+    const auto alpha = std::find(channels.begin(), channels.end(), "A");
+    if (alpha != channels.end()) spec.alpha_channel = int(alpha - channels.begin());
+    auto out = OIIO::ImageOutput::create(path);
+    ASSERT_TRUE(out) << OIIO::geterror();
+    ASSERT_TRUE(out->open(path, spec) && out->write_image(OIIO::TypeDesc::FLOAT, pixels.data()) && out->close())
+        << out->geterror();
+  }
+};
+
+std::string rgb_image(const TempDir& dir, const std::string& name, const std::vector<float>& rgb, int w = 8, int h = 4) {
+  const std::string path = dir.file(name);
+  TestImage(w, h, {"R", "G", "B"}).fill(rgb).write(path);
+  return path;
+}
+
+struct Stats {
+  double mean, max;
+  long pixels;
+};
+
+Stats parse_stats(const std::string& out) {
+  Stats s{-1, -1, -1};
+  const int n = std::sscanf(out.c_str(), "mean %lf max %lf pixels %ld", &s.mean, &s.max, &s.pixels);
+  EXPECT_EQ(n, 3) << out;
+  return s;
+}
+
+double chain_delta_e(const Rgb& a, const Rgb& b) {
+  const DisplayTransform display;
+  return ciede2000(display.linear_to_lab(a), display.linear_to_lab(b));
+}
+
+// ---- deltae ----------------------------------------------------------------------------------------------
+
+TEST(DeltaeCli, OneValuePerLine) {
+  TempDir dir;
+  test::write_bytes(dir.file("pairs.txt"),
+                    "50.0000 2.6772 -79.7751 50.0000 0.0000 -82.7485\n"
+                    "\n"
+                    "  50 2.4900 -0.0010\t50 -2.4900 0.0010  \n"
+                    "50.0000 2.5000 0.0000 73.0000 25.0000 -18.0000\r\n"
+                    "2.0776 0.0795 -1.1350 0.9033 -0.0636 -0.5514\n");
+  const RunResult r = facetfit("deltae <" + dir.file("pairs.txt"));
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.err, "");
+  const std::vector<std::string> out = lines_of(r.out);
+  ASSERT_EQ(out.size(), 4u) << r.out;
+  const double expected[4] = {2.0425, 7.1792, 27.1492, 0.9082};  // Sharma et al. pairs 1, 10, 17, 34
+  for (int i = 0; i < 4; ++i) {
+    EXPECT_NEAR(std::stod(out[i]), expected[i], 0.5e-4) << out[i];
+    EXPECT_EQ(out[i].size() - out[i].find('.') - 1, 6u) << out[i];  // 6 decimals
+  }
+}
+
+TEST(DeltaeCli, MalformedLinesAreNamedAndSkipped) {
+  TempDir dir;
+  test::write_bytes(dir.file("pairs.txt"),
+                    "50 0 0 50 -1 2\n"
+                    "50 0 zero 50 -1 2\n"
+                    "50 0 0 50 -1 2\n"
+                    "50 0 0\n"
+                    "50 0 0 50 -1 2 7\n"
+                    "50 0 0 50 -1 nan\n");
+  const RunResult r = facetfit("deltae <" + dir.file("pairs.txt"));
+  EXPECT_EQ(r.status, 1);
+  EXPECT_EQ(r.out, "2.366859\n2.366859\n");
+  const std::vector<std::string> err = lines_of(r.err);
+  ASSERT_EQ(err.size(), 4u) << r.err;
+  EXPECT_NE(err[0].find("facetfit: error: stdin line 2: 'zero' is not a finite number"), std::string::npos) << err[0];
+  EXPECT_NE(err[1].find("stdin line 4: 3 numbers, expected 6"), std::string::npos) << err[1];
+  EXPECT_NE(err[2].find("stdin line 5: more than 6 numbers"), std::string::npos) << err[2];
+  EXPECT_NE(err[3].find("stdin line 6: 'nan' is not a finite number"), std::string::npos) << err[3];
+}
+
+TEST(DeltaeCli, EmptyInputIsNoError) {
+  const RunResult r = facetfit("deltae </dev/null");
+  EXPECT_EQ(r.status, 0);
+  EXPECT_EQ(r.out, "");
+}
+
+// ---- diff ------------------------------------------------------------------------------------------------
+
+TEST(DiffCli, IdenticalImagesDifferByZero) {
+  TempDir dir;
+  TestImage image(16, 8, {"R", "G", "B", "A"});
+  for (int y = 0; y < 8; ++y)
+    for (int x = 0; x < 16; ++x) {
+      float* p = image.at(x, y);
+      p[0] = float(x) / 8, p[1] = float(y) / 8, p[2] = 0.3f, p[3] = 1;
+    }
+  image.write(dir.file("a.exr"));
+  const RunResult r = facetfit("diff " + dir.file("a.exr") + " " + dir.file("a.exr"));
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.out, "mean 0.000000 max 0.000000 pixels 128\n");
+}
+
+// Middle grey against white: lightness only, so ΔE00 = ΔL / S_L in closed form.
+TEST(DiffCli, GreyAgainstWhite) {
+  TempDir dir;
+  const std::string a = rgb_image(dir, "grey.exr", {0.18f, 0.18f, 0.18f});
+  const std::string b = rgb_image(dir, "white.exr", {1, 1, 1});
+  const double L1 = 116 * std::cbrt(double(0.18f)) - 16, L2 = 100, m = (L1 + L2) / 2 - 50;
+  const double expected = (L2 - L1) / (1 + 0.015 * m * m / std::sqrt(20 + m * m));
+  const RunResult r = facetfit("diff " + a + " " + b);
+  EXPECT_EQ(r.status, 0) << r.err;
+  const Stats s = parse_stats(r.out);
+  EXPECT_NEAR(s.mean, expected, 1e-4);
+  EXPECT_NEAR(s.max, expected, 1e-4);
+  EXPECT_EQ(s.pixels, 32);
+
+  const RunResult j = facetfit("diff " + a + " " + b + " --json");
+  EXPECT_EQ(j.status, 0) << j.err;
+  const nlohmann::json json = nlohmann::json::parse(j.out);
+  EXPECT_NEAR(json.at("mean").get<double>(), expected, 1e-4);
+  EXPECT_NEAR(json.at("max").get<double>(), expected, 1e-4);
+  EXPECT_EQ(json.at("pixels").get<long>(), 32);
+}
+
+// Red against blue: reading channels by position (EXR stores A, B, G, R) would swap them.
+TEST(DiffCli, ChannelsByName) {
+  TempDir dir;
+  const std::string a = rgb_image(dir, "red.exr", {1, 0, 0});
+  const std::string b = rgb_image(dir, "dark.exr", {0.5f, 0.2f, 0});
+  const RunResult r = facetfit("diff " + a + " " + b);
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_NEAR(parse_stats(r.out).mean, chain_delta_e(Rgb(1, 0, 0), Rgb(0.5f, 0.2f, 0)), 1e-4);
+  EXPECT_GT(parse_stats(r.out).mean, 10);
+}
+
+TEST(DiffCli, SizeMismatch) {
+  TempDir dir;
+  const std::string a = rgb_image(dir, "a.exr", {0, 0, 0}, 8, 4);
+  const std::string b = rgb_image(dir, "b.exr", {0, 0, 0}, 4, 4);
+  const RunResult r = facetfit("diff " + a + " " + b);
+  EXPECT_EQ(r.status, 1);
+  EXPECT_EQ(r.out, "");
+  EXPECT_EQ(r.err, "facetfit: error: " + b + ": is 4 x 4 but " + a + " is 8 x 4\n");
+}
+
+TEST(DiffCli, BadInputs) {
+  TempDir dir;
+  const std::string a = rgb_image(dir, "a.exr", {0, 0, 0});
+  RunResult r = facetfit("diff " + a + " " + dir.file("missing.exr"));
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("facetfit: error: " + dir.file("missing.exr") + ": "), std::string::npos) << r.err;
+
+  TestImage(8, 4, {"Y"}).fill({0.5f}).write(dir.file("grey.exr"));
+  r = facetfit("diff " + a + " " + dir.file("grey.exr"));
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find(dir.file("grey.exr") + ": no R channel (channels: Y)"), std::string::npos) << r.err;
+
+  r = facetfit("diff " + a + " " + a + " --heatmap " + dir.file("heat.jpg"));
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("must end in .png"), std::string::npos) << r.err;
+
+  r = facetfit("diff " + a + " " + a + " --heatmap " + dir.file("no/such/folder/heat.png"));
+  EXPECT_EQ(r.status, 1);
+  EXPECT_EQ(r.out, "");
+}
+
+// A and B differ on the left half only.
+struct HalfDifferent {
+  TempDir dir;
+  std::string a, b;
+  HalfDifferent() {
+    a = dir.file("a.exr"), b = dir.file("b.exr");
+    TestImage(8, 4, {"R", "G", "B"}).fill({0.2f, 0.1f, 0.05f}).write(a);
+    TestImage(8, 4, {"R", "G", "B"}).fill({0.2f, 0.1f, 0.05f}).fill({0.25f, 0.1f, 0.05f}, 0, 4).write(b);
+  }
+  double left() const { return chain_delta_e(Rgb(0.2f, 0.1f, 0.05f), Rgb(0.25f, 0.1f, 0.05f)); }
+  std::string mask(const std::string& name, int x0, int x1) const {
+    TestImage(8, 4, {"Y"}).fill({1.0f}, x0, x1).write(dir.file(name));
+    return dir.file(name);
+  }
+};
+
+TEST(DiffCli, Mask) {
+  const HalfDifferent h;
+  Stats s = parse_stats(facetfit("diff " + h.a + " " + h.b).out);
+  EXPECT_NEAR(s.mean, h.left() / 2, 1e-5);
+  EXPECT_NEAR(s.max, h.left(), 1e-5);
+  EXPECT_EQ(s.pixels, 32);
+
+  s = parse_stats(facetfit("diff " + h.a + " " + h.b + " --mask " + h.mask("left.exr", 0, 4)).out);
+  EXPECT_NEAR(s.mean, h.left(), 1e-5);
+  EXPECT_EQ(s.pixels, 16);
+
+  s = parse_stats(facetfit("diff " + h.a + " " + h.b + " --mask " + h.mask("right.exr", 4, 8)).out);
+  EXPECT_EQ(s.mean, 0.0);
+  EXPECT_EQ(s.pixels, 16);
+
+  RunResult r = facetfit("diff " + h.a + " " + h.b + " --mask " + h.mask("none.exr", 0, 0));
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("the mask selects no pixel"), std::string::npos) << r.err;
+
+  TestImage(4, 4, {"Y"}).fill({1.0f}).write(h.dir.file("small.exr"));
+  r = facetfit("diff " + h.a + " " + h.b + " --mask " + h.dir.file("small.exr"));
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("mask is 4 x 4, the images are 8 x 4"), std::string::npos) << r.err;
+}
+
+// Without --mask, a render's alpha decides: pixels covered in either image.
+TEST(DiffCli, AlphaCoverage) {
+  TempDir dir;
+  TestImage a(8, 4, {"R", "G", "B", "A"}), b(8, 4, {"R", "G", "B", "A"});
+  a.fill({0.2f, 0.1f, 0.05f, 1}, 0, 2).fill({0.9f, 0.9f, 0.9f, 0}, 2, 8);  // background differs, uncovered
+  b.fill({0.2f, 0.1f, 0.05f, 0}).fill({0.2f, 0.1f, 0.05f, 1}, 2, 3).fill({0.1f, 0.1f, 0.1f, 0}, 3, 8);
+  a.write(dir.file("a.exr"));
+  b.write(dir.file("b.exr"));
+  const RunResult r = facetfit("diff " + dir.file("a.exr") + " " + dir.file("b.exr"));
+  EXPECT_EQ(r.status, 0) << r.err;
+  const Stats s = parse_stats(r.out);
+  EXPECT_EQ(s.pixels, 12);  // columns 0-1 covered in a, column 2 in b
+  EXPECT_NEAR(s.mean, chain_delta_e(Rgb(0.9f), Rgb(0.2f, 0.1f, 0.05f)) / 3, 1e-4);
+
+  TestImage none(8, 4, {"R", "G", "B", "A"});
+  none.write(dir.file("empty.exr"));
+  const RunResult e = facetfit("diff " + dir.file("empty.exr") + " " + dir.file("empty.exr"));
+  EXPECT_EQ(e.status, 1);
+  EXPECT_NE(e.err.find("no pixel has alpha > 0 in either image"), std::string::npos) << e.err;
+}
+
+TEST(DiffCli, Heatmap) {
+  TempDir dir;
+  const std::string a = dir.file("a.exr"), b = dir.file("b.exr"), png = dir.file("heat.png");
+  TestImage(8, 4, {"R", "G", "B", "A"}).fill({0.5f, 0.5f, 0.5f, 1}).fill({0, 0, 0, 0}, 6, 8).write(a);
+  TestImage(8, 4, {"R", "G", "B", "A"}).fill({0.5f, 0.5f, 0.5f, 1}).fill({1, 1, 1, 1}, 0, 2).fill({0, 0, 0, 0}, 6, 8).write(b);
+  const RunResult r = facetfit("diff " + a + " " + b + " --heatmap " + png);
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(parse_stats(r.out).pixels, 24);
+
+  auto in = OIIO::ImageInput::open(png);
+  ASSERT_TRUE(in) << OIIO::geterror();
+  const OIIO::ImageSpec& spec = in->spec();
+  EXPECT_EQ(spec.width, 8);
+  EXPECT_EQ(spec.height, 4);
+  EXPECT_EQ(spec.nchannels, 3);
+  EXPECT_EQ(spec.format, OIIO::TypeDesc::UINT8);
+  std::vector<unsigned char> pixels(8 * 4 * 3);
+  ASSERT_TRUE(in->read_image(0, 0, 0, 3, OIIO::TypeDesc::UINT8, pixels.data()));
+  const auto px = [&](int x, int y) {
+    const unsigned char* p = &pixels[std::size_t(y * 8 + x) * 3];
+    return std::vector<int>{p[0], p[1], p[2]};
+  };
+  EXPECT_EQ(px(0, 0), (std::vector<int>{253, 231, 37}));  // grey against white: far past 10, the top of the map
+  EXPECT_EQ(px(3, 2), (std::vector<int>{68, 1, 84}));     // equal: the bottom of the map
+  EXPECT_EQ(px(7, 3), (std::vector<int>{0, 0, 0}));       // outside the coverage: black
+  // No temporary left beside it.
+  int files = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(dir.path())) files += entry.is_regular_file();
+  EXPECT_EQ(files, 3);
+}
+
+}  // namespace
+}  // namespace facetfit

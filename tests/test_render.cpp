@@ -1,0 +1,119 @@
+// The reference renderer against answers known in closed form.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "model/analytic.h"
+#include "model/tabulated.h"
+#include "render/renderer.h"
+#include "test_util.h"
+
+namespace facetfit {
+namespace {
+
+// A sphere of `m` filling most of a small image, under a uniform environment of radiance 1.
+SceneDesc furnace(const MaterialDesc& m, int spp = 64) {
+  SceneDesc s = default_scene(m);
+  s.camera.position = Vec3(0, 0, 4);
+  s.camera.width = s.camera.height = 32;
+  s.environment.kind = EnvironmentDesc::Kind::constant;
+  s.environment.constant = Rgb(1.0);
+  s.spp = spp;
+  return s;
+}
+
+TEST(Render, LambertianSphereInAConstantEnvironmentIsItsAlbedo) {
+  MaterialDesc m;
+  m.type = "lambert";
+  m.albedo = Rgb(0.8, 0.5, 0.2);
+  const RenderedImage img = render(furnace(m, 64));
+  // Unbiased: the mean over the sphere is the albedo; each pixel is within its Monte Carlo noise.
+  int covered = 0;
+  Rgb mean(0.0);
+  for (int p = 0; p < img.width * img.height; ++p) {
+    const float* px = img.rgba.data() + p * 4;
+    if (px[3] < 1.0f) continue;  // edge pixels mix in the background
+    ++covered;
+    mean += Rgb(px[0], px[1], px[2]);
+    EXPECT_NEAR(px[0], 0.8, 0.1);
+  }
+  ASSERT_GT(covered, 300);
+  mean /= double(covered);
+  EXPECT_NEAR(mean.r, 0.8, 0.004);
+  EXPECT_NEAR(mean.g, 0.5, 0.0025);
+  EXPECT_NEAR(mean.b, 0.2, 0.001);
+}
+
+TEST(Render, WhiteFurnaceNeverExceedsOneAndMatchesTheAlbedo) {
+  // A white (F = 1) GGX sphere: each pixel is the model's directional albedo at its view angle (< 1).
+  MaterialDesc m;
+  m.type = "ggx";
+  m.alpha = 0.5;
+  m.f0 = m.f82 = Rgb(1.0);
+  const RenderedImage img = render(furnace(m, 1024));
+  const MicrofacetBrdf brdf(Ndf::isotropic(NdfType::ggx, 0.5), Smith::correlated, Fresnel::one());
+  // Albedo at a view angle by quadrature, for comparison at the centre pixel (normal view).
+  const auto albedo = [&](double cos_o) {
+    const Vec3 o(std::sqrt(1 - cos_o * cos_o), 0, cos_o);
+    double sum = 0.0;
+    const int n = 400;
+    for (int a = 0; a < n; ++a)
+      for (int b = 0; b < n; ++b) {
+        const double c = (a + 0.5) / n, s = std::sqrt(1 - c * c), phi = (b + 0.5) / n * 2 * kPi;
+        sum += brdf.eval(Vec3(s * std::cos(phi), s * std::sin(phi), c), o)->g * c / (n * n) * 2 * kPi;
+      }
+    return sum;
+  };
+  double max_value = 0.0;
+  for (int p = 0; p < img.width * img.height; ++p)
+    if (img.rgba[std::size_t(p) * 4 + 3] >= 1.0f) max_value = std::max(max_value, double(img.rgba[std::size_t(p) * 4 + 1]));
+  EXPECT_LE(max_value, 1.0 + 0.02);
+  // The central 4 x 4 pixels see the sphere within 6 degrees of its normal, where the albedo changes
+  // by less than 0.1%: their mean averages the noise down (about 0.002).
+  double centre = 0.0;
+  for (int y = 14; y < 18; ++y)
+    for (int x = 14; x < 18; ++x) centre += img.rgba[(std::size_t(y) * 32 + x) * 4 + 1] / 16.0;
+  EXPECT_NEAR(centre, albedo(0.997), 0.006);
+}
+
+TEST(Render, SameSceneSameImage) {
+  MaterialDesc m;
+  m.type = "ggx";
+  m.alpha = 0.2;
+  SceneDesc s = default_scene(m);
+  s.camera.width = s.camera.height = 24;
+  s.spp = 8;
+  RenderSettings one_pass;
+  one_pass.passes = 1;
+  const RenderedImage a = render(s), b = render(s, one_pass);
+  EXPECT_EQ(a.rgba, b.rgba);  // passes, tiles and threads do not change the per-pixel sequences
+}
+
+TEST(Render, BadScenesGetOneClearLine) {
+  test::TempDir dir;
+  test::write_bytes(dir.file("a.json"), R"({"objects": [{"type": "sphere", "material": "nope"}]})");
+  EXPECT_NE(test::error_of([&] { parse_scene(dir.file("a.json")); }).find("undefined material \"nope\""), std::string::npos);
+  test::write_bytes(dir.file("b.json"), "[1, 2");
+  EXPECT_NE(test::error_of([&] { parse_scene(dir.file("b.json")); }).find("b.json: not a JSON object"), std::string::npos);
+  test::write_bytes(dir.file("c.json"),
+                    R"({"materials": {"m": {"type": "measured", "file": "missing.binary"}}, "objects": [{"type": "sphere", "material": "m"}]})");
+  const std::string missing = test::error_of([&] { render(parse_scene(dir.file("c.json"))); });
+  EXPECT_NE(missing.find("missing.binary: cannot open"), std::string::npos) << missing;
+}
+
+TEST(Render, ObjMeshes) {
+  test::TempDir dir;
+  test::write_bytes(dir.file("quad.obj"), "v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nf 1 2 3 4\n");
+  std::vector<float> p;
+  std::vector<unsigned> idx;
+  read_obj(dir.file("quad.obj"), p, idx);
+  EXPECT_EQ(p.size(), 12u);
+  EXPECT_EQ(idx, (std::vector<unsigned>{0, 1, 2, 0, 2, 3}));
+  test::write_bytes(dir.file("bad.obj"), "v 0 0 0\nf 1 2 3\n");
+  p.clear();
+  idx.clear();
+  EXPECT_NE(test::error_of([&] { read_obj(dir.file("bad.obj"), p, idx); }).find("line 2: vertex index out of range"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace facetfit
