@@ -28,6 +28,9 @@ void add_builtins_command(CLI::App& app, int& status);
 void add_bake_command(CLI::App& app, int& status);
 void add_info_command(CLI::App& app, int& status);
 void add_render_command(CLI::App& app, int& status);
+void add_deltae_command(CLI::App& app, int& status);
+void add_diff_command(CLI::App& app, int& status);
+void add_report_command(CLI::App& app, int& status);
 
 // "facetfit: error: <message>" on stderr, one line.
 void report_error(const std::string& message);

@@ -49,6 +49,9 @@ int main(int argc, char** argv) {
   add_bake_command(app, status);
   add_info_command(app, status);
   add_render_command(app, status);
+  add_diff_command(app, status);
+  add_deltae_command(app, status);
+  add_report_command(app, status);
   add_convert_command(app, status);
   add_builtins_command(app, status);
   try {

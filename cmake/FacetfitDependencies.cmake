@@ -12,6 +12,8 @@ find_package(OpenSSL REQUIRED)  # SHA-256 of sources (LUT metadata, bake cache)
 find_package(Imath CONFIG REQUIRED)
 find_package(OpenImageIO CONFIG REQUIRED)
 find_package(embree 3 CONFIG REQUIRED)
+# Debian installs OpenColorIO's CMake config under /usr/share/cmake.
+find_package(OpenColorIO CONFIG REQUIRED PATHS /usr/share/cmake)
 
 # Debian's imported targets list include folders that do not exist (/usr/include/opencv4), which CMake
 # rejects: keep only the folders that are there.
@@ -28,3 +30,4 @@ function(facetfit_keep_existing_includes target)
 endfunction()
 facetfit_keep_existing_includes(OpenImageIO::OpenImageIO)
 facetfit_keep_existing_includes(OpenImageIO::OpenImageIO_Util)
+facetfit_keep_existing_includes(OpenColorIO::OpenColorIO)

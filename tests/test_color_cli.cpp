@@ -55,7 +55,8 @@ struct TestImage {
   }
 };
 
-std::string rgb_image(const TempDir& dir, const std::string& name, const std::vector<float>& rgb, int w = 8, int h = 4) {
+std::string rgb_image(const TempDir& dir, const std::string& name, const std::vector<float>& rgb, int w = 8,
+                      int h = 4) {
   const std::string path = dir.file(name);
   TestImage(w, h, {"R", "G", "B"}).fill(rgb).write(path);
   return path;
@@ -164,15 +165,32 @@ TEST(DiffCli, GreyAgainstWhite) {
   EXPECT_EQ(json.at("pixels").get<long>(), 32);
 }
 
-// Red against blue: reading channels by position (EXR stores A, B, G, R) would swap them.
+// Channels are found by name whatever order they were written in, and other channels are ignored.
 TEST(DiffCli, ChannelsByName) {
   TempDir dir;
   const std::string a = rgb_image(dir, "red.exr", {1, 0, 0});
-  const std::string b = rgb_image(dir, "dark.exr", {0.5f, 0.2f, 0});
+  const std::string b = dir.file("layers.exr");
+  TestImage(8, 4, {"Z", "B", "G", "R"}).fill({5.0f, 0.0f, 0.2f, 0.5f}).write(b);
   const RunResult r = facetfit("diff " + a + " " + b);
   EXPECT_EQ(r.status, 0) << r.err;
   EXPECT_NEAR(parse_stats(r.out).mean, chain_delta_e(Rgb(1, 0, 0), Rgb(0.5f, 0.2f, 0)), 1e-4);
   EXPECT_GT(parse_stats(r.out).mean, 10);
+}
+
+// PNG and other images OIIO reports as "sRGB" hold display code values already: they skip the display
+// transform, so an 8-bit PNG matches the EXR of the linear value it encodes.
+TEST(DiffCli, DisplayReferredInput) {
+  TempDir dir;
+  const std::string png = dir.file("grey.png");
+  OIIO::ImageSpec spec(8, 4, 3, OIIO::TypeDesc::UINT8);
+  const std::vector<unsigned char> code(8 * 4 * 3, 118);
+  auto out = OIIO::ImageOutput::create(png);
+  ASSERT_TRUE(out && out->open(png, spec) && out->write_image(OIIO::TypeDesc::UINT8, code.data()) && out->close());
+  const float linear = float(srgb_decode(118.0 / 255));
+  const std::string exr = rgb_image(dir, "grey.exr", {linear, linear, linear});
+  const RunResult r = facetfit("diff " + png + " " + exr);
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_LT(parse_stats(r.out).max, 1e-3) << r.out;
 }
 
 TEST(DiffCli, SizeMismatch) {
@@ -272,7 +290,11 @@ TEST(DiffCli, Heatmap) {
   TempDir dir;
   const std::string a = dir.file("a.exr"), b = dir.file("b.exr"), png = dir.file("heat.png");
   TestImage(8, 4, {"R", "G", "B", "A"}).fill({0.5f, 0.5f, 0.5f, 1}).fill({0, 0, 0, 0}, 6, 8).write(a);
-  TestImage(8, 4, {"R", "G", "B", "A"}).fill({0.5f, 0.5f, 0.5f, 1}).fill({1, 1, 1, 1}, 0, 2).fill({0, 0, 0, 0}, 6, 8).write(b);
+  TestImage(8, 4, {"R", "G", "B", "A"})
+      .fill({0.5f, 0.5f, 0.5f, 1})
+      .fill({1, 1, 1, 1}, 0, 2)
+      .fill({0, 0, 0, 0}, 6, 8)
+      .write(b);
   const RunResult r = facetfit("diff " + a + " " + b + " --heatmap " + png);
   EXPECT_EQ(r.status, 0) << r.err;
   EXPECT_EQ(parse_stats(r.out).pixels, 24);

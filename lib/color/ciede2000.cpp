@@ -22,7 +22,7 @@ double hue_degrees(double a_prime, double b) {
 
 // Whether |h1' - h2'| <= 180 degrees, the test on which both the hue difference and the mean hue branch
 // (for C'1 C'2 != 0). Rounded degrees can put two hues that are exactly opposite, which the paper counts
-// as <= 180 (its pairs 10 and 14: a'2 = -a'1, b2 = -b1), on either side of 180. Near 180 the answer
+// as <= 180 (as in its pairs 10 and 14: a'2 = -a'1, b2 = -b1), on either side of 180. Near 180 the answer
 // comes instead from the cross product of (a'1, b1) and (a'2, b2), C'1 C'2 sin(h2' - h1'): exactly zero
 // for exactly opposite vectors, and otherwise of the sign that tells on which side of 180 the real
 // difference lies (sin(180 - e) > 0 > sin(180 + e)).

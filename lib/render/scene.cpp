@@ -9,6 +9,7 @@
 #include "io/input.h"
 #include "lut/lut.h"
 #include "model/analytic.h"
+#include "model/builtin.h"
 #include "model/parametric.h"
 
 namespace facetfit {
@@ -38,10 +39,12 @@ MaterialDesc parse_material(const std::string& name, const json& j, const std::s
   if (!j.is_object()) fail(path, "material " + name + " must be an object");
   MaterialDesc m;
   m.type = get<std::string>(j, "type", "", path);
-  if (m.type != "measured" && m.type != "lut" && m.type != "ggx" && m.type != "beckmann" && m.type != "lambert")
-    fail(path, "material " + name + ": type must be measured, lut, ggx, beckmann or lambert");
+  if (m.type != "measured" && m.type != "lut" && m.type != "ggx" && m.type != "beckmann" && m.type != "lambert" &&
+      m.type != "analytic")
+    fail(path, "material " + name + ": type must be measured, lut, ggx, beckmann, lambert or analytic");
   m.file = get<std::string>(j, "file", "", path);
-  if ((m.type == "measured" || m.type == "lut") && m.file.empty()) fail(path, "material " + name + " needs a \"file\"");
+  if ((m.type == "measured" || m.type == "lut" || m.type == "analytic") && m.file.empty())
+    fail(path, "material " + name + " needs a \"file\"");
   m.alpha = get<double>(j, "alpha", 0.0, path);
   if ((m.type == "ggx" || m.type == "beckmann") && m.file.empty() && !(m.alpha > 0.0))
     fail(path, "material " + name + " needs \"alpha\" > 0 or a LUT \"file\"");
@@ -169,6 +172,15 @@ std::string resolve(const SceneDesc& scene, const std::string& file) {
 
 std::shared_ptr<const ShadingModel> load_material(const SceneDesc& scene, const MaterialDesc& m) {
   if (m.type == "lambert") return std::make_shared<ShadingModel>(std::make_shared<LambertBrdf>(m.albedo), nullptr);
+  if (m.type == "analytic") {  // a built-in's analytic model itself: the ground truth
+    const std::string name = m.file.rfind(kBuiltinPrefix, 0) == 0 ? m.file.substr(std::string(kBuiltinPrefix).size()) : m.file;
+    const auto builtin = find_builtin(name);
+    if (!builtin) fail(m.file, "analytic materials are built-ins (builtin:NAME)");
+    std::shared_ptr<const TabulatedMicrofacet> proposal;
+    if (const auto* mf = dynamic_cast<const MicrofacetBrdf*>(builtin->brdf.get()))
+      proposal = std::make_shared<TabulatedMicrofacet>(MicrofacetTables{tabulate_ndf(mf->ndf()), mf->smith(), {}});
+    return std::make_shared<ShadingModel>(builtin->brdf, proposal);
+  }
   if (m.type == "measured") {
     // The measurement is what is rendered; its fit only proposes directions.
     auto table = std::make_shared<MerlTable>(load_table(resolve(scene, m.file)));

@@ -1,0 +1,321 @@
+#include "report/report.h"
+
+#include <algorithm>
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+#include "color/image_diff.h"
+#include "core/error.h"
+#include "io/atomic_file.h"
+#include "io/input.h"
+#include "io/sha256.h"
+#include "render/renderer.h"
+
+namespace facetfit {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+const std::vector<std::string>& report_representations() {
+  static const std::vector<std::string> names{"tabulated", "ggx", "beckmann"};
+  return names;
+}
+
+namespace {
+
+// The RGB of an RGBA render, interleaved.
+std::vector<float> rgb_of(const RenderedImage& image) {
+  std::vector<float> rgb(std::size_t(image.width) * image.height * 3);
+  for (std::size_t p = 0; p < rgb.size() / 3; ++p)
+    for (int c = 0; c < 3; ++c) rgb[3 * p + c] = image.rgba[4 * p + c];
+  return rgb;
+}
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+json read_json_file(const fs::path& path) {
+  std::ifstream in(path);
+  if (!in) return json();
+  json j = json::parse(in, nullptr, false);
+  return j.is_discarded() ? json() : j;
+}
+
+// The scene every material is rendered in: the default sphere under the built-in sky.
+SceneDesc report_scene(const MaterialDesc& m, const ReportOptions& o) {
+  SceneDesc s = default_scene(m);
+  s.camera.width = s.camera.height = o.size;
+  s.spp = o.spp;
+  return s;
+}
+
+// Means per representation, and the worst materials by tabulated Delta E.
+void summarize(json& report) {
+  json means = json::object();
+  for (const std::string& r : report_representations()) {
+    double sum = 0.0;
+    int n = 0;
+    for (const json& m : report["materials"])
+      if (m["delta_e"].contains(r)) sum += m["delta_e"][r].get<double>(), ++n;
+    means[r] = n > 0 ? json(sum / n) : json(nullptr);
+  }
+  report["database_mean_delta_e"] = means;
+  std::vector<std::pair<double, std::string>> worst;
+  for (const json& m : report["materials"]) {
+    double w = 0.0;
+    for (const auto& [r, v] : m["delta_e"].items()) w = std::max(w, v.get<double>());
+    worst.emplace_back(w, m["name"].get<std::string>());
+  }
+  std::sort(worst.rbegin(), worst.rend());
+  report["worst"] = json::array();
+  for (std::size_t k = 0; k < std::min<std::size_t>(5, worst.size()); ++k)
+    report["worst"].push_back({{"name", worst[k].second}, {"max_delta_e", worst[k].first}});
+}
+
+std::string html_escape(const std::string& s) {
+  std::string out;
+  for (char c : s) {
+    if (c == '<') out += "&lt;";
+    else if (c == '>') out += "&gt;";
+    else if (c == '&') out += "&amp;";
+    else if (c == '"') out += "&quot;";
+    else out += c;
+  }
+  return out;
+}
+
+// Run time against error: one point per material and representation, log-scaled time.
+std::string time_error_plot(const json& report) {
+  const char* colours[] = {"#1f77b4", "#d62728", "#2ca02c"};
+  double max_de = 0.1, min_t = 1e9, max_t = 1e-9;
+  for (const json& m : report["materials"])
+    for (const std::string& r : report_representations())
+      if (m["delta_e"].contains(r)) {
+        max_de = std::max(max_de, m["delta_e"][r].get<double>());
+        const double t = m["seconds"]["render"][r].get<double>();
+        min_t = std::min(min_t, t), max_t = std::max(max_t, t);
+      }
+  if (min_t > max_t) min_t = 0.1, max_t = 1.0;
+  const double lo = std::log10(min_t) - 0.1, hi = std::log10(max_t) + 0.1;
+  std::ostringstream svg;
+  svg << "<svg width='560' height='300' xmlns='http://www.w3.org/2000/svg' font-size='11'>"
+      << "<line x1='50' y1='260' x2='540' y2='260' stroke='black'/><line x1='50' y1='20' x2='50' y2='260' stroke='black'/>"
+      << "<text x='240' y='292'>render time (s, log scale)</text><text x='4' y='14'>mean Delta E 2000</text>"
+      << "<text x='50' y='275'>" << min_t << "</text><text x='500' y='275'>" << max_t << "</text>"
+      << "<text x='8' y='30'>" << max_de << "</text>";
+  for (std::size_t k = 0; k < report_representations().size(); ++k) {
+    const std::string& r = report_representations()[k];
+    svg << "<text x='" << 420 << "' y='" << 30 + 14 * k << "' fill='" << colours[k] << "'>&#9679; " << r << "</text>";
+    for (const json& m : report["materials"]) {
+      if (!m["delta_e"].contains(r)) continue;
+      const double t = m["seconds"]["render"][r].get<double>(), de = m["delta_e"][r].get<double>();
+      const double x = 50 + 490 * (std::log10(std::max(t, 1e-6)) - lo) / (hi - lo), y = 260 - 240 * de / max_de;
+      svg << "<circle cx='" << x << "' cy='" << y << "' r='4' fill='" << colours[k] << "'><title>"
+          << html_escape(m["name"].get<std::string>()) << " " << r << ": " << de << "</title></circle>";
+    }
+  }
+  svg << "</svg>";
+  return svg.str();
+}
+
+std::string report_html(const json& report) {
+  std::ostringstream h;
+  h << "<!doctype html><html><head><meta charset='utf-8'><title>facetfit accuracy report</title><style>"
+       "body{font-family:sans-serif;margin:2em}table{border-collapse:collapse}td,th{border:1px solid #ccc;padding:4px 8px}"
+       "th{cursor:pointer;background:#eee}img{image-rendering:pixelated;width:128px}.bad{color:#b00}"
+       "</style></head><body><h1>facetfit accuracy report</h1>";
+  h << "<p>facetfit " << html_escape(report["facetfit_version"].get<std::string>()) << ", "
+    << report["materials"].size() << " materials, " << report["settings"]["size"] << "&sup2; pixels, "
+    << report["settings"]["spp"] << " spp. Mean CIE Delta E 2000 over the sphere between the render of the measurement "
+    << "and of each representation (display-referred sRGB; docs/colour.md).</p><h2>Database mean</h2><table><tr>";
+  for (const std::string& r : report_representations()) h << "<th>" << r << "</th>";
+  h << "</tr><tr>";
+  for (const std::string& r : report_representations()) {
+    const json& v = report["database_mean_delta_e"][r];
+    h << "<td>" << (v.is_null() ? std::string("-") : std::to_string(v.get<double>())) << "</td>";
+  }
+  h << "</tr></table>";
+  if (!report["regressions"].empty()) {
+    h << "<h2 class='bad'>Regressions against the previous report</h2><ul>";
+    for (const json& g : report["regressions"])
+      h << "<li class='bad'>" << html_escape(g["name"].get<std::string>()) << " " << g["representation"].get<std::string>() << ": "
+        << g["before"].get<double>() << " &rarr; " << g["after"].get<double>() << "</li>";
+    h << "</ul>";
+  }
+  h << "<h2>Worst materials</h2><ol>";
+  for (const json& w : report["worst"]) h << "<li>" << html_escape(w["name"].get<std::string>()) << ": " << w["max_delta_e"].get<double>() << "</li>";
+  h << "</ol><h2>Run time against error</h2>" << time_error_plot(report);
+  h << "<h2>Materials</h2><p>Click a column header to sort.</p><table id='t'><tr><th>material</th>";
+  for (const std::string& r : report_representations()) h << "<th>&Delta;E " << r << "</th>";
+  h << "<th>bake s</th><th>measured</th>";
+  for (const std::string& r : report_representations()) h << "<th>" << r << "</th><th>&Delta;E map</th>";
+  h << "</tr>";
+  for (const json& m : report["materials"]) {
+    const std::string name = m["name"].get<std::string>();
+    h << "<tr><td>" << html_escape(name) << "</td>";
+    for (const std::string& r : report_representations())
+      h << "<td>" << (m["delta_e"].contains(r) ? std::to_string(m["delta_e"][r].get<double>()) : std::string("-")) << "</td>";
+    h << "<td>" << m["seconds"]["bake"].get<double>() << "</td><td><img src='images/" << html_escape(name) << "/measured.png'></td>";
+    for (const std::string& r : report_representations())
+      h << "<td><img src='images/" << html_escape(name) << "/" << r << ".png'></td><td><img src='images/" << html_escape(name) << "/"
+        << r << "_delta_e.png'></td>";
+    h << "</tr>";
+  }
+  h << "</table>";
+  if (!report["failures"].empty()) {
+    h << "<h2 class='bad'>Failures</h2><ul>";
+    for (const json& f : report["failures"]) h << "<li>" << html_escape(f["error"].get<std::string>()) << "</li>";
+    h << "</ul>";
+  }
+  h << "<p>Heatmaps: Delta E 2000 from 0 (dark) to 10 (bright), see docs/colour.md.</p>"
+       "<script>document.querySelectorAll('#t th').forEach((th,c)=>th.onclick=()=>{const t=th.closest('table');"
+       "const rows=[...t.rows].slice(1);const num=v=>{const x=parseFloat(v);return isNaN(x)?v:x};"
+       "const dir=th.dataset.dir=th.dataset.dir==='1'?'-1':'1';rows.sort((a,b)=>{const x=num(a.cells[c].innerText),"
+       "y=num(b.cells[c].innerText);return (x>y?1:x<y?-1:0)*dir});rows.forEach(r=>t.appendChild(r))});</script></body></html>";
+  return h.str();
+}
+
+void write_outputs(const json& report, const std::string& out_dir) {
+  write_file_atomic((fs::path(out_dir) / "report.json").string(), report.dump(2) + "\n");
+  write_file_atomic((fs::path(out_dir) / "index.html").string(), report_html(report));
+}
+
+}  // namespace
+
+json find_regressions(const json& previous, const json& current) {
+  json out = json::array();
+  if (!previous.is_object() || !previous.contains("materials")) return out;
+  std::map<std::string, json> before;
+  for (const json& m : previous["materials"]) before[m["name"].get<std::string>()] = m["delta_e"];
+  for (const json& m : current["materials"]) {
+    const auto it = before.find(m["name"].get<std::string>());
+    if (it == before.end()) continue;
+    for (const auto& [r, v] : m["delta_e"].items()) {
+      if (!it->second.contains(r)) continue;
+      const double a = it->second[r].get<double>(), b = v.get<double>();
+      if (b > a * 1.1 && b > a + 0.1) out.push_back({{"name", m["name"]}, {"representation", r}, {"before", a}, {"after", b}});
+    }
+  }
+  return out;
+}
+
+json run_report(const ReportOptions& o) {
+  std::error_code ec;
+  fs::create_directories(fs::path(o.out_dir) / "luts", ec);
+  if (!fs::is_directory(fs::path(o.out_dir) / "luts")) fail(o.out_dir, "cannot create report folder");
+  remove_stale_temporaries(o.out_dir);
+  remove_stale_temporaries((fs::path(o.out_dir) / "luts").string());
+  const json previous = read_json_file(fs::path(o.out_dir) / "report.json");
+  std::map<std::string, json> reusable;
+  if (previous.is_object() && previous.contains("materials"))
+    for (const json& m : previous["materials"]) reusable[m["name"].get<std::string>()] = m;
+
+  std::vector<std::string> inputs = expand_inputs(o.inputs.empty() ? std::vector<std::string>{kBuiltinPrefix} : o.inputs);
+  std::sort(inputs.begin(), inputs.end());
+  std::vector<std::string> mine;  // this shard's, a deterministic subset
+  for (std::size_t k = 0; k < inputs.size(); ++k)
+    if (int(k % std::size_t(o.shards)) == o.shard - 1) mine.push_back(inputs[k]);
+
+  json report;
+  report["facetfit_version"] = FACETFIT_VERSION;
+  report["settings"] = {{"size", o.size}, {"spp", o.spp}, {"smith", to_string(o.bake.fit.smith)}, {"resolution", o.bake.fit.resolution},
+                        {"tolerance", o.bake.tolerance}};
+  report["shard"] = std::to_string(o.shard) + "/" + std::to_string(o.shards);
+  report["materials"] = json::array();
+  report["failures"] = json::array();
+  const Fitter fitter(o.bake.fit);
+  const DisplayTransform display;
+  std::size_t done = 0;
+  for (const std::string& source : mine) {
+    const std::string name = source_name(source);
+    const fs::path images = fs::path(o.out_dir) / "images" / name;
+    try {
+      const auto bake_start = std::chrono::steady_clock::now();
+      const BakeOutcome baked = bake_material(source, name, (fs::path(o.out_dir) / "luts").string(), o.bake, fitter);
+      if (baked.status == BakeOutcome::Status::failed) throw Error(baked.error);
+      const double bake_seconds = seconds_since(bake_start);
+      // An entry is reused when its bake, the render settings and facetfit are unchanged.
+      const std::string key_text = baked.record["cache_key"].get<std::string>() + "|" + report["settings"].dump() + "|" + FACETFIT_VERSION;
+      const std::string key = sha256_hex(key_text.data(), key_text.size());
+      const auto old = reusable.find(name);
+      if (!o.force && old != reusable.end() && old->second.value("key", "") == key && fs::exists(images / "measured.png")) {
+        report["materials"].push_back(old->second);
+      } else {
+        fs::create_directories(images, ec);
+        const std::string lut = (fs::path(o.out_dir) / "luts" / (name + ".exr")).string();
+        json entry;
+        entry["name"] = name;
+        entry["source"] = source;
+        entry["key"] = key;
+        entry["representation"] = baked.record["representation"];
+        entry["seconds"]["bake"] = bake_seconds;
+        const auto render_as = [&](const std::string& type, const std::string& file) {
+          MaterialDesc m;
+          m.type = type;
+          m.file = file;
+          const RenderedImage img = render(report_scene(m, o));
+          return img;
+        };
+        const RenderedImage measured = render_as("measured", source);
+        entry["seconds"]["render"]["measured"] = measured.seconds;
+        write_display_png((images / "measured.png").string(), measured.rgba.data(), measured.width, measured.height, 4, display);
+        std::vector<bool> mask(std::size_t(measured.width) * measured.height);
+        for (std::size_t p = 0; p < mask.size(); ++p) mask[p] = measured.rgba[p * 4 + 3] >= 1.0f;  // the sphere
+        for (const std::string& r : report_representations()) {
+          const RenderedImage img = render_as(r == "tabulated" ? "lut" : r, lut);
+          entry["seconds"]["render"][r] = img.seconds;
+          write_display_png((images / (r + ".png")).string(), img.rgba.data(), img.width, img.height, 4, display);
+          const ImageDiff diff = image_delta_e(rgb_of(measured), false, rgb_of(img), false, mask, display);
+          entry["delta_e"][r] = diff.mean;
+          entry["max_delta_e"][r] = diff.max;
+          write_heatmap_png((images / (r + "_delta_e.png")).string(), img.width, img.height, diff.delta_e, mask);
+        }
+        report["materials"].push_back(entry);
+      }
+    } catch (const Error& e) {
+      report["failures"].push_back({{"source", source}, {"error", e.what()}});
+    }
+    if (o.progress) o.progress(name, ++done, mine.size());
+  }
+  summarize(report);
+  report["regressions"] = find_regressions(previous, report);
+  write_outputs(report, o.out_dir);
+  return report;
+}
+
+json merge_reports(const std::vector<std::string>& parts, const std::string& out_dir) {
+  std::error_code ec;
+  fs::create_directories(fs::path(out_dir) / "images", ec);
+  const json previous = read_json_file(fs::path(out_dir) / "report.json");
+  json merged;
+  merged["materials"] = json::array();
+  merged["failures"] = json::array();
+  for (const std::string& part : parts) {
+    const json r = read_json_file(fs::path(part) / "report.json");
+    if (!r.is_object() || !r.contains("materials")) fail(part, "no report.json (not a facetfit report folder)");
+    if (merged.contains("settings") && merged["settings"] != r["settings"]) fail(part, "rendered with other settings than the first part");
+    merged["facetfit_version"] = r["facetfit_version"];
+    merged["settings"] = r["settings"];
+    for (const json& m : r["materials"]) {
+      merged["materials"].push_back(m);
+      const fs::path from = fs::path(part) / "images" / m["name"].get<std::string>();
+      fs::copy(from, fs::path(out_dir) / "images" / m["name"].get<std::string>(),
+               fs::copy_options::recursive | fs::copy_options::overwrite_existing, ec);
+      if (ec) fail(from.string(), "cannot copy images: " + ec.message());
+    }
+    for (const json& f : r["failures"]) merged["failures"].push_back(f);
+  }
+  std::sort(merged["materials"].begin(), merged["materials"].end(),
+            [](const json& a, const json& b) { return a["name"].get<std::string>() < b["name"].get<std::string>(); });
+  merged["shard"] = "merged";
+  summarize(merged);
+  merged["regressions"] = find_regressions(previous, merged);
+  write_outputs(merged, out_dir);
+  return merged;
+}
+
+}  // namespace facetfit

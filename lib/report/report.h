@@ -1,0 +1,40 @@
+// The nightly database accuracy report: every material of a database rendered from its measurement and
+// from each fitted representation, compared by mean CIE Delta E 2000 on the display-referred images.
+#pragma once
+
+#include <functional>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "lut/bake.h"
+
+namespace facetfit {
+
+struct ReportOptions {
+  std::vector<std::string> inputs;  // files, folders, globs, builtin:...
+  std::string out_dir;
+  int size = 128;   // image side, pixels
+  int spp = 32;
+  int shard = 1, shards = 1;  // this run renders materials k with k % shards == shard - 1
+  bool force = false;
+  BakeOptions bake;
+  std::function<void(const std::string& name, std::size_t done, std::size_t total)> progress;
+};
+
+// The representations compared with the measurement, in report order.
+const std::vector<std::string>& report_representations();
+
+// Runs the report into options.out_dir (report.json, index.html, images/, luts/), reusing the previous
+// report's entries whose inputs, settings and version are unchanged. Returns report.json's content.
+// Materials that fail are listed under "failures"; the run goes on.
+nlohmann::json run_report(const ReportOptions& options);
+
+// Joins shard reports (their report.json folders) into one, copying their images.
+nlohmann::json merge_reports(const std::vector<std::string>& parts, const std::string& out_dir);
+
+// Materials whose Delta E rose against `previous` (same name and representation): by more than 10%
+// and more than 0.1. Each entry: {name, representation, before, after}.
+nlohmann::json find_regressions(const nlohmann::json& previous, const nlohmann::json& current);
+
+}  // namespace facetfit

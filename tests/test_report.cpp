@@ -1,0 +1,114 @@
+// The nightly report: outputs, the cache of unchanged entries, regressions, shards and merge.
+#include <gtest/gtest.h>
+
+#include <fstream>
+
+#include "report/report.h"
+#include "test_util.h"
+
+namespace facetfit {
+namespace {
+
+using nlohmann::json;
+using test::TempDir;
+
+ReportOptions small(const std::string& out) {
+  ReportOptions o;
+  o.inputs = {"builtin:gold-ggx-0.15", "builtin:copper-beckmann-0.30", "builtin:red-plastic"};
+  o.out_dir = out;
+  o.size = 24;
+  o.spp = 4;
+  return o;
+}
+
+json read_json(const std::string& path) {
+  std::ifstream in(path);
+  return json::parse(in);
+}
+
+TEST(Report, WritesEveryOutputAndTheRightOrder) {
+  TempDir dir;
+  const json r = run_report(small(dir.path().string()));
+  ASSERT_EQ(r["materials"].size(), 3u);
+  EXPECT_TRUE(r["failures"].empty());
+  for (const json& m : r["materials"]) {
+    const std::string name = m["name"];
+    for (const char* f : {"measured.png", "tabulated.png", "ggx.png", "beckmann.png", "ggx_delta_e.png"})
+      EXPECT_TRUE(std::filesystem::exists(dir.path() / "images" / name / f)) << name << "/" << f;
+    EXPECT_TRUE(std::filesystem::exists(dir.path() / "luts" / (name + ".exr")));
+  }
+  // One lobe fits a one-lobe material; it cannot fit a diffuse-plus-specular plastic.
+  const auto entry = [&](const std::string& name) {
+    for (const json& m : r["materials"])
+      if (m["name"] == name) return m;
+    return json();
+  };
+  EXPECT_LT(entry("gold-ggx-0.15")["delta_e"]["ggx"].get<double>(), 0.5);
+  EXPECT_LT(entry("copper-beckmann-0.30")["delta_e"]["beckmann"].get<double>(), 0.5);
+  EXPECT_GT(entry("red-plastic")["delta_e"]["ggx"].get<double>(), 3.0);
+  EXPECT_EQ(r["worst"][0]["name"], "red-plastic");
+  EXPECT_EQ(read_json(dir.file("report.json")), r);
+  const std::string html = test::read_bytes(dir.file("index.html"));
+  EXPECT_NE(html.find("<svg"), std::string::npos);          // run time against error
+  EXPECT_NE(html.find("images/red-plastic/ggx_delta_e.png"), std::string::npos);
+}
+
+TEST(Report, UnchangedMaterialsAreNotRenderedAgain) {
+  TempDir dir;
+  const json first = run_report(small(dir.path().string()));
+  const json second = run_report(small(dir.path().string()));
+  EXPECT_EQ(first["materials"], second["materials"]);  // the same entries, render timings included
+  ReportOptions bigger = small(dir.path().string());
+  bigger.spp = 8;  // other settings: everything is rendered again
+  const json third = run_report(bigger);
+  EXPECT_NE(first["materials"][0]["seconds"], third["materials"][0]["seconds"]);
+}
+
+TEST(Report, RegressionsAgainstThePreviousReport) {
+  TempDir dir;
+  json r = run_report(small(dir.path().string()));
+  // Pretend the previous night was much better for gold's GGX fit.
+  for (json& m : r["materials"])
+    if (m["name"] == "gold-ggx-0.15") m["delta_e"]["ggx"] = 0.0;
+  test::write_bytes(dir.file("report.json"), r.dump());
+  ReportOptions again = small(dir.path().string());
+  again.force = true;
+  const json now = run_report(again);
+  bool found = false;
+  for (const json& g : now["regressions"]) found |= g["name"] == "gold-ggx-0.15" && g["representation"] == "ggx";
+  double gold_ggx = 0.0;
+  for (const json& m : now["materials"])
+    if (m["name"] == "gold-ggx-0.15") gold_ggx = m["delta_e"]["ggx"].get<double>();
+  // A regression needs +10% and +0.1: from the pretended 0, exactly when gold's Delta E exceeds 0.1.
+  EXPECT_EQ(found, gold_ggx > 0.1);
+  json previous = now, current = now;
+  previous["materials"][2]["delta_e"]["ggx"] = 1.0;
+  current["materials"][2]["delta_e"]["ggx"] = 2.0;
+  ASSERT_EQ(find_regressions(previous, current).size(), 1u);
+  EXPECT_EQ(find_regressions(current, previous).size(), 0u);  // getting better is not a regression
+}
+
+TEST(Report, ShardsMergeIntoTheWholeReport) {
+  TempDir whole, part1, part2, merged;
+  const json full = run_report(small(whole.path().string()));
+  ReportOptions a = small(part1.path().string()), b = small(part2.path().string());
+  a.shard = 1, a.shards = 2;
+  b.shard = 2, b.shards = 2;
+  const json ra = run_report(a), rb = run_report(b);
+  EXPECT_EQ(ra["materials"].size() + rb["materials"].size(), 3u);
+  EXPECT_FALSE(ra["materials"].empty());
+  EXPECT_FALSE(rb["materials"].empty());
+  const json m = merge_reports({part1.path().string(), part2.path().string()}, merged.path().string());
+  ASSERT_EQ(m["materials"].size(), 3u);
+  for (std::size_t k = 0; k < 3; ++k) {
+    EXPECT_EQ(m["materials"][k]["name"], full["materials"][k]["name"]);
+    EXPECT_EQ(m["materials"][k]["delta_e"], full["materials"][k]["delta_e"]);  // fixed seeds: the same numbers
+    EXPECT_TRUE(std::filesystem::exists(merged.path() / "images" / m["materials"][k]["name"].get<std::string>() / "measured.png"));
+  }
+  EXPECT_EQ(m["database_mean_delta_e"], full["database_mean_delta_e"]);
+  EXPECT_NE(test::error_of([&] { merge_reports({merged.file("nope")}, merged.path().string()); }).find("not a facetfit report"),
+            std::string::npos);
+}
+
+}  // namespace
+}  // namespace facetfit
