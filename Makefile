@@ -1,5 +1,5 @@
 # facetfit: the two commands of the README, and the maintenance targets.
-#   make demo   install what is missing, build, fit and bake the built-in material set
+#   make demo   install what is missing, build, fit and bake the built-in material set, run the accuracy report
 #   make test   install what is missing, build, run every test (and the unit and stress tests under ASan+UBSan)
 
 BUILD      ?= build/release
@@ -22,6 +22,8 @@ demo: build
 	$(BUILD)/bin/facetfit fit --builtin
 	$(BUILD)/bin/facetfit bake builtin: -o out/luts
 	@echo "LUTs: $(CURDIR)/out/luts (index: out/luts/index.json; inspect one with: $(BUILD)/bin/facetfit info out/luts/gold-ggx-0.15.exr)"
+	$(BUILD)/bin/facetfit report -o out/report
+	@echo "Report: $(CURDIR)/out/report/index.html"
 
 asan: deps
 	@cmake -S . -B $(ASAN_BUILD) $(CMAKE_GEN) -DCMAKE_BUILD_TYPE=RelWithDebInfo -DFACETFIT_SANITIZE=ON \

@@ -5,6 +5,7 @@
 
 #include "commands.h"
 #include "core/error.h"
+#include "color/image_diff.h"
 #include "render/renderer.h"
 
 namespace facetfit::cli {
@@ -14,6 +15,7 @@ namespace {
 struct RenderArgs {
   std::string scene;
   std::string output;
+  std::string png;
   int spp = 0;
   std::uint64_t seed = 0;
   std::string material = "builtin:gold-ggx-0.15";
@@ -45,6 +47,7 @@ void run_render(const RenderArgs& args, int& status) {
     write_exr(args.output, image,
               {{"scene", args.scene.empty() ? "default" : args.scene}, {"spp", std::to_string(image.spp)},
                {"seconds", std::to_string(image.seconds)}});
+    if (!args.png.empty()) write_display_png(args.png, image.rgba.data(), image.width, image.height, 4, DisplayTransform());
     std::printf("%s (%dx%d, %d spp, %.2f s)\n", args.output.c_str(), image.width, image.height, image.spp, image.seconds);
   } catch (const Error& e) {
     report_error(e.what());
@@ -59,6 +62,7 @@ void add_render_command(CLI::App& app, int& status) {
   CLI::App* cmd = app.add_subcommand("render", "Render a scene (or the embedded default) with the reference renderer");
   cmd->add_option("scene", args->scene, "Scene JSON (docs/scene-format.md); omitted: a sphere under the built-in sky");
   cmd->add_option("-o,--output", args->output, "Linear EXR to write")->required();
+  cmd->add_option("--png", args->png, "Also write a display-referred sRGB PNG (OpenColorIO display transform)");
   cmd->add_option("--spp", args->spp, "Samples per pixel (default: the scene's)");
   cmd->add_option("--seed", args->seed, "Random seed (default: the scene's)");
   cmd->add_option("--width", args->width, "Image width (default: the scene's)");

@@ -221,3 +221,43 @@ TEST_F(RglPipeline, BakeTheWholeDatabase) {
 
 }  // namespace
 }  // namespace facetfit
+
+namespace facetfit {
+namespace {
+
+TEST(ReportCli, FailOnRegressionAndMerge) {
+  TempDir dir;
+  const std::string out = dir.file("r"), args = " builtin:gold-ggx-0.15 builtin:red-plastic --size 16 --spp 2 ";
+  RunResult r = facetfit("report" + args + "-o " + out);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find(out + "/index.html"), std::string::npos);
+  // Make the previous report better than anything this run can do.
+  nlohmann::json previous = read_json(out + "/report.json");
+  for (auto& m : previous["materials"]) m["delta_e"]["ggx"] = 0.0;
+  test::write_bytes(out + "/report.json", previous.dump());
+  r = facetfit("report" + args + "--force --fail-on-regression -o " + out);
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("regression: red-plastic ggx"), std::string::npos) << r.err;
+  // Shards and merge through the command.
+  ASSERT_EQ(facetfit("report" + args + "--shard 1/2 -o " + dir.file("s1")).status, 0);
+  ASSERT_EQ(facetfit("report" + args + "--shard 2/2 -o " + dir.file("s2")).status, 0);
+  r = facetfit("report merge " + dir.file("s1") + " " + dir.file("s2") + " -o " + dir.file("m"));
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(read_json(dir.file("m/report.json"))["materials"].size(), 2u);
+  EXPECT_EQ(facetfit("report" + args + "--shard 3/2 -o " + dir.file("x")).status, 2);
+}
+
+TEST(RenderCli, DefaultSceneToExrAndPng) {
+  TempDir dir;
+  const RunResult r = facetfit("render -o " + dir.file("a.exr") + " --png " + dir.file("a.png") + " --width 24 --height 24 --spp 2");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(std::filesystem::exists(dir.file("a.exr")));
+  EXPECT_TRUE(std::filesystem::exists(dir.file("a.png")));
+  const RunResult diff = facetfit("diff " + dir.file("a.exr") + " " + dir.file("a.exr"));
+  EXPECT_EQ(diff.status, 0) << diff.err;
+  EXPECT_NE(diff.out.find("mean 0.000000"), std::string::npos) << diff.out;
+  EXPECT_EQ(facetfit("render " + dir.file("missing.json") + " -o " + dir.file("b.exr")).status, 1);
+}
+
+}  // namespace
+}  // namespace facetfit
