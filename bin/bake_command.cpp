@@ -6,7 +6,6 @@
 #include <cstdio>
 #include <filesystem>
 #include <map>
-#include <mutex>
 #include <thread>
 
 #include "commands.h"
@@ -14,6 +13,7 @@
 #include "io/atomic_file.h"
 #include "io/input.h"
 #include "lut/bake.h"
+#include "progress.h"
 
 namespace facetfit::cli {
 
@@ -32,35 +32,12 @@ struct BakeArgs {
   FitSettings settings;
 };
 
-// One line per material, or a progress bar when stderr is a terminal.
-class Progress {
- public:
-  explicit Progress(std::size_t total) : total_(total), tty_(::isatty(STDERR_FILENO) == 1) {}
-  void report(const BakeOutcome& o) {
-    std::lock_guard<std::mutex> lock(mutex_);
-    ++done_;
-    failed_ += o.status == BakeOutcome::Status::failed;
-    if (tty_) {
-      constexpr int kWidth = 30;
-      const int filled = int(kWidth * done_ / std::max<std::size_t>(total_, 1));
-      std::fprintf(stderr, "\r[%-*s] %zu/%zu %s%-30.30s", kWidth, std::string(std::size_t(filled), '=').c_str(), done_, total_,
-                   failed_ ? ("(" + std::to_string(failed_) + " failed) ").c_str() : "", o.name.c_str());
-      if (o.status == BakeOutcome::Status::failed) std::fprintf(stderr, "\rfacetfit: error: %s\n", o.error.c_str());
-      if (done_ == total_) std::fprintf(stderr, "\n");
-    } else if (o.status == BakeOutcome::Status::failed) {
-      std::fprintf(stderr, "facetfit: error: %s\n", o.error.c_str());
-    } else {
-      std::fprintf(stderr, "%s %s (%.0f ms)\n", o.status == BakeOutcome::Status::cached ? "cached" : "baked ", o.name.c_str(),
-                   o.seconds * 1e3);
-    }
-    std::fflush(stderr);
-  }
-
- private:
-  std::mutex mutex_;
-  std::size_t total_, done_ = 0, failed_ = 0;
-  bool tty_;
-};
+void report_outcome(Progress& progress, const BakeOutcome& o) {
+  char line[512];
+  std::snprintf(line, sizeof line, "%s %s (%.0f ms)", o.status == BakeOutcome::Status::cached ? "cached" : "baked ", o.name.c_str(),
+                o.seconds * 1e3);
+  progress.step(o.name, line, o.status == BakeOutcome::Status::failed ? o.error : "");
+}
 
 std::string canonical(const std::string& source) {
   if (source.rfind(kBuiltinPrefix, 0) == 0) return source;
@@ -125,14 +102,14 @@ void run_bake(const BakeArgs& args, int& status) {
   }
   Progress progress(inputs.size());
   for (const auto& o : outcomes)
-    if (!o.error.empty()) progress.report(o);
+    if (!o.error.empty()) report_outcome(progress, o);
   const int jobs = args.jobs > 0 ? args.jobs : int(std::thread::hardware_concurrency());
   tbb::task_arena arena(std::max(1, jobs));
   arena.execute([&] {
     tbb::parallel_for(std::size_t(0), todo.size(), [&](std::size_t t) {
       const std::size_t k = todo[t];
       outcomes[k] = bake_material(inputs[k], source_name(inputs[k]), args.out_dir, options, fitter);
-      progress.report(outcomes[k]);
+      report_outcome(progress, outcomes[k]);
     }, tbb::simple_partitioner());
   });
 

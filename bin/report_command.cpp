@@ -5,6 +5,7 @@
 
 #include "commands.h"
 #include "core/error.h"
+#include "progress.h"
 #include "report/report.h"
 
 namespace facetfit::cli {
@@ -54,15 +55,10 @@ void run_report_command(const ReportArgs& args, int& status) {
     status = 2;
     return;
   }
-  const bool tty = ::isatty(STDERR_FILENO) == 1;
-  o.progress = [tty](const std::string& name, std::size_t done, std::size_t total) {
-    if (tty) {
-      const int width = 30, filled = int(width * done / std::max<std::size_t>(total, 1));
-      std::fprintf(stderr, "\r[%-*s] %zu/%zu %-30.30s%s", width, std::string(std::size_t(filled), '=').c_str(), done, total,
-                   name.c_str(), done == total ? "\n" : "");
-    } else {
-      std::fprintf(stderr, "report: %zu/%zu %s\n", done, total, name.c_str());
-    }
+  std::shared_ptr<Progress> progress;
+  o.progress = [&progress](const std::string& name, std::size_t done, std::size_t total) {
+    if (!progress) progress = std::make_shared<Progress>(total);
+    progress->step(name, "report: " + std::to_string(done) + "/" + std::to_string(total) + " " + name);
   };
   try {
     finish(run_report(o), o.out_dir, args.fail_on_regression, status);

@@ -123,13 +123,6 @@ TEST(Render, ObjMeshes) {
 namespace facetfit {
 namespace {
 
-std::vector<float> rgb_of(const RenderedImage& image) {
-  std::vector<float> rgb(std::size_t(image.width) * image.height * 3);
-  for (std::size_t p = 0; p < rgb.size() / 3; ++p)
-    for (int c = 0; c < 3; ++c) rgb[3 * p + c] = image.rgba[4 * p + c];
-  return rgb;
-}
-
 TEST(Render, MeasuredGgxTableMatchesTheAnalyticGgx) {
   // The analytic gold GGX, tabulated into a MERL table and rendered from it (trilinear lookup), against
   // the analytic model itself, same scene and seeds: mean Delta E 2000 over the sphere < 0.5.
@@ -145,7 +138,7 @@ TEST(Render, MeasuredGgxTableMatchesTheAnalyticGgx) {
   const RenderedImage ia = render(a), ib = render(b);
   std::vector<bool> mask(std::size_t(ia.width) * ia.height);
   for (std::size_t p = 0; p < mask.size(); ++p) mask[p] = ia.rgba[4 * p + 3] >= 1.0f;
-  const ImageDiff d = image_delta_e(rgb_of(ia), false, rgb_of(ib), false, mask, DisplayTransform());
+  const ImageDiff d = image_delta_e(ia.rgb(), false, ib.rgb(), false, mask, DisplayTransform());
   EXPECT_GT(d.pixels, 1000u);
   EXPECT_LT(d.mean, 0.5);
   std::printf("measured vs analytic GGX: mean Delta E 2000 %.4f, max %.4f over %zu pixels\n", d.mean, d.max, d.pixels);

@@ -286,6 +286,13 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
   return image;
 }
 
+std::vector<float> RenderedImage::rgb() const {
+  std::vector<float> out(std::size_t(width) * height * 3);
+  for (std::size_t p = 0; p < out.size() / 3; ++p)
+    for (int c = 0; c < 3; ++c) out[3 * p + c] = rgba[4 * p + c];
+  return out;
+}
+
 void write_exr(const std::string& path, const RenderedImage& image, const std::vector<std::pair<std::string, std::string>>& metadata) {
   OIIO::ImageSpec spec(image.width, image.height, 4, OIIO::TypeDesc::FLOAT);
   spec.channelnames = {"R", "G", "B", "A"};

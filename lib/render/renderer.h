@@ -23,6 +23,8 @@ struct RenderedImage {
   std::vector<float> rgba;  // linear Rec.709, alpha = coverage of the objects
   int spp = 0;
   double seconds = 0.0;
+
+  std::vector<float> rgb() const;  // the colour alone, interleaved
 };
 
 // Loads what the scene needs (its environment, and only the materials its objects use) and renders.

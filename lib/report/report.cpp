@@ -26,14 +26,6 @@ const std::vector<std::string>& report_representations() {
 
 namespace {
 
-// The RGB of an RGBA render, interleaved.
-std::vector<float> rgb_of(const RenderedImage& image) {
-  std::vector<float> rgb(std::size_t(image.width) * image.height * 3);
-  for (std::size_t p = 0; p < rgb.size() / 3; ++p)
-    for (int c = 0; c < 3; ++c) rgb[3 * p + c] = image.rgba[4 * p + c];
-  return rgb;
-}
-
 double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
@@ -269,7 +261,7 @@ json run_report(const ReportOptions& o) {
           const RenderedImage img = render_as(r == "tabulated" ? "lut" : r, lut);
           entry["seconds"]["render"][r] = img.seconds;
           write_display_png((images / (r + ".png")).string(), img.rgba.data(), img.width, img.height, 4, display);
-          const ImageDiff diff = image_delta_e(rgb_of(measured), false, rgb_of(img), false, mask, display);
+          const ImageDiff diff = image_delta_e(measured.rgb(), false, img.rgb(), false, mask, display);
           entry["delta_e"][r] = diff.mean;
           entry["max_delta_e"][r] = diff.max;
           write_heatmap_png((images / (r + "_delta_e.png")).string(), img.width, img.height, diff.delta_e, mask);

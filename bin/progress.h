@@ -1,0 +1,44 @@
+// Progress of a batch on stderr: a bar redrawn in place on a terminal, one plain line per item otherwise
+// (logs, CI). Thread-safe.
+#pragma once
+
+#include <unistd.h>
+
+#include <cstdio>
+#include <mutex>
+#include <string>
+
+namespace facetfit::cli {
+
+class Progress {
+ public:
+  explicit Progress(std::size_t total) : total_(total), tty_(::isatty(STDERR_FILENO) == 1) {}
+
+  // One item done: `name` on the bar; `line` for logs; an `error` is printed either way.
+  void step(const std::string& name, const std::string& line, const std::string& error = "") {
+    std::lock_guard<std::mutex> lock(mutex_);
+    ++done_;
+    failed_ += !error.empty();
+    if (tty_) {
+      constexpr int kWidth = 30;
+      const int filled = int(kWidth * done_ / (total_ > 0 ? total_ : 1));
+      const std::string failed = failed_ ? "(" + std::to_string(failed_) + " failed) " : "";
+      std::fprintf(stderr, "\r[%-*s] %zu/%zu %s%-30.30s", kWidth, std::string(std::size_t(filled), '=').c_str(), done_, total_,
+                   failed.c_str(), name.c_str());
+      if (!error.empty()) std::fprintf(stderr, "\rfacetfit: error: %s\n", error.c_str());
+      if (done_ == total_) std::fprintf(stderr, "\n");
+    } else if (!error.empty()) {
+      std::fprintf(stderr, "facetfit: error: %s\n", error.c_str());
+    } else {
+      std::fprintf(stderr, "%s\n", line.c_str());
+    }
+    std::fflush(stderr);
+  }
+
+ private:
+  std::mutex mutex_;
+  std::size_t total_, done_ = 0, failed_ = 0;
+  bool tty_;
+};
+
+}  // namespace facetfit::cli
