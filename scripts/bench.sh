@@ -18,4 +18,5 @@ print(statistics.median(times))
 PY
 )
 python3 "$root/scripts/bench_to_md.py" "$json" "$root/docs/benchmarks.md" "$startup_ms"
+"$build/bench/facetfit_pareto" "$root/docs"
 echo "wrote docs/benchmarks.md"

@@ -58,6 +58,9 @@ def main(src, dst, startup_ms=None):
         "above the bar. On two cores the hash runs beside the read (`BM_Bake/threads:0`), and a batch uses",
         "both cores (`BM_BakeBatch`, materials_per_second).",
         "",
+        "Run time against error of the rendered result (LUT resolution x samples per pixel, Pareto front):",
+        "[pareto.md](pareto.md).",
+        "",
     ]
     if startup_ms is not None:
         lines += [
