@@ -6,6 +6,7 @@
 #include "commands.h"
 #include "core/error.h"
 #include "color/image_diff.h"
+#include "render/environment.h"
 #include "render/renderer.h"
 
 namespace facetfit::cli {
@@ -16,6 +17,7 @@ struct RenderArgs {
   std::string scene;
   std::string output;
   std::string png;
+  std::string save_sky;
   int spp = 0;
   std::uint64_t seed = 0;
   std::string material = "builtin:gold-ggx-0.15";
@@ -25,6 +27,15 @@ struct RenderArgs {
 
 void run_render(const RenderArgs& args, int& status) {
   try {
+    if (!args.save_sky.empty()) {  // the built-in sky as a lat-long EXR, for other renderers
+      const Environment sky = Environment::sky();
+      RenderedImage img;
+      img.width = sky.width();
+      img.height = sky.height();
+      for (std::size_t p = 0; p < sky.pixels().size() / 3; ++p)
+        img.rgba.insert(img.rgba.end(), {sky.pixels()[3 * p], sky.pixels()[3 * p + 1], sky.pixels()[3 * p + 2], 1.0f});
+      write_exr(args.save_sky, img, {{"environment", "builtin sky"}});
+    }
     SceneDesc scene;
     if (args.scene.empty()) {
       MaterialDesc subject;
@@ -63,6 +74,7 @@ void add_render_command(CLI::App& app, int& status) {
   cmd->add_option("scene", args->scene, "Scene JSON (docs/scene-format.md); omitted: a sphere under the built-in sky");
   cmd->add_option("-o,--output", args->output, "Linear EXR to write")->required();
   cmd->add_option("--png", args->png, "Also write a display-referred sRGB PNG (OpenColorIO display transform)");
+  cmd->add_option("--save-sky", args->save_sky, "Also write the built-in sky as a lat-long EXR (for other renderers)");
   cmd->add_option("--spp", args->spp, "Samples per pixel (default: the scene's)");
   cmd->add_option("--seed", args->seed, "Random seed (default: the scene's)");
   cmd->add_option("--width", args->width, "Image width (default: the scene's)");

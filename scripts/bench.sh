@@ -19,4 +19,7 @@ PY
 )
 python3 "$root/scripts/bench_to_md.py" "$json" "$root/docs/benchmarks.md" "$startup_ms"
 "$build/bench/facetfit_pareto" "$root/docs"
+# Cycles through Blender's bpy wheel, in a venv of the build.
+py=$("$root/scripts/setup-bpy.sh" "$build/../bpy-venv" | tail -n 1)
+"$py" "$root/scripts/cycles_compare.py" "$build/bin/facetfit" "$root/docs/cycles.md"
 echo "wrote docs/benchmarks.md"

@@ -59,7 +59,7 @@ def main(src, dst, startup_ms=None):
         "both cores (`BM_BakeBatch`, materials_per_second).",
         "",
         "Run time against error of the rendered result (LUT resolution x samples per pixel, Pareto front):",
-        "[pareto.md](pareto.md).",
+        "[pareto.md](pareto.md). The reference renderer against Blender Cycles on the same scene: [cycles.md](cycles.md).",
         "",
     ]
     if startup_ms is not None:
