@@ -1,0 +1,223 @@
+// facetfit.h: the tabulated microfacet model of a facetfit LUT in OSL (docs/lut-format.md, docs/osl.md).
+//
+// The same maths as lib/model/tabulated.cpp, reading the LUT only through texture lookups at texel
+// centres with explicit "interp" "linear", "wrap" "clamp" (OSL's defaults would filter and fade a one-row
+// table) and the metadata through gettextureinfo. Directions are in the local frame (z = normal), both
+// pointing away from the surface: i toward the light, o toward the viewer (Cycles' I is o in world space).
+
+#ifndef FACETFIT_H
+#define FACETFIT_H
+
+#define FACETFIT_PI 3.14159265358979323846
+
+// Rows of the LUT image.
+#define FACETFIT_NDF_ROW 0
+#define FACETFIT_SIGMA_ROW 1
+#define FACETFIT_FRESNEL_ROW 2
+#define FACETFIT_SAMPLING_ROW 3
+
+struct FacetfitLut {
+  string file;
+  int width;
+  int height;
+  int resolution;  // R: nodes 0..R
+  int smith;       // 0 masking, 1 correlated, 2 separable
+  int sampling;    // sampling rows present
+  int ok;
+};
+
+// Opens a LUT: its size and metadata. ok = 0 when the file is missing or is not a facetfit LUT.
+FacetfitLut facetfit_open(string file) {
+  FacetfitLut lut;
+  lut.file = file;
+  lut.ok = 0;
+  int res[2] = {0, 0};
+  int version = 0, resolution = 0, sampling = 0;
+  string smith = "";
+  if (gettextureinfo(file, "resolution", res) && gettextureinfo(file, "facetfit:format_version", version) &&
+      gettextureinfo(file, "facetfit:resolution", resolution) && gettextureinfo(file, "facetfit:smith", smith) &&
+      version == 1) {
+    gettextureinfo(file, "facetfit:sampling", sampling);
+    lut.width = res[0];
+    lut.height = res[1];
+    lut.resolution = resolution;
+    lut.sampling = sampling;
+    lut.smith = smith == "masking" ? 0 : (smith == "separable" ? 2 : 1);
+    lut.ok = 1;
+  }
+  return lut;
+}
+
+// The value stored at texel x of a row (the R channel), exactly: a lookup at the texel's centre.
+float facetfit_texel(FacetfitLut lut, int row, int x) {
+  float s = (x + 0.5) / lut.width, t = (row + 0.5) / lut.height;
+  return texture(lut.file, s, t, "interp", "linear", "wrap", "clamp");
+}
+
+// The uniform Catmull-Rom spline in u through the nodes of a row, at theta; ghost nodes as in
+// ThetaGrid::stencil: node -1 mirrors node 1, node R+1 continues the last interval linearly.
+float facetfit_spline(FacetfitLut lut, int row, float theta) {
+  int R = lut.resolution;
+  float x = min(sqrt(max(theta, 0.0) / (0.5 * FACETFIT_PI)), 1.0) * R;
+  int j = min(int(floor(x)), R - 1);
+  float t = x - j, t2 = t * t, t3 = t2 * t;
+  float w0 = 0.5 * (-t + 2.0 * t2 - t3), w1 = 0.5 * (2.0 - 5.0 * t2 + 3.0 * t3);
+  float w2 = 0.5 * (t + 4.0 * t2 - 3.0 * t3), w3 = 0.5 * (t3 - t2);
+  int i0 = j == 0 ? 1 : j - 1;
+  int i3 = j + 2;
+  if (i3 > R) {
+    w2 += 2.0 * w3;
+    w1 -= w3;
+    w3 = 0.0;
+    i3 = R;
+  }
+  return w0 * facetfit_texel(lut, row, i0) + w1 * facetfit_texel(lut, row, j) + w2 * facetfit_texel(lut, row, j + 1) +
+         w3 * facetfit_texel(lut, row, i3);
+}
+
+float facetfit_D(FacetfitLut lut, float cos_h) {
+  if (cos_h <= 0.0) return 0.0;
+  return max(0.0, facetfit_spline(lut, FACETFIT_NDF_ROW, acos(min(cos_h, 1.0))));
+}
+
+// Smith masking G1 = cos / sigma.
+float facetfit_G1(FacetfitLut lut, float cos_w) {
+  if (cos_w <= 0.0) return 0.0;
+  float s = facetfit_spline(lut, FACETFIT_SIGMA_ROW, acos(min(cos_w, 1.0)));
+  return s > cos_w ? cos_w / s : 1.0;
+}
+
+float facetfit_G2(FacetfitLut lut, float g1_i, float g1_o) {
+  if (lut.smith == 0) return min(g1_i, g1_o);
+  if (lut.smith == 2) return g1_i * g1_o;
+  float den = g1_i + g1_o - g1_i * g1_o;
+  return den > 0.0 ? g1_i * g1_o / den : 0.0;
+}
+
+// The RGB Fresnel curve: 90 texels at theta_d = x degrees, linear between them, constant past 89.
+color facetfit_fresnel(FacetfitLut lut, float cos_d) {
+  float x = clamp(acos(clamp(cos_d, 0.0, 1.0)) / (0.5 * FACETFIT_PI) * 90.0, 0.0, 89.0);
+  float s = (x + 0.5) / lut.width, t = (FACETFIT_FRESNEL_ROW + 0.5) / lut.height;
+  return texture(lut.file, s, t, "interp", "linear", "wrap", "clamp");
+}
+
+// f(i, o) in 1/sr.
+color facetfit_eval(FacetfitLut lut, vector i, vector o) {
+  if (i[2] <= 0.0 || o[2] <= 0.0) return color(0);
+  vector h = normalize(i + o);
+  float g2 = facetfit_G2(lut, facetfit_G1(lut, i[2]), facetfit_G1(lut, o[2]));
+  return facetfit_fresnel(lut, dot(i, h)) * (facetfit_D(lut, h[2]) * g2 / (4.0 * i[2] * o[2]));
+}
+
+// ---- sampling the visible normals (docs/sampling.md) ----
+
+// Interval j and fraction t of theta on the grid.
+void facetfit_locate(FacetfitLut lut, float cos_theta, output int j, output float t) {
+  float x = min(sqrt(acos(clamp(cos_theta, -1.0, 1.0)) / (0.5 * FACETFIT_PI)), 1.0) * lut.resolution;
+  j = min(int(floor(x)), lut.resolution - 1);
+  t = x - j;
+}
+
+float facetfit_cos_node(FacetfitLut lut, int j) {
+  float u = float(j) / lut.resolution;
+  return cos(u * u * 0.5 * FACETFIT_PI);
+}
+
+float facetfit_cdf(FacetfitLut lut, int slice, int node) { return facetfit_texel(lut, FACETFIT_SAMPLING_ROW + slice, node); }
+
+float facetfit_phi_integral(float a, float b) {
+  if (a <= b) return 2.0 * FACETFIT_PI * b;
+  return 2.0 * (sqrt(a * a - b * b) + b * acos(-b / a));
+}
+
+// Density of the visible normals h seen from o, per steradian of h.
+float facetfit_visible_normal_pdf(FacetfitLut lut, vector o, vector h) {
+  float oh = dot(o, h);
+  if (o[2] <= 0.0 || h[2] <= 0.0 || oh <= 0.0 || !lut.sampling) return 0.0;
+  int vj, nj;
+  float vt, nt;
+  facetfit_locate(lut, o[2], vj, vt);
+  facetfit_locate(lut, h[2], nj, nt);
+  float band = facetfit_cos_node(lut, nj) - facetfit_cos_node(lut, nj + 1);
+  if (band <= 0.0) return 0.0;
+  float m0 = facetfit_cdf(lut, vj, nj + 1) - facetfit_cdf(lut, vj, nj);
+  float m1 = facetfit_cdf(lut, vj + 1, nj + 1) - facetfit_cdf(lut, vj + 1, nj);
+  float mass = (1.0 - vt) * m0 + vt * m1;
+  float sin_o = sqrt(max(0.0, 1.0 - o[2] * o[2])), sin_h = sqrt(max(0.0, 1.0 - h[2] * h[2]));
+  float total = facetfit_phi_integral(sin_o * sin_h, o[2] * h[2]);
+  return total > 0.0 ? mass / band * oh / total : 0.0;
+}
+
+float facetfit_pdf(FacetfitLut lut, vector o, vector i) {
+  if (i[2] <= 0.0 || o[2] <= 0.0) return 0.0;
+  vector h = normalize(o + i);
+  float oh = dot(o, h);
+  return oh > 0.0 ? facetfit_visible_normal_pdf(lut, o, h) / (4.0 * oh) : 0.0;
+}
+
+// phi in (-pi, pi] with density proportional to max(0, a cos(phi) + b).
+float facetfit_sample_phi(float a, float b, float u_in) {
+  float phi_max = a <= b ? FACETFIT_PI : acos(-b / a);
+  float sgn = u_in < 0.5 ? -1.0 : 1.0;
+  float u = u_in < 0.5 ? 2.0 * u_in : 2.0 * u_in - 1.0;
+  float total = a * sin(phi_max) + b * phi_max;
+  if (total <= 0.0) return sgn * u * FACETFIT_PI;
+  float target = u * total, lo = 0.0, hi = phi_max, phi = u * phi_max;
+  for (int it = 0; it < 40; ++it) {
+    float f = a * sin(phi) + b * phi - target;
+    if (f > 0.0) hi = phi; else lo = phi;
+    float df = a * cos(phi) + b;
+    float next = df > 0.0 ? phi - f / df : 0.5 * (lo + hi);
+    if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
+    float step = abs(next - phi);
+    phi = next;
+    if (step < 1e-7) break;
+  }
+  return sgn * phi;
+}
+
+// Draws i for o from two uniform numbers; returns 0 when no direction (below the horizon, no tables).
+int facetfit_sample(FacetfitLut lut, vector o, float u1_in, float u2, output vector i, output float pdf) {
+  if (o[2] <= 0.0 || !lut.sampling) return 0;
+  int vj;
+  float vt;
+  facetfit_locate(lut, o[2], vj, vt);
+  int slice = vj;
+  float u1 = u1_in;
+  if (u1 < 1.0 - vt) {
+    u1 /= 1.0 - vt;
+  } else {
+    u1 = (u1 - (1.0 - vt)) / vt;
+    slice = vj + 1;
+  }
+  u1 = clamp(u1, 0.0, 0.99999994);
+  // The last node whose CDF is <= u1: binary search over nodes 0..R.
+  int lo = 0, hi = lut.resolution;
+  while (hi - lo > 1) {
+    int mid = (lo + hi) / 2;
+    if (facetfit_cdf(lut, slice, mid) <= u1) lo = mid; else hi = mid;
+  }
+  int j = lo;
+  float c0 = facetfit_cdf(lut, slice, j), m = facetfit_cdf(lut, slice, j + 1) - c0;
+  float frac = m > 0.0 ? clamp((u1 - c0) / m, 0.0, 1.0) : 0.5;
+  float cos_h = facetfit_cos_node(lut, j) - frac * (facetfit_cos_node(lut, j) - facetfit_cos_node(lut, j + 1));
+  float sin_h = sqrt(max(0.0, 1.0 - cos_h * cos_h)), sin_o = sqrt(max(0.0, 1.0 - o[2] * o[2]));
+  float phi = facetfit_sample_phi(sin_o * sin_h, o[2] * cos_h, u2) + (sin_o > 0.0 ? atan2(o[1], o[0]) : 0.0);
+  vector h = vector(sin_h * cos(phi), sin_h * sin(phi), cos_h);
+  i = 2.0 * dot(o, h) * h - o;
+  if (i[2] <= 0.0) return 0;
+  pdf = facetfit_pdf(lut, o, i);
+  return pdf > 0.0;
+}
+
+// The local frame of a shading point: z = N, x = T (any tangent for isotropic materials).
+void facetfit_frame(normal Nn, output vector T, output vector B) {
+  vector a = abs(Nn[0]) > 0.9 ? vector(0, 1, 0) : vector(1, 0, 0);
+  T = normalize(cross(a, Nn));
+  B = cross(Nn, T);
+}
+
+vector facetfit_to_local(vector v, vector T, vector B, normal Nn) { return vector(dot(v, T), dot(v, B), dot(v, Nn)); }
+vector facetfit_to_world(vector v, vector T, vector B, normal Nn) { return v[0] * T + v[1] * B + v[2] * Nn; }
+
+#endif  // FACETFIT_H
