@@ -25,10 +25,4 @@ std::optional<Rgb> SumBrdf::eval(const Vec3& i, const Vec3& o) const {
   return sum;
 }
 
-std::optional<Rgb> ScaledBrdf::eval(const Vec3& i, const Vec3& o) const {
-  const auto f = base_->eval(i, o);
-  if (!f) return std::nullopt;
-  return *f * scale_;
-}
-
 }  // namespace facetfit

@@ -46,15 +46,4 @@ class SumBrdf final : public Brdf {
   std::vector<std::shared_ptr<const Brdf>> lobes_;
 };
 
-// Scales another BRDF per channel (a coloured coat, a dimmer measurement).
-class ScaledBrdf final : public Brdf {
- public:
-  ScaledBrdf(std::shared_ptr<const Brdf> base, const Rgb& scale) : base_(std::move(base)), scale_(scale) {}
-  std::optional<Rgb> eval(const Vec3& i, const Vec3& o) const override;
-
- private:
-  std::shared_ptr<const Brdf> base_;
-  Rgb scale_;
-};
-
 }  // namespace facetfit
