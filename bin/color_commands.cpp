@@ -20,7 +20,7 @@
 #include "color/image_diff.h"
 #include "commands.h"
 #include "core/error.h"
-#include "io/atomic_file.h"
+#include "io/image_file.h"
 
 namespace facetfit::cli {
 
@@ -87,11 +87,7 @@ std::string size_text(int width, int height) { return std::to_string(width) + " 
 
 // Every channel of the first subimage as float, with its spec.
 std::vector<float> read_all(const std::string& path, OIIO::ImageSpec& spec) {
-  auto in = OIIO::ImageInput::open(path);
-  if (!in) {
-    const std::string why = OIIO::geterror();
-    fail(path, why.empty() ? "cannot open" : why.substr(0, why.find('\n')));
-  }
+  auto in = open_image(path);
   spec = in->spec();
   if (spec.deep) fail(path, "deep images are not supported");
   if (spec.depth != 1) fail(path, "volume images are not supported");

@@ -7,7 +7,7 @@
 #include <cstdint>
 
 #include "core/error.h"
-#include "io/atomic_file.h"
+#include "io/image_file.h"
 
 namespace facetfit {
 
@@ -60,13 +60,7 @@ void write_png8(const std::string& path, int width, int height, const std::vecto
   OIIO::ImageSpec spec(width, height, 3, OIIO::TypeDesc::UINT8);
   spec.channelnames = {"R", "G", "B"};
   spec.attribute("oiio:ColorSpace", "sRGB");
-  AtomicFile out(path);
-  auto image = OIIO::ImageOutput::create(out.temp_path());
-  if (!image) fail(path, "cannot write: " + OIIO::geterror());
-  if (!image->open(out.temp_path(), spec) || !image->write_image(OIIO::TypeDesc::UINT8, pixels.data()) || !image->close())
-    fail(path, "cannot write: " + image->geterror());
-  image.reset();
-  out.commit();
+  write_image_atomic(path, spec, pixels.data());
 }
 
 }  // namespace

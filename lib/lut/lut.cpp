@@ -6,14 +6,12 @@
 
 #include "core/error.h"
 #include "fit/roughness.h"
-#include "io/atomic_file.h"
+#include "io/image_file.h"
 
 namespace facetfit {
 
 namespace {
 
-using OIIO::ImageInput;
-using OIIO::ImageOutput;
 using OIIO::ImageSpec;
 using OIIO::TypeDesc;
 
@@ -122,22 +120,11 @@ void write_lut(const std::string& path, const Lut& lut) {
   spec.attribute(key("tolerance"), float(m.tolerance));
   spec.attribute(key("sampling"), m.sampling ? 1 : 0);
 
-  AtomicFile out(path);
-  auto image = ImageOutput::create(out.temp_path());
-  if (!image) fail(path, "cannot write: " + OIIO::geterror());
-  if (!image->open(out.temp_path(), spec) || !image->write_image(TypeDesc::FLOAT, pixels.data()) || !image->close())
-    fail(path, "cannot write: " + image->geterror());
-  image.reset();
-  out.commit();
+  write_image_atomic(path, spec, pixels.data());
 }
 
 Lut read_lut(const std::string& path) {
-  auto image = ImageInput::open(path);
-  if (!image) {
-    std::string why = OIIO::geterror();
-    if (why.empty()) why = "cannot open";
-    fail(path, why.substr(0, why.find('\n')));
-  }
+  auto image = open_image(path);
   const ImageSpec& spec = image->spec();
   const int version = spec.get_int_attribute(key("format_version"), -1);
   if (version < 0) fail(path, "not a facetfit LUT (no facetfit:format_version attribute)");

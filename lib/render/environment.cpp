@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "core/error.h"
+#include "io/image_file.h"
 
 namespace facetfit {
 
@@ -40,11 +41,7 @@ Environment Environment::from_pixels(int width, int height, std::vector<float> r
 }
 
 Environment Environment::load(const std::string& path) {
-  auto in = OIIO::ImageInput::open(path);
-  if (!in) {
-    const std::string why = OIIO::geterror();
-    fail(path, why.empty() ? "cannot open environment map" : why.substr(0, why.find('\n')));
-  }
+  auto in = open_image(path, "cannot open environment map");
   const OIIO::ImageSpec& spec = in->spec();
   if (spec.width < 2 || spec.height < 1 || spec.width > 65536 || spec.height > 32768) fail(path, "unusable environment map size");
   int channel[3];

@@ -12,7 +12,7 @@
 #include <sstream>
 
 #include "core/error.h"
-#include "io/atomic_file.h"
+#include "io/image_file.h"
 #include "render/environment.h"
 
 namespace facetfit {
@@ -300,13 +300,7 @@ void write_exr(const std::string& path, const RenderedImage& image, const std::v
   spec.attribute("compression", "zip");
   spec.attribute("oiio:ColorSpace", "Linear");
   for (const auto& [k, v] : metadata) spec.attribute("facetfit:" + k, v);
-  AtomicFile out(path);
-  auto img = OIIO::ImageOutput::create(out.temp_path());
-  if (!img) fail(path, "cannot write: " + OIIO::geterror());
-  if (!img->open(out.temp_path(), spec) || !img->write_image(OIIO::TypeDesc::FLOAT, image.rgba.data()) || !img->close())
-    fail(path, "cannot write: " + img->geterror());
-  img.reset();
-  out.commit();
+  write_image_atomic(path, spec, image.rgba.data());
 }
 
 }  // namespace facetfit
