@@ -40,7 +40,7 @@ void report_outcome(Progress& progress, const BakeOutcome& o) {
 }
 
 std::string canonical(const std::string& source) {
-  if (source.rfind(kBuiltinPrefix, 0) == 0) return source;
+  if (is_builtin(source)) return source;
   std::error_code ec;
   const fs::path p = fs::weakly_canonical(source, ec);
   return ec ? source : p.string();

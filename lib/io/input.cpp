@@ -15,14 +15,19 @@ namespace fs = std::filesystem;
 
 namespace {
 
-bool starts_with(const std::string& s, const std::string& prefix) { return s.compare(0, prefix.size(), prefix) == 0; }
-
 bool is_supported_file(const fs::path& p) { return p.extension() == ".binary" || p.extension() == ".bsdf"; }
 
 }  // namespace
 
+bool is_builtin(const std::string& source) { return source.compare(0, std::string(kBuiltinPrefix).size(), kBuiltinPrefix) == 0; }
+
+std::string resolve_source(const std::string& base_dir, const std::string& source) {
+  if (is_builtin(source) || fs::path(source).is_absolute()) return source;
+  return (fs::path(base_dir) / source).lexically_normal().string();
+}
+
 MerlTable load_table(const std::string& source) {
-  if (starts_with(source, kBuiltinPrefix)) {
+  if (is_builtin(source)) {
     const std::string name = source.substr(std::string(kBuiltinPrefix).size());
     const auto material = find_builtin(name);
     if (!material) fail(source, "no such built-in material (facetfit list-builtins shows them)");
@@ -43,7 +48,7 @@ std::vector<std::string> expand_inputs(const std::vector<std::string>& args) {
     std::error_code ec;
     if (arg == kBuiltinPrefix) {
       for (const auto& m : builtin_materials()) out.push_back(kBuiltinPrefix + m.name);
-    } else if (!starts_with(arg, kBuiltinPrefix) && fs::is_directory(arg, ec)) {
+    } else if (!is_builtin(arg) && fs::is_directory(arg, ec)) {
       std::vector<std::string> files;
       for (const auto& entry : fs::directory_iterator(arg, ec))
         if (entry.is_regular_file(ec) && is_supported_file(entry.path())) files.push_back(entry.path().string());
@@ -67,7 +72,7 @@ std::vector<std::string> expand_inputs(const std::vector<std::string>& args) {
 }
 
 std::string source_name(const std::string& source) {
-  if (starts_with(source, kBuiltinPrefix)) return source.substr(std::string(kBuiltinPrefix).size());
+  if (is_builtin(source)) return source.substr(std::string(kBuiltinPrefix).size());
   return fs::path(source).stem().string();
 }
 

@@ -22,6 +22,13 @@ MerlTable load_table(const std::string& source);
 // Anything else is passed through (and fails later, with its own message, if it is not loadable).
 std::vector<std::string> expand_inputs(const std::vector<std::string>& args);
 
+// Whether a source names a built-in material (builtin:NAME).
+bool is_builtin(const std::string& source);
+
+// A source named inside a file (a scene): relative paths resolve against `base_dir`; built-ins and
+// absolute paths stay as they are.
+std::string resolve_source(const std::string& base_dir, const std::string& source);
+
 // The short name of a source: file stem, or the built-in's name.
 std::string source_name(const std::string& source);
 

@@ -38,7 +38,7 @@ std::string bake_cache_key(const std::string& source_sha256, const BakeOptions& 
 namespace {
 
 std::string source_hash(const std::string& source) {
-  if (source.rfind(kBuiltinPrefix, 0) == 0) {
+  if (is_builtin(source)) {
     // A built-in is defined by its name and the code that makes it: the version is in the cache key.
     return sha256_hex(source.data(), source.size());
   }
@@ -171,7 +171,7 @@ std::vector<std::string> scene_materials(const std::string& scene_path) {
     if (item.is_string()) file = item.get<std::string>();
     else if (item.is_object() && item.contains("file") && item["file"].is_string()) file = item["file"].get<std::string>();
     else fail(scene_path, "material entry " + item.dump() + " is neither a path nor an object with \"file\"");
-    if (file.rfind(kBuiltinPrefix, 0) != 0 && fs::path(file).is_relative()) file = (base / file).lexically_normal().string();
+    file = resolve_source(base.string(), file);
     if (std::find(out.begin(), out.end(), file) == out.end()) out.push_back(file);
   }
   return out;

@@ -166,14 +166,13 @@ SceneDesc default_scene(const MaterialDesc& subject) {
 }
 
 std::string resolve(const SceneDesc& scene, const std::string& file) {
-  if (file.rfind(kBuiltinPrefix, 0) == 0 || fs::path(file).is_absolute()) return file;
-  return (fs::path(scene.base_dir) / file).lexically_normal().string();
+  return resolve_source(scene.base_dir, file);
 }
 
 std::shared_ptr<const ShadingModel> load_material(const SceneDesc& scene, const MaterialDesc& m) {
   if (m.type == "lambert") return std::make_shared<ShadingModel>(std::make_shared<LambertBrdf>(m.albedo), nullptr);
   if (m.type == "analytic") {  // a built-in's analytic model itself: the ground truth
-    const std::string name = m.file.rfind(kBuiltinPrefix, 0) == 0 ? m.file.substr(std::string(kBuiltinPrefix).size()) : m.file;
+    const std::string name = is_builtin(m.file) ? source_name(m.file) : m.file;
     const auto builtin = find_builtin(name);
     if (!builtin) fail(m.file, "analytic materials are built-ins (builtin:NAME)");
     std::shared_ptr<const TabulatedMicrofacet> proposal;
