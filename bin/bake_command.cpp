@@ -13,6 +13,7 @@
 #include "io/atomic_file.h"
 #include "io/input.h"
 #include "lut/bake.h"
+#include "render/scene.h"
 #include "progress.h"
 
 namespace facetfit::cli {

@@ -151,6 +151,15 @@ TEST(Bake, SceneBakesOnlyWhatItReferences) {
   EXPECT_EQ(r.status, 0) << r.err;
   EXPECT_TRUE(std::filesystem::exists(out.file("all/gold.exr")));
   EXPECT_TRUE(std::filesystem::exists(out.file("all/red-plastic.exr")));
+  // A renderer scene (docs/scene-format.md): only the measured materials its objects use.
+  test::write_bytes(in.file("render.json"), R"({
+    "materials": {"a": {"type": "measured", "file": "silver.binary"}, "b": {"type": "lambert"},
+                  "unused": {"type": "measured", "file": "gold.binary"}},
+    "objects": [{"type": "sphere", "material": "a"}, {"type": "plane", "material": "b"}]})");
+  r = facetfit("bake " + in.path().string() + " --scene " + in.file("render.json") + " -o " + out.file("render"));
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(std::filesystem::exists(out.file("render/silver.exr")));
+  EXPECT_FALSE(std::filesystem::exists(out.file("render/gold.exr")));
   test::write_bytes(in.file("bad.json"), "{not json");
   EXPECT_NE(facetfit("bake --scene " + in.file("bad.json") + " -o " + out.file("x")).status, 0);
 }

@@ -157,24 +157,4 @@ int remove_stale_temporaries(const std::string& dir) {
   return removed;
 }
 
-std::vector<std::string> scene_materials(const std::string& scene_path) {
-  std::ifstream in(scene_path);
-  if (!in) fail(scene_path, "cannot open scene");
-  const nlohmann::json scene = nlohmann::json::parse(in, nullptr, false);
-  if (scene.is_discarded()) fail(scene_path, "not valid JSON");
-  const nlohmann::json& list = scene.is_object() ? scene.value("materials", nlohmann::json()) : scene;
-  if (!list.is_array()) fail(scene_path, "a scene is a list of material paths or an object with a \"materials\" list");
-  const fs::path base = fs::path(scene_path).parent_path();
-  std::vector<std::string> out;
-  for (const auto& item : list) {
-    std::string file;
-    if (item.is_string()) file = item.get<std::string>();
-    else if (item.is_object() && item.contains("file") && item["file"].is_string()) file = item["file"].get<std::string>();
-    else fail(scene_path, "material entry " + item.dump() + " is neither a path nor an object with \"file\"");
-    file = resolve_source(base.string(), file);
-    if (std::find(out.begin(), out.end(), file) == out.end()) out.push_back(file);
-  }
-  return out;
-}
-
 }  // namespace facetfit

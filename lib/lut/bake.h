@@ -36,8 +36,4 @@ BakeOutcome bake_material(const std::string& source, const std::string& name, co
 // Removes temporaries left in `dir` by facetfit runs that no longer exist (a kill mid-write).
 int remove_stale_temporaries(const std::string& dir);
 
-// The materials a scene references, resolved against the scene's folder. A scene is a JSON list of
-// material paths or an object with a "materials" list (of paths, or of objects with a "file" key).
-std::vector<std::string> scene_materials(const std::string& scene_path);
-
 }  // namespace facetfit

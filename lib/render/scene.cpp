@@ -1,5 +1,6 @@
 #include "render/scene.h"
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -163,6 +164,37 @@ SceneDesc default_scene(const MaterialDesc& subject) {
   sphere.material = "subject";
   s.objects.push_back(sphere);
   return s;
+}
+
+std::vector<std::string> scene_materials(const std::string& scene_path) {
+  std::ifstream in(scene_path);
+  if (!in) fail(scene_path, "cannot open scene");
+  const json scene = json::parse(in, nullptr, false);
+  if (scene.is_discarded()) fail(scene_path, "not valid JSON");
+  std::vector<std::string> out;
+  const auto add = [&out](const std::string& file) {
+    if (std::find(out.begin(), out.end(), file) == out.end()) out.push_back(file);
+  };
+  if (scene.is_object() && scene.contains("materials") && scene["materials"].is_object()) {
+    const SceneDesc s = parse_scene(scene_path);
+    for (const ObjectDesc& o : s.objects) {
+      const MaterialDesc& m = s.materials.at(o.material);
+      if (m.type == "measured") add(resolve(s, m.file));
+    }
+    return out;
+  }
+  const json list = scene.is_object() ? scene.value("materials", json()) : scene;
+  if (!list.is_array())
+    fail(scene_path, "not a scene: a renderer scene, a list of material paths, or an object with a \"materials\" list");
+  const std::string base = fs::path(scene_path).parent_path().string();
+  for (const auto& item : list) {
+    std::string file;
+    if (item.is_string()) file = item.get<std::string>();
+    else if (item.is_object() && item.contains("file") && item["file"].is_string()) file = item["file"].get<std::string>();
+    else fail(scene_path, "material entry " + item.dump() + " is neither a path nor an object with \"file\"");
+    add(resolve_source(base, file));
+  }
+  return out;
 }
 
 std::string resolve(const SceneDesc& scene, const std::string& file) {

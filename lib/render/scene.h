@@ -70,6 +70,11 @@ SceneDesc parse_scene(const std::string& path);
 // The embedded default: a sphere of `subject` under the built-in sky. Needs no asset.
 SceneDesc default_scene(const MaterialDesc& subject);
 
+// The measured sources a scene needs baked, resolved against the scene's folder: for a renderer scene,
+// the files of the `measured` materials its objects use; a plain JSON list of paths (or an object with a
+// "materials" list of paths or {"file": ...}) is taken as it is.
+std::vector<std::string> scene_materials(const std::string& scene_path);
+
 // Resolves a file name of the scene: relative names against the scene's folder, builtin: as is.
 std::string resolve(const SceneDesc& scene, const std::string& file);
 
