@@ -146,3 +146,35 @@ TEST(Render, MeasuredGgxTableMatchesTheAnalyticGgx) {
 
 }  // namespace
 }  // namespace facetfit
+
+#include <random>
+
+#include "render/environment.h"
+
+namespace facetfit {
+namespace {
+
+TEST(Environment, ImportanceSamplingAgreesWithItsPdf) {
+  const Environment sky = Environment::sky(128);
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  // The pdf integrates to one over the sphere (uniform-sphere estimate) ...
+  double integral = 0.0, flux_uniform = 0.0, flux_sampled = 0.0;
+  const int n = 400000;
+  for (int k = 0; k < n; ++k) {
+    const double z = 1.0 - 2.0 * u(rng), r = std::sqrt(std::max(0.0, 1.0 - z * z)), phi = 2.0 * kPi * u(rng);
+    const Vec3 d(r * std::cos(phi), z, r * std::sin(phi));
+    integral += sky.pdf(d) * 4.0 * kPi / n;
+    flux_uniform += luminance(sky.radiance(d)) * 4.0 * kPi / n;
+    // ... the drawn pixel's pdf is the pdf of its direction, and importance sampling is unbiased.
+    const Environment::Sample s = sky.sample(u(rng), u(rng));
+    const Environment::Sample l = sky.lookup(s.d);
+    EXPECT_NEAR(s.pdf, l.pdf, 1e-9 * l.pdf + 1e-12);
+    flux_sampled += luminance(s.radiance) / s.pdf / n;
+  }
+  EXPECT_NEAR(integral, 1.0, 0.01);
+  EXPECT_NEAR(flux_sampled, flux_uniform, 0.03 * flux_uniform);
+}
+
+}  // namespace
+}  // namespace facetfit

@@ -115,11 +115,20 @@ int Environment::pixel_of(const Vec3& d, int* x, int* y) const {
   return *y * width_ + *x;
 }
 
-Rgb Environment::radiance(const Vec3& d) const {
-  if (is_constant()) return constant_;
+Rgb Environment::radiance(const Vec3& d) const { return lookup(d).radiance; }
+
+Environment::Sample Environment::at_pixel(const Vec3& d, int pixel) const {
+  const float* p = rgb_.data() + std::size_t(pixel) * 3;
+  const double s = std::sqrt(std::max(0.0, 1.0 - d.y * d.y));
+  // Density over [0,1]^2 to solid angle: d(omega) = 2 pi^2 sin(theta) du dv.
+  const double pdf = s > 0.0 ? density_[std::size_t(pixel)] / (2.0 * kPi * kPi * s) : 0.0;
+  return {d, Rgb(p[0], p[1], p[2]), pdf};
+}
+
+Environment::Sample Environment::lookup(const Vec3& d) const {
+  if (is_constant()) return {d, constant_, 1.0 / (4.0 * kPi)};
   int x, y;
-  const float* p = rgb_.data() + std::size_t(pixel_of(d, &x, &y)) * 3;
-  return {p[0], p[1], p[2]};
+  return at_pixel(d, pixel_of(d, &x, &y));
 }
 
 Environment::Sample Environment::sample(double u1, double u2) const {
@@ -138,17 +147,9 @@ Environment::Sample Environment::sample(double u1, double u2) const {
   const int y = pick(row_cdf_.data(), height_, u1, &tv);
   const int x = pick(col_cdf_.data() + std::size_t(y) * (width_ + 1), width_, u2, &tu);
   const double u = (x + tu) / width_, v = (y + tv) / height_;
-  const Vec3 d = direction_of(u, v);
-  return {d, radiance(d), pdf(d)};
+  return at_pixel(direction_of(u, v), y * width_ + x);  // the pixel drawn: no second lookup
 }
 
-double Environment::pdf(const Vec3& d) const {
-  if (is_constant()) return 1.0 / (4.0 * kPi);
-  const double s = std::sqrt(std::max(0.0, 1.0 - d.y * d.y));
-  if (s <= 0.0) return 0.0;
-  int x, y;
-  // Density over [0,1]^2 to solid angle: d(omega) = 2 pi^2 sin(theta) du dv.
-  return density_[std::size_t(pixel_of(d, &x, &y))] / (2.0 * kPi * kPi * s);
-}
+double Environment::pdf(const Vec3& d) const { return lookup(d).pdf; }
 
 }  // namespace facetfit

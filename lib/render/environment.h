@@ -29,6 +29,8 @@ class Environment {
     Rgb radiance;
     double pdf;  // per steradian
   };
+  // Radiance and pdf of a direction with one pixel lookup (the d of the result is d).
+  Sample lookup(const Vec3& d) const;
   Sample sample(double u1, double u2) const;
   double pdf(const Vec3& d) const;
   bool is_constant() const { return width_ == 0; }
@@ -39,6 +41,7 @@ class Environment {
  private:
   void build_distribution();
   int pixel_of(const Vec3& d, int* x, int* y) const;
+  Sample at_pixel(const Vec3& d, int pixel) const;
 
   int width_ = 0, height_ = 0;  // 0: constant
   Rgb constant_{0.0};

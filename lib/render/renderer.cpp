@@ -228,8 +228,8 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
       if (const auto bs = model.sample(o, u[2], u[3], u[4])) {
         const Vec3 d = frame.to_world(bs->i);
         if (!occluded(origin, d, std::numeric_limits<float>::infinity())) {
-          const double w = power_heuristic(bs->pdf, env->pdf(d));
-          sum += bs->weight * env->radiance(d) * w;
+          const Environment::Sample e = env->lookup(d);
+          sum += bs->weight * e.radiance * power_heuristic(bs->pdf, e.pdf);
         }
       }
     }
