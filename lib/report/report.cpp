@@ -249,8 +249,7 @@ json run_report(const ReportOptions& o) {
           MaterialDesc m;
           m.type = type;
           m.file = file;
-          const RenderedImage img = render(report_scene(m, o));
-          return img;
+          return render(report_scene(m, o));
         };
         const RenderedImage measured = render_as("measured", source);
         entry["seconds"]["render"]["measured"] = measured.seconds;
