@@ -3,11 +3,12 @@
 #   make test   install what is missing, build, run every test (and the unit and stress tests under ASan+UBSan)
 
 BUILD      ?= build/release
+BPY_VENV   ?= build/bpy-venv
 ASAN_BUILD ?= build/asan
 JOBS       ?= $(shell nproc)
 CMAKE_GEN  := -G Ninja
 
-.PHONY: all deps build demo test asan bench accuracy clean
+.PHONY: all deps build demo test asan osl-host osl-docs bench accuracy clean
 
 all: build
 
@@ -15,7 +16,8 @@ deps:
 	@scripts/install-deps.sh
 
 build: deps
-	@cmake -S . -B $(BUILD) $(CMAKE_GEN) -DCMAKE_BUILD_TYPE=Release -DFACETFIT_WERROR=ON >/dev/null
+	@cmake -S . -B $(BUILD) $(CMAKE_GEN) -DCMAKE_BUILD_TYPE=Release -DFACETFIT_WERROR=ON \
+	  -DFACETFIT_BPY_PYTHON=$(CURDIR)/$(BPY_VENV)/bin/python >/dev/null
 	@cmake --build $(BUILD) -j $(JOBS)
 
 demo: build
@@ -30,10 +32,18 @@ asan: deps
 	  -DFACETFIT_BUILD_TOOLS=OFF -DFACETFIT_WERROR=ON >/dev/null
 	@cmake --build $(ASAN_BUILD) -j $(JOBS) --target facetfit_unit_tests facetfit_stress_tests
 
-test: build asan
+# Blender's bpy wheel (Cycles with OSL) in a venv: the host of the OSL tests (label osl).
+osl-host:
+	@scripts/setup-bpy.sh $(BPY_VENV) >/dev/null
+
+test: build asan osl-host
 	cd $(BUILD) && ctest --output-on-failure -j $(JOBS)
 	cd $(ASAN_BUILD) && ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1 \
 	  ctest --output-on-failure -j $(JOBS) -L 'unit|stress'
+
+# Regenerates the pictures and figures of docs/osl.md (the OSL sphere tests, in Cycles).
+osl-docs: build osl-host
+	FACETFIT_OSL_PICTURES=$(CURDIR)/docs/images/osl $(BUILD)/tests/facetfit_osl_tests --gtest_filter='OslSphere*'
 
 # Regenerates docs/benchmarks.md (Google Benchmark, this machine).
 bench: build

@@ -48,10 +48,82 @@ FacetfitLut facetfit_open(string file) {
   return lut;
 }
 
+// ---- accurate angles ----
+// OSL renderers may compile acos, atan2, sin and cos to fast approximations (Cycles' OSL: acos off by up
+// to 9e-5 rad, cos by 6e-6), too coarse for the grid near the normal, where the first interval spans
+// 1.9e-4 rad. These use only +, *, / and sqrt; they agree with the C++ library's double maths to float
+// precision (tests/test_osl.cpp).
+
+// atan(x) for x in [0, 1]: Abramowitz & Stegun 4.4.49, |error| <= 2e-8.
+float facetfit_atan_unit(float x) {
+  float x2 = x * x;
+  float p = 0.0028662257;
+  p = p * x2 - 0.0161657367;
+  p = p * x2 + 0.0429096138;
+  p = p * x2 - 0.0752896400;
+  p = p * x2 + 0.1065626393;
+  p = p * x2 - 0.1420889944;
+  p = p * x2 + 0.1999355085;
+  p = p * x2 - 0.3333314528;
+  return x * (1.0 + p * x2);
+}
+
+// The angle in [0, pi] of the point (c, s), s >= 0: atan2(s, c).
+float facetfit_angle(float s, float c) {
+  if (s <= 0.0 && c <= 0.0) return c < 0.0 ? FACETFIT_PI : 0.0;
+  float a = abs(c) >= s ? facetfit_atan_unit(s / abs(c)) : 0.5 * FACETFIT_PI - facetfit_atan_unit(abs(c) / s);
+  return c >= 0.0 ? a : FACETFIT_PI - a;
+}
+
+// Polar angle of a direction from +z (the normal).
+float facetfit_theta(vector w) { return facetfit_angle(sqrt(w[0] * w[0] + w[1] * w[1]), w[2]); }
+
+// acos(x): Abramowitz & Stegun 4.4.46 on [0, 1], |error| <= 2e-8, mirrored for x < 0.
+float facetfit_acos(float x_in) {
+  float x = clamp(abs(x_in), 0.0, 1.0);
+  float p = -0.0012624911;
+  p = p * x + 0.0066700901;
+  p = p * x - 0.0170881256;
+  p = p * x + 0.0308918810;
+  p = p * x - 0.0501743046;
+  p = p * x + 0.0889789874;
+  p = p * x - 0.2145988016;
+  p = p * x + 1.5707963050;
+  float a = sqrt(1.0 - x) * p;
+  return x_in >= 0.0 ? a : FACETFIT_PI - a;
+}
+
+// Azimuth in (-pi, pi] of (x, y).
+float facetfit_azimuth(float x, float y) {
+  float a = facetfit_angle(abs(y), x);
+  return y >= 0.0 ? a : -a;
+}
+
+// sin and cos of x in [-2 pi, 2 pi]: reduced to [-pi/4, pi/4] by quarter turns, then Taylor series to
+// x^11 and x^12 (error below 1e-11 before float rounding).
+void facetfit_sincos(float x, output float s, output float c) {
+  float k = floor(x / (0.5 * FACETFIT_PI) + 0.5);
+  float r = x - k * (0.5 * FACETFIT_PI), r2 = r * r;
+  float sr = r * (1.0 + r2 * (-1.0 / 6.0 + r2 * (1.0 / 120.0 + r2 * (-1.0 / 5040.0 + r2 * (1.0 / 362880.0 - r2 / 39916800.0)))));
+  float cr = 1.0 + r2 * (-0.5 + r2 * (1.0 / 24.0 + r2 * (-1.0 / 720.0 + r2 * (1.0 / 40320.0 + r2 * (-1.0 / 3628800.0 + r2 / 479001600.0)))));
+  int q = int(k) % 4;
+  if (q < 0) q += 4;
+  s = q == 0 ? sr : (q == 1 ? cr : (q == 2 ? -sr : -cr));
+  c = q == 0 ? cr : (q == 1 ? -sr : (q == 2 ? -cr : sr));
+}
+
+// 1 - cos(theta) = 2 sin^2(theta / 2) for theta in [0, pi/2], without cancellation near 0 (Taylor series
+// of sin to x^11: error below 1e-11 for x <= pi/4).
+float facetfit_one_minus_cos(float theta) {
+  float x = 0.5 * theta, x2 = x * x;
+  float s = x * (1.0 + x2 * (-1.0 / 6.0 + x2 * (1.0 / 120.0 + x2 * (-1.0 / 5040.0 + x2 * (1.0 / 362880.0 - x2 / 39916800.0)))));
+  return 2.0 * s * s;
+}
+
 // The value stored at texel x of a row (the R channel), exactly: a lookup at the texel's centre.
 float facetfit_texel(FacetfitLut lut, int row, int x) {
   float s = (x + 0.5) / lut.width, t = (row + 0.5) / lut.height;
-  return texture(lut.file, s, t, "interp", "linear", "wrap", "clamp");
+  return texture(lut.file, s, t, "interp", "linear", "wrap", "clamp", "width", 0.0);
 }
 
 // The uniform Catmull-Rom spline in u through the nodes of a row, at theta; ghost nodes as in
@@ -75,16 +147,17 @@ float facetfit_spline(FacetfitLut lut, int row, float theta) {
          w3 * facetfit_texel(lut, row, i3);
 }
 
-float facetfit_D(FacetfitLut lut, float cos_h) {
-  if (cos_h <= 0.0) return 0.0;
-  return max(0.0, facetfit_spline(lut, FACETFIT_NDF_ROW, acos(min(cos_h, 1.0))));
+// D of a unit half vector h.
+float facetfit_D(FacetfitLut lut, vector h) {
+  if (h[2] <= 0.0) return 0.0;
+  return max(0.0, facetfit_spline(lut, FACETFIT_NDF_ROW, facetfit_theta(h)));
 }
 
-// Smith masking G1 = cos / sigma.
-float facetfit_G1(FacetfitLut lut, float cos_w) {
-  if (cos_w <= 0.0) return 0.0;
-  float s = facetfit_spline(lut, FACETFIT_SIGMA_ROW, acos(min(cos_w, 1.0)));
-  return s > cos_w ? cos_w / s : 1.0;
+// Smith masking G1 = cos / sigma of a unit direction w.
+float facetfit_G1(FacetfitLut lut, vector w) {
+  if (w[2] <= 0.0) return 0.0;
+  float s = facetfit_spline(lut, FACETFIT_SIGMA_ROW, facetfit_theta(w));
+  return s > w[2] ? w[2] / s : 1.0;
 }
 
 float facetfit_G2(FacetfitLut lut, float g1_i, float g1_o) {
@@ -95,39 +168,42 @@ float facetfit_G2(FacetfitLut lut, float g1_i, float g1_o) {
 }
 
 // The RGB Fresnel curve: 90 texels at theta_d = x degrees, linear between them, constant past 89.
-color facetfit_fresnel(FacetfitLut lut, float cos_d) {
-  float x = clamp(acos(clamp(cos_d, 0.0, 1.0)) / (0.5 * FACETFIT_PI) * 90.0, 0.0, 89.0);
+color facetfit_fresnel(FacetfitLut lut, float theta_d) {
+  float x = clamp(theta_d / (0.5 * FACETFIT_PI) * 90.0, 0.0, 89.0);
   float s = (x + 0.5) / lut.width, t = (FACETFIT_FRESNEL_ROW + 0.5) / lut.height;
-  return texture(lut.file, s, t, "interp", "linear", "wrap", "clamp");
+  return texture(lut.file, s, t, "interp", "linear", "wrap", "clamp", "width", 0.0);
 }
 
 // f(i, o) in 1/sr.
 color facetfit_eval(FacetfitLut lut, vector i, vector o) {
   if (i[2] <= 0.0 || o[2] <= 0.0) return color(0);
   vector h = normalize(i + o);
-  float g2 = facetfit_G2(lut, facetfit_G1(lut, i[2]), facetfit_G1(lut, o[2]));
-  return facetfit_fresnel(lut, dot(i, h)) * (facetfit_D(lut, h[2]) * g2 / (4.0 * i[2] * o[2]));
+  float g2 = facetfit_G2(lut, facetfit_G1(lut, i), facetfit_G1(lut, o));
+  float theta_d = facetfit_angle(length(cross(i, h)), dot(i, h));
+  return facetfit_fresnel(lut, theta_d) * (facetfit_D(lut, h) * g2 / (4.0 * i[2] * o[2]));
 }
 
 // ---- sampling the visible normals (docs/sampling.md) ----
 
-// Interval j and fraction t of theta on the grid.
-void facetfit_locate(FacetfitLut lut, float cos_theta, output int j, output float t) {
-  float x = min(sqrt(acos(clamp(cos_theta, -1.0, 1.0)) / (0.5 * FACETFIT_PI)), 1.0) * lut.resolution;
+// Interval j and fraction t of the polar angle of w on the grid.
+void facetfit_locate(FacetfitLut lut, vector w, output int j, output float t) {
+  float x = min(sqrt(facetfit_theta(w) / (0.5 * FACETFIT_PI)), 1.0) * lut.resolution;
   j = min(int(floor(x)), lut.resolution - 1);
   t = x - j;
 }
 
-float facetfit_cos_node(FacetfitLut lut, int j) {
+// 1 - cos(theta_j) of grid node j: the sampling works in it, as cos itself has no float resolution left
+// near the normal.
+float facetfit_node_one_minus_cos(FacetfitLut lut, int j) {
   float u = float(j) / lut.resolution;
-  return cos(u * u * 0.5 * FACETFIT_PI);
+  return facetfit_one_minus_cos(u * u * 0.5 * FACETFIT_PI);
 }
 
 float facetfit_cdf(FacetfitLut lut, int slice, int node) { return facetfit_texel(lut, FACETFIT_SAMPLING_ROW + slice, node); }
 
 float facetfit_phi_integral(float a, float b) {
   if (a <= b) return 2.0 * FACETFIT_PI * b;
-  return 2.0 * (sqrt(a * a - b * b) + b * acos(-b / a));
+  return 2.0 * (sqrt(a * a - b * b) + b * facetfit_acos(-b / a));
 }
 
 // Density of the visible normals h seen from o, per steradian of h.
@@ -136,14 +212,14 @@ float facetfit_visible_normal_pdf(FacetfitLut lut, vector o, vector h) {
   if (o[2] <= 0.0 || h[2] <= 0.0 || oh <= 0.0 || !lut.sampling) return 0.0;
   int vj, nj;
   float vt, nt;
-  facetfit_locate(lut, o[2], vj, vt);
-  facetfit_locate(lut, h[2], nj, nt);
-  float band = facetfit_cos_node(lut, nj) - facetfit_cos_node(lut, nj + 1);
+  facetfit_locate(lut, o, vj, vt);
+  facetfit_locate(lut, h, nj, nt);
+  float band = facetfit_node_one_minus_cos(lut, nj + 1) - facetfit_node_one_minus_cos(lut, nj);
   if (band <= 0.0) return 0.0;
   float m0 = facetfit_cdf(lut, vj, nj + 1) - facetfit_cdf(lut, vj, nj);
   float m1 = facetfit_cdf(lut, vj + 1, nj + 1) - facetfit_cdf(lut, vj + 1, nj);
   float mass = (1.0 - vt) * m0 + vt * m1;
-  float sin_o = sqrt(max(0.0, 1.0 - o[2] * o[2])), sin_h = sqrt(max(0.0, 1.0 - h[2] * h[2]));
+  float sin_o = sqrt(o[0] * o[0] + o[1] * o[1]), sin_h = sqrt(h[0] * h[0] + h[1] * h[1]);
   float total = facetfit_phi_integral(sin_o * sin_h, o[2] * h[2]);
   return total > 0.0 ? mass / band * oh / total : 0.0;
 }
@@ -157,16 +233,19 @@ float facetfit_pdf(FacetfitLut lut, vector o, vector i) {
 
 // phi in (-pi, pi] with density proportional to max(0, a cos(phi) + b).
 float facetfit_sample_phi(float a, float b, float u_in) {
-  float phi_max = a <= b ? FACETFIT_PI : acos(-b / a);
+  float phi_max = a <= b ? FACETFIT_PI : facetfit_acos(-b / a);
   float sgn = u_in < 0.5 ? -1.0 : 1.0;
   float u = u_in < 0.5 ? 2.0 * u_in : 2.0 * u_in - 1.0;
-  float total = a * sin(phi_max) + b * phi_max;
+  // The CDF a sin(phi) + b phi at phi_max; sin(phi_max) = sqrt(1 - (b / a)^2) where a > b.
+  float total = a <= b ? b * phi_max : a * sqrt(max(0.0, 1.0 - (b / a) * (b / a))) + b * phi_max;
   if (total <= 0.0) return sgn * u * FACETFIT_PI;
   float target = u * total, lo = 0.0, hi = phi_max, phi = u * phi_max;
   for (int it = 0; it < 40; ++it) {
-    float f = a * sin(phi) + b * phi - target;
+    float sp, cp;
+    facetfit_sincos(phi, sp, cp);
+    float f = a * sp + b * phi - target;
     if (f > 0.0) hi = phi; else lo = phi;
-    float df = a * cos(phi) + b;
+    float df = a * cp + b;
     float next = df > 0.0 ? phi - f / df : 0.5 * (lo + hi);
     if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
     float step = abs(next - phi);
@@ -181,7 +260,7 @@ int facetfit_sample(FacetfitLut lut, vector o, float u1_in, float u2, output vec
   if (o[2] <= 0.0 || !lut.sampling) return 0;
   int vj;
   float vt;
-  facetfit_locate(lut, o[2], vj, vt);
+  facetfit_locate(lut, o, vj, vt);
   int slice = vj;
   float u1 = u1_in;
   if (u1 < 1.0 - vt) {
@@ -200,10 +279,14 @@ int facetfit_sample(FacetfitLut lut, vector o, float u1_in, float u2, output vec
   int j = lo;
   float c0 = facetfit_cdf(lut, slice, j), m = facetfit_cdf(lut, slice, j + 1) - c0;
   float frac = m > 0.0 ? clamp((u1 - c0) / m, 0.0, 1.0) : 0.5;
-  float cos_h = facetfit_cos_node(lut, j) - frac * (facetfit_cos_node(lut, j) - facetfit_cos_node(lut, j + 1));
-  float sin_h = sqrt(max(0.0, 1.0 - cos_h * cos_h)), sin_o = sqrt(max(0.0, 1.0 - o[2] * o[2]));
-  float phi = facetfit_sample_phi(sin_o * sin_h, o[2] * cos_h, u2) + (sin_o > 0.0 ? atan2(o[1], o[0]) : 0.0);
-  vector h = vector(sin_h * cos(phi), sin_h * sin(phi), cos_h);
+  float om0 = facetfit_node_one_minus_cos(lut, j);
+  float om_h = om0 + frac * (facetfit_node_one_minus_cos(lut, j + 1) - om0);  // 1 - cos(theta_h)
+  float cos_h = 1.0 - om_h, sin_h = sqrt(max(0.0, om_h * (2.0 - om_h)));
+  float sin_o = sqrt(o[0] * o[0] + o[1] * o[1]);
+  float phi = facetfit_sample_phi(sin_o * sin_h, o[2] * cos_h, u2) + (sin_o > 0.0 ? facetfit_azimuth(o[0], o[1]) : 0.0);
+  float sin_phi, cos_phi;
+  facetfit_sincos(phi, sin_phi, cos_phi);
+  vector h = vector(sin_h * cos_phi, sin_h * sin_phi, cos_h);
   i = 2.0 * dot(o, h) * h - o;
   if (i[2] <= 0.0) return 0;
   pdf = facetfit_pdf(lut, o, i);

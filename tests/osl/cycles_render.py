@@ -1,0 +1,135 @@
+"""Renders with Blender's Cycles (bpy wheel, OSL on the CPU) for tests/test_osl.cpp and docs/osl.md.
+
+    python cycles_render.py probe SHADER OUT.exr SIZE [NAME=VALUE ...]
+        An orthographic view of the plane [-1, 1]^2 at z = 0, SIZE x SIZE pixels, one sample per pixel at
+        its centre: each pixel shows the shader's emission at that pixel (tests/osl/facetfit_probe.osl).
+    python cycles_render.py sphere SHADER OUT.exr SIZE SPP ENV.exr [NAME=VALUE ...]
+        The reference renderer's default view (docs/scene-format.md) of a unit sphere shaded by SHADER
+        under the lat-long map ENV.exr, direct lighting, box pixel filter, transparent film.
+
+NAME=VALUE set the shader's parameters (ints, floats or strings, as the parameter's type). Output: float
+RGBA OpenEXR, scene-linear, no view transform.
+"""
+import glob
+import math
+import os
+import sys
+
+# OpenImageIO's module and oslquery, which script nodes need, ship inside bpy's own tree.
+sys.path += glob.glob(os.path.join(sys.prefix, "lib", "python3*", "site-packages", "bpy", "*", "python", "lib",
+                                   "python3*", "site-packages"))
+import bpy  # noqa: E402
+
+
+def new_scene(size, spp):
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    scene = bpy.context.scene
+    scene.render.engine = "CYCLES"
+    scene.cycles.device = "CPU"
+    scene.cycles.shading_system = True  # OSL
+    scene.cycles.samples = spp
+    scene.cycles.use_adaptive_sampling = False
+    scene.cycles.use_denoising = False
+    scene.cycles.max_bounces = 1  # direct lighting, as the reference renderer
+    scene.cycles.pixel_filter_type = "BOX"
+    scene.render.resolution_x = scene.render.resolution_y = size
+    scene.render.resolution_percentage = 100
+    scene.render.film_transparent = True
+    scene.view_settings.view_transform = "Standard"
+    scene.view_settings.look = "None"
+    scene.render.image_settings.file_format = "OPEN_EXR"
+    scene.render.image_settings.color_depth = "32"
+    scene.render.image_settings.color_mode = "RGBA"
+    return scene
+
+
+def script_material(shader, params):
+    material = bpy.data.materials.new("facetfit")
+    material.use_nodes = True
+    nodes = material.node_tree.nodes
+    nodes.clear()
+    script = nodes.new("ShaderNodeScript")
+    script.mode = "EXTERNAL"
+    script.filepath = os.path.abspath(shader)
+    script.update()
+    if not script.outputs:
+        sys.exit(f"{shader}: the script node has no outputs (the shader did not compile)")
+    for name, text in params.items():
+        if name not in script.inputs:
+            sys.exit(f"{shader}: no parameter '{name}' (has {[i.name for i in script.inputs]})")
+        socket = script.inputs[name]
+        value = socket.default_value
+        socket.default_value = type(value)(text) if isinstance(value, (int, float, str)) else text
+    out = nodes.new("ShaderNodeOutputMaterial")
+    material.node_tree.links.new(script.outputs[0], out.inputs["Surface"])
+    return material
+
+
+def render(scene, out):
+    scene.render.filepath = out
+    bpy.ops.render.render(write_still=True)
+    if not os.path.exists(out):
+        sys.exit(f"{out}: Cycles wrote no image")
+
+
+def probe(shader, out, size, params):
+    scene = new_scene(size, 1)
+    scene.cycles.filter_width = 0.01  # one sample at each pixel's centre, no neighbour bleeding in
+    bpy.ops.mesh.primitive_plane_add(size=2.0)
+    bpy.context.active_object.data.materials.append(script_material(shader, params))
+    bpy.ops.object.camera_add(location=(0, 0, 1), rotation=(0, 0, 0))
+    camera = bpy.context.active_object
+    camera.data.type = "ORTHO"
+    camera.data.ortho_scale = 2.0
+    scene.camera = camera
+    render(scene, out)
+
+
+def sphere(shader, out, size, spp, environment, params):
+    scene = new_scene(size, spp)
+    bpy.ops.mesh.primitive_uv_sphere_add(segments=256, ring_count=128, radius=1.0)
+    bpy.ops.object.shade_smooth()
+    bpy.context.active_object.data.materials.append(script_material(shader, params))
+    # Blender is z-up: facetfit's (x, y, z) is Blender's (x, z, -y) read backwards, i.e. Blender (x, y, z)
+    # = facetfit (x, -z, y). The camera at facetfit (0, 0.6, 4) looking at the origin.
+    bpy.ops.object.camera_add(location=(0, -4, 0.6))
+    camera = bpy.context.active_object
+    camera.rotation_euler = (-camera.location).to_track_quat("-Z", "Y").to_euler()
+    camera.data.sensor_fit = "VERTICAL"
+    camera.data.angle_y = math.radians(30)
+    scene.camera = camera
+    world = bpy.data.worlds.new("environment")
+    world.use_nodes = True
+    tree = world.node_tree
+    texture = tree.nodes.new("ShaderNodeTexEnvironment")
+    texture.image = bpy.data.images.load(os.path.abspath(environment))
+    texture.image.colorspace_settings.name = "Linear Rec.709"
+    texture.interpolation = "Closest"  # the reference renderer reads one pixel per direction
+    # Blender's lat-long u is atan2(y, -x) / 2 pi + 1/2, facetfit's (atan2(x, -z) + pi) / 2 pi in its own
+    # frame: the same map needs the lookup direction turned a quarter turn about z.
+    coords = tree.nodes.new("ShaderNodeTexCoord")
+    mapping = tree.nodes.new("ShaderNodeMapping")
+    mapping.vector_type = "VECTOR"
+    mapping.inputs["Rotation"].default_value = (0, 0, math.pi / 2)
+    tree.links.new(coords.outputs["Generated"], mapping.inputs["Vector"])
+    tree.links.new(mapping.outputs["Vector"], texture.inputs["Vector"])
+    tree.links.new(texture.outputs["Color"], tree.nodes["Background"].inputs["Color"])
+    scene.world = world
+    render(scene, out)
+
+
+def main(argv):
+    if len(argv) < 5:
+        sys.exit(__doc__)
+    command, shader, out, size = argv[1], argv[2], argv[3], int(argv[4])
+    rest = argv[5:]
+    if command == "probe":
+        probe(shader, out, size, dict(a.split("=", 1) for a in rest))
+    elif command == "sphere":
+        sphere(shader, out, size, int(rest[0]), rest[1], dict(a.split("=", 1) for a in rest[2:]))
+    else:
+        sys.exit(__doc__)
+
+
+if __name__ == "__main__":
+    main(sys.argv)
