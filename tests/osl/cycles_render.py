@@ -105,12 +105,12 @@ def sphere(shader, out, size, spp, environment, params):
     texture.image = bpy.data.images.load(os.path.abspath(environment))
     texture.image.colorspace_settings.name = "Linear Rec.709"
     texture.interpolation = "Closest"  # the reference renderer reads one pixel per direction
-    # Blender's lat-long u is atan2(y, -x) / 2 pi + 1/2, facetfit's (atan2(x, -z) + pi) / 2 pi in its own
-    # frame: the same map needs the lookup direction turned a quarter turn about z.
+    # Blender's lat-long u is 1/2 - atan2(y, x) / 2 pi; facetfit's, (atan2(x, -z) + pi) / 2 pi in its own
+    # frame, is that plus 1/4: the lookup direction turns a quarter turn clockwise about z.
     coords = tree.nodes.new("ShaderNodeTexCoord")
     mapping = tree.nodes.new("ShaderNodeMapping")
     mapping.vector_type = "VECTOR"
-    mapping.inputs["Rotation"].default_value = (0, 0, math.pi / 2)
+    mapping.inputs["Rotation"].default_value = (0, 0, -math.pi / 2)
     tree.links.new(coords.outputs["Generated"], mapping.inputs["Vector"])
     tree.links.new(mapping.outputs["Vector"], texture.inputs["Vector"])
     tree.links.new(texture.outputs["Color"], tree.nodes["Background"].inputs["Color"])
