@@ -257,6 +257,72 @@ TEST_F(RglSynthetic, CopiesShareTablesAndMovesWork) {
   EXPECT_EQ(*moved.eval(i, o), ref);
 }
 
+// A GGX material (alpha 0.5) whose ndf, sigma and vndf are tabulated as the acquisition does, at
+// theta = theta_of_u(u) on the node grid: with the format's theta = (pi/2) u^2 the tables agree with
+// each other under the reader's parameterization; with any other map, the reader sees them disagree,
+// as a reader with a wrong map would see the real files' tables.
+std::vector<TField> ggx_fields(double (*theta_of_u)(double), double jacobian_of_u(double)) {
+  constexpr double kAlpha = 0.5;
+  constexpr std::uint64_t kT = 65, kP = 33;  // theta columns, phi rows
+  const auto ggx = [](double th) {
+    const double c = std::cos(th), a2 = kAlpha * kAlpha, d = c * c * (a2 - 1.0) + 1.0;
+    return a2 / (kPi * d * d);
+  };
+  // Smith's projected area of GGX: cos (1 + Lambda) = (cos + sqrt(cos^2 + alpha^2 sin^2)) / 2.
+  const auto sigma = [](double th) {
+    const double c = std::max(0.0, std::cos(th)), s = std::sin(th);
+    return 0.5 * (c + std::sqrt(c * c + kAlpha * kAlpha * s * s));
+  };
+  std::vector<float> ndf, sig, vndf;
+  for (std::uint64_t y = 0; y < 2; ++y)
+    for (std::uint64_t x = 0; x < kT; ++x) {
+      const double th = theta_of_u(double(x) / double(kT - 1));
+      ndf.push_back(float(ggx(th)));
+      sig.push_back(float(sigma(th)));
+    }
+  for (const float theta_i : kSynthThetaI) {
+    const Vec3 i = spherical_direction(double(theta_i), 0.0);
+    for (std::uint64_t y = 0; y < kP; ++y)
+      for (std::uint64_t x = 0; x < kT; ++x) {
+        const double u = double(x) / double(kT - 1), th = theta_of_u(u);
+        const Vec3 m = spherical_direction(th, (2.0 * double(y) / double(kP - 1) - 1.0) * kPi);
+        vndf.push_back(float(jacobian_of_u(u) * ggx(th) * std::max(0.0, glm::dot(i, m)) / sigma(double(theta_i))));
+      }
+  }
+  std::vector<TField> fields = synthetic_fields();
+  field(fields, "ndf") = f32("ndf", {2, kT}, ndf);
+  field(fields, "sigma") = f32("sigma", {2, kT}, sig);
+  field(fields, "vndf") = f32("vndf", {1, kSynthThetaI.size(), kP, kT}, vndf);
+  return fields;
+}
+
+double theta_sqrt(double u) { return 0.5 * kPi * u * u; }
+double jacobian_sqrt(double u) { return 2.0 * kPi * kPi * u * std::sin(theta_sqrt(u)); }  // d(omega) / du
+double theta_linear(double u) { return 0.5 * kPi * u; }
+double jacobian_linear(double u) { return kPi * kPi * std::sin(theta_linear(u)); }
+
+TEST_F(RglSynthetic, SelfConsistencySeesAParameterizationMismatch) {
+  const RglBsdf::Consistency good =
+      RglBsdf::read(write("ggx.bsdf", serialize(ggx_fields(theta_sqrt, jacobian_sqrt)))).self_consistency();
+  EXPECT_LT(good.sigma_error, 2e-3);
+  EXPECT_LT(good.vndf_error, 1e-5);
+
+  // The same material tabulated with theta linear in u: what a reader mapping theta -> u linearly
+  // would make of the database files. Both checks flag it.
+  const RglBsdf::Consistency linear =
+      RglBsdf::read(write("linear.bsdf", serialize(ggx_fields(theta_linear, jacobian_linear)))).self_consistency();
+  EXPECT_GT(linear.sigma_error, 0.05);
+  EXPECT_GT(linear.vndf_error, 0.05);
+
+  // The closed-form material's tables are arbitrary: sigma = 1 is not the projected area of D = 1/pi.
+  const RglBsdf::Consistency arbitrary = RglBsdf::read(write("synthetic.bsdf", serialize(synthetic_fields()))).self_consistency();
+  std::printf("[ consistency ] sigma / vndf errors: GGX %.1e / %.1e, theta linear in u %.2f / %.2f, arbitrary %.2f / %.2f\n",
+              good.sigma_error, good.vndf_error, linear.sigma_error, linear.vndf_error, arbitrary.sigma_error,
+              arbitrary.vndf_error);
+  EXPECT_GT(arbitrary.sigma_error, 0.05);
+  EXPECT_GT(arbitrary.vndf_error, 0.05);
+}
+
 // ---------------------------------------------------------------------------------------------
 // Synthetic files: validation
 
@@ -459,6 +525,25 @@ TEST(RglReal, MeasuredNdfIntegratesToOne) {
     EXPECT_NEAR(integral, 1.0, 1e-4);
     EXPECT_NEAR(b.measured_ndf_stored_integral(), 1.0, 0.02);
     EXPECT_GT(b.measured_ndf(0.0), 0.0);
+  }
+}
+
+// The acquisition computes `sigma` and `vndf` from its `ndf`; under the reader's parameterization
+// (theta -> u = sqrt(theta / (pi/2)), phi from the slice's plane, node-centred grids, theta along
+// the last axis) they must agree. A wrong theta map makes sigma disagree by ~40%, texel centres
+// instead of nodes by ~5%, and phi measured from 0 instead of -pi puts the VNDF on the wrong side.
+TEST(RglReal, TablesAreSelfConsistent) {
+  REQUIRE_RGL_DATA();
+  for (const RealFile& f : kRealFiles) {
+    SCOPED_TRACE(f.name);
+    const RglBsdf b = RglBsdf::read(real_path(f));
+    const RglBsdf::Consistency c = b.self_consistency();
+    std::printf("[ consistency ] %-28s sigma from ndf vs sigma field %.1e, vndf vs D max(0, i.m) %.1e\n", f.name,
+                c.sigma_error, c.vndf_error);
+    EXPECT_LT(c.sigma_error, 2e-3);
+    EXPECT_LT(c.vndf_error, 1e-5);
+    EXPECT_NEAR(b.measured_sigma(0.0), 1.0, 1e-6);
+    EXPECT_EQ(b.slice_elevations().size(), 8u);
   }
 }
 

@@ -276,6 +276,28 @@ double elevation(const Vec3& d) {
   return 2.0 * std::asin(std::min(1.0, 0.5 * chord));
 }
 
+// Linear interpolation of values on the nodes of a uniform grid over [0, 1].
+double lerp_nodes(const std::vector<double>& v, double u) {
+  const Segment s = uniform_segment(u, v.size());
+  return (1.0 - s.t) * v[s.k] + s.t * v[s.k + 1];
+}
+
+// Mean over the rows of a grid (the phi axis) of the bilinear interpolant: the trapezoid rule.
+std::vector<double> phi_average(const Grid& g) {
+  std::vector<double> out(g.nx, 0.0);
+  for (std::size_t y = 0; y < g.ny; ++y) {
+    const double w = (y == 0 || y + 1 == g.ny ? 0.5 : 1.0) / double(g.ny - 1);
+    for (std::size_t x = 0; x < g.nx; ++x) out[x] += w * g.v[y * g.nx + x];
+  }
+  return out;
+}
+
+// integral over phi in [0, 2 pi) of max(0, a cos(phi) + b), for a >= 0.
+double positive_cosine_over_phi(double a, double b) {
+  if (a <= std::abs(b)) return b > 0.0 ? 2.0 * kPi * b : 0.0;
+  return 2.0 * (std::sqrt(a * a - b * b) + b * std::acos(-b / a));
+}
+
 // Five-point Gauss-Legendre rule on [-1, 1].
 constexpr double kGaussX[5] = {-0.9061798459386640, -0.5384693101056831, 0.0, 0.5384693101056831, 0.9061798459386640};
 constexpr double kGaussW[5] = {0.2369268850561891, 0.4786286704993665, 0.5688888888888889, 0.4786286704993665,
@@ -344,8 +366,9 @@ struct RglBsdf::Tables {
   std::size_t rx = 0, ry = 0;
   std::vector<double> rgb;
 
-  std::vector<double> ndf_iso;  // D averaged over u_phi, at the nx nodes of u_theta
-  double ndf_integral = 0.0;    // integral D cos d(omega) of ndf_iso
+  std::vector<double> ndf_iso;    // D averaged over u_phi, at the nx nodes of u_theta
+  double ndf_integral = 0.0;      // integral D cos d(omega) of ndf_iso
+  std::vector<double> sigma_iso;  // sigma averaged over u_phi, at the nx nodes of u_theta
 
   std::array<double, 2> invert_vndf(const SliceBlend& b, double u0, double u1) const;
 };
@@ -464,13 +487,10 @@ RglBsdf RglBsdf::read(const std::string& path) {
   in.check(jac.count == 1, "field 'jacobian' has shape " + dims(jac) + ", expected 1");
   t->jacobian = in.data(jac)[0] != 0;
 
-  // Phi-averaged NDF: the mean of the bilinear interpolant over u_phi is the trapezoid rule over rows.
+  // Phi-averaged NDF and sigma: the mean of the bilinear interpolant over u_phi is the trapezoid rule over rows.
   const Grid& g = t->ndf;
-  t->ndf_iso.assign(g.nx, 0.0);
-  for (std::size_t y = 0; y < g.ny; ++y) {
-    const double w = (y == 0 || y + 1 == g.ny ? 0.5 : 1.0) / double(g.ny - 1);
-    for (std::size_t x = 0; x < g.nx; ++x) t->ndf_iso[x] += w * g.v[y * g.nx + x];
-  }
+  t->ndf_iso = phi_average(g);
+  t->sigma_iso = phi_average(t->sigma);
   // integral D cos d(omega) = 2 pi int_0^1 D(u) cos(theta) sin(theta) (d theta / du) du, theta = (pi/2) u^2.
   double integral = 0.0;
   const double du = 1.0 / double(g.nx - 1);
@@ -491,9 +511,70 @@ RglBsdf RglBsdf::read(const std::string& path) {
 
 double RglBsdf::measured_ndf(double theta) const {
   if (!(theta >= 0.0 && theta <= 0.5 * kPi)) return 0.0;
-  const Segment s = uniform_segment(theta_to_u(theta), t_->ndf_iso.size());
-  const double d = (1.0 - s.t) * t_->ndf_iso[s.k] + s.t * t_->ndf_iso[s.k + 1];
-  return d / t_->ndf_integral;
+  return lerp_nodes(t_->ndf_iso, theta_to_u(theta)) / t_->ndf_integral;
+}
+
+double RglBsdf::measured_sigma(double theta) const {
+  if (!(theta >= 0.0 && theta <= 0.5 * kPi)) return 0.0;
+  return lerp_nodes(t_->sigma_iso, theta_to_u(theta));
+}
+
+const std::vector<double>& RglBsdf::slice_elevations() const { return t_->theta_i; }
+
+RglBsdf::Consistency RglBsdf::self_consistency() const {
+  const Tables& t = *t_;
+  Consistency c;
+
+  // sigma(theta_k) = integral max(0, k.h) D(h) dw_h of the normalized, phi-averaged ndf. The phi
+  // integral is closed-form; theta runs through u (theta = (pi/2) u^2, d theta = pi u du) with a
+  // Gauss rule on quarters of each ndf interval, where D is linear in u.
+  const std::size_t intervals = 4 * (t.ndf_iso.size() - 1);
+  const double du = 1.0 / double(intervals);
+  const std::size_t nodes = t.sigma_iso.size();
+  for (std::size_t j = 0; j < nodes; ++j) {
+    const double u_k = double(j) / double(nodes - 1);
+    const double theta_k = 0.5 * kPi * u_k * u_k;
+    double sigma = 0.0;
+    for (std::size_t x = 0; x < intervals; ++x)
+      for (int q = 0; q < 5; ++q) {
+        const double u = (double(x) + 0.5 * (1.0 + kGaussX[q])) * du;
+        const double theta = 0.5 * kPi * u * u;
+        const double phi_integral =
+            positive_cosine_over_phi(std::sin(theta_k) * std::sin(theta), std::cos(theta_k) * std::cos(theta));
+        sigma += 0.5 * du * kGaussW[q] * lerp_nodes(t.ndf_iso, u) * phi_integral * std::sin(theta) * kPi * u;
+      }
+    sigma /= t.ndf_integral;
+    c.sigma_error = std::max(c.sigma_error, std::abs(sigma - t.sigma_iso[j]) / t.sigma_iso[j]);
+  }
+
+  // The VNDF of slice theta_i over (u_theta, u_phi) of the half vector m, phi measured from the
+  // slice's plane: D(m) max(0, i.m) / sigma(i) d(omega)/d(u) with d(omega) = 2 pi^2 u_theta sin(theta_m) du.
+  // Constant factors cancel in the normalization, so the model is D(m) max(0, i.m) u_theta sin(theta_m).
+  const std::size_t slice = t.vx * t.vy;
+  std::vector<double> model(slice);
+  for (std::size_t s = 0; s < t.theta_i.size(); ++s) {
+    const Vec3 i = spherical_direction(t.theta_i[s], 0.0);
+    double model_total = 0.0, table_total = 0.0;
+    for (std::size_t y = 0; y < t.vy; ++y)
+      for (std::size_t x = 0; x < t.vx; ++x) {
+        const double u0 = double(x) / double(t.vx - 1), u1 = double(y) / double(t.vy - 1);
+        const double theta_m = 0.5 * kPi * u0 * u0;
+        const Vec3 m = spherical_direction(theta_m, (2.0 * u1 - 1.0) * kPi);
+        const double v = lerp_nodes(t.ndf_iso, u0) * std::max(0.0, glm::dot(i, m)) * u0 * std::sin(theta_m);
+        model[y * t.vx + x] = v;
+        model_total += v;
+        table_total += t.vndf_pdf[s * slice + y * t.vx + x];
+      }
+    if (!(model_total > 0.0)) {
+      c.vndf_error = 1.0;
+      continue;
+    }
+    double tv = 0.0;
+    for (std::size_t k = 0; k < slice; ++k)
+      tv += std::abs(t.vndf_pdf[s * slice + k] / table_total - model[k] / model_total);
+    c.vndf_error = std::max(c.vndf_error, 0.5 * tv);
+  }
+  return c;
 }
 
 Rgb RglBsdf::table_value(const Vec3& p, const Vec3& q) const {

@@ -14,12 +14,19 @@
 // eval as "f_r * cos"; the data agree: dividing by the other cosine instead breaks reciprocity by
 // ~90%, and the white paper's albedo comes out 0.82 at normal incidence, f = 0.28/sr).
 //
+// This parameterization is checked against the files themselves: the acquisition derives `sigma`
+// and `vndf` from `ndf`, and under the maps above (node-centred grids, theta along the last axis)
+// they agree to 5e-4 and 1e-7 on the database files (self_consistency). The retro-reflection in the
+// `rgb` table, however, does not reproduce `ndf` through the 2015 power iteration (docs/accuracy.md):
+// the acquisition measured `ndf` separately, and the files do not say how.
+//
 // Only isotropic files (phi_i with a single entry) are supported. Negative (out-of-gamut) RGB values
 // of the colour-converted spectra are clipped to zero, as powitacq_rgb does.
 #pragma once
 
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "core/brdf.h"
 
@@ -57,6 +64,32 @@ class RglBsdf final : public Brdf {
 
   // integral D cos(theta) d(omega) of the stored `ndf` table before that renormalization.
   double measured_ndf_stored_integral() const;
+
+  // The file's `sigma` field at elevation theta, phi-averaged: the projected area
+  // integral max(0, k.h) D(h) dw_h of the NDF, which the acquisition computed from its `ndf` and
+  // scaled to sigma(0) = 1, i.e. the sigma of measured_ndf (self_consistency checks it). Zero outside
+  // [0, pi/2].
+  double measured_sigma(double theta) const;
+
+  // The incident elevations theta_i of the file's slices, increasing. Only at these angles does the
+  // RGB table hold a measurement of a given configuration; in between, eval blends two slices.
+  const std::vector<double>& slice_elevations() const;
+
+  // How well the file's tables agree with each other under this reader's parameterization (the
+  // theta -> u = sqrt(theta / (pi/2)) and phi -> (phi - phi_i + pi) / 2pi maps, node-centred grids,
+  // theta along the last axis). The acquisition derives `sigma` and `vndf` from `ndf`, so a reader
+  // that maps any of these axes wrongly sees them disagree; on the database files both errors are
+  // below 1e-3. These checks cannot see the RGB table, which the acquisition measured separately.
+  struct Consistency {
+    // Largest relative difference, over the nodes of `sigma`, between the field and
+    // integral max(0, k.h) measured_ndf(h) dw_h computed here.
+    double sigma_error = 0.0;
+    // Largest total-variation distance, over the theta_i slices, between the `vndf` table and
+    // D(m) max(0, i.m) sin(theta_m) u_theta (the visible normals times the Jacobian of the unit
+    // square), both normalized over the same nodes; 0 is identical, 1 disjoint.
+    double vndf_error = 0.0;
+  };
+  Consistency self_consistency() const;
 
   // The `jacobian` flag: whether the RGB table is to be multiplied by ndf / (4 sigma).
   bool jacobian() const;
