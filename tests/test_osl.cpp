@@ -340,7 +340,7 @@ INSTANTIATE_TEST_SUITE_P(Materials, OslModel,
 
 // Small renders with many samples: the comparison is of means over pixels, and Monte Carlo noise in
 // either image adds to Delta E (the pictures of make osl-docs are larger).
-int sphere_size() { return std::getenv("FACETFIT_OSL_PICTURES") ? 160 : 64; }
+int sphere_size() { return std::getenv("FACETFIT_OSL_PICTURES") ? 96 : 64; }
 
 // The environment of the sphere tests: a lat-long map in the reference renderer's convention (row 0 at
 // the zenith, u = (atan2(x, -z) + pi) / 2 pi, +y up), smooth enough that the preview shader's BRDF
