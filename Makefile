@@ -43,6 +43,7 @@ test: build asan osl-host
 
 # Regenerates the pictures and figures of docs/osl.md (the OSL sphere tests, in Cycles).
 osl-docs: build osl-host
+	rm -f docs/images/osl/figures.md
 	FACETFIT_OSL_PICTURES=$(CURDIR)/docs/images/osl $(BUILD)/tests/facetfit_osl_tests --gtest_filter='OslSphere*'
 
 # Regenerates docs/benchmarks.md (Google Benchmark, this machine).
