@@ -26,24 +26,33 @@ struct FacetfitLut {
   int ok;
 };
 
-// Opens a LUT: its size and metadata. ok = 0 when the file is missing or is not a facetfit LUT.
+// The Smith model (0 masking, 1 correlated, 2 separable) of a LUT: the integer attribute, or the string
+// one for renderers that read strings (Cycles' OSL returns string attributes empty); -1 when neither says.
+int facetfit_smith_code(string file) {
+  int code = -1;
+  if (gettextureinfo(file, "facetfit:smith_code", code)) return code;
+  string smith = "";
+  gettextureinfo(file, "facetfit:smith", smith);
+  return smith == "masking" ? 0 : (smith == "correlated" ? 1 : (smith == "separable" ? 2 : -1));
+}
+
+// Opens a LUT: its size and metadata. ok = 0 when the file is missing, is not a facetfit LUT, or does
+// not say its Smith model in a way this renderer can read.
 FacetfitLut facetfit_open(string file) {
   FacetfitLut lut;
   lut.file = file;
   lut.ok = 0;
   int res[2] = {0, 0};
   int version = 0, resolution = 0, sampling = 0;
-  string smith = "";
   if (gettextureinfo(file, "resolution", res) && gettextureinfo(file, "facetfit:format_version", version) &&
-      gettextureinfo(file, "facetfit:resolution", resolution) && gettextureinfo(file, "facetfit:smith", smith) &&
-      version == 1) {
+      gettextureinfo(file, "facetfit:resolution", resolution) && version == 1) {
     gettextureinfo(file, "facetfit:sampling", sampling);
     lut.width = res[0];
     lut.height = res[1];
     lut.resolution = resolution;
     lut.sampling = sampling;
-    lut.smith = smith == "masking" ? 0 : (smith == "separable" ? 2 : 1);
-    lut.ok = 1;
+    lut.smith = facetfit_smith_code(file);
+    lut.ok = lut.smith >= 0 && lut.smith <= 2;
   }
   return lut;
 }

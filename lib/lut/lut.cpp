@@ -31,6 +31,26 @@ std::optional<Rgb> get_color(const ImageSpec& spec, const char* name) {
   return Rgb(v[0], v[1], v[2]);
 }
 
+// Integer codes of the metadata choices, fixed by the LUT format (docs/lut-format.md), for readers that
+// cannot read string attributes.
+int smith_code(Smith s) {
+  switch (s) {
+    case Smith::masking: return 0;
+    case Smith::correlated: return 1;
+    case Smith::separable: return 2;
+  }
+  return -1;
+}
+
+int representation_code(Representation r) {
+  switch (r) {
+    case Representation::tabulated: return 0;
+    case Representation::ggx: return 1;
+    case Representation::beckmann: return 2;
+  }
+  return -1;
+}
+
 }  // namespace
 
 const char* to_string(Representation r) {
@@ -117,6 +137,9 @@ void write_lut(const std::string& path, const Lut& lut) {
   spec.attribute(key("ndf_error_ggx"), float(m.ndf_error_ggx));
   spec.attribute(key("ndf_error_beckmann"), float(m.ndf_error_beckmann));
   spec.attribute(key("representation"), to_string(m.representation));
+  // The same two choices as integers: Cycles' OSL (1.14) returns string attributes as empty strings.
+  spec.attribute(key("smith_code"), smith_code(m.smith));
+  spec.attribute(key("representation_code"), representation_code(m.representation));
   spec.attribute(key("tolerance"), float(m.tolerance));
   spec.attribute(key("sampling"), m.sampling ? 1 : 0);
 
@@ -145,6 +168,10 @@ Lut read_lut(const std::string& path) {
     fail(path, "facetfit LUT with missing or invalid metadata");
   m.smith = *smith;
   m.representation = *representation;
+  // The integer codes, where present (LUTs of facetfit 0.1.0 before they were added have none), must agree.
+  if (spec.get_int_attribute(key("smith_code"), smith_code(m.smith)) != smith_code(m.smith) ||
+      spec.get_int_attribute(key("representation_code"), representation_code(m.representation)) != representation_code(m.representation))
+    fail(path, "facetfit LUT whose smith_code or representation_code contradicts its smith or representation");
   m.f0 = *f0;
   m.f82 = *f82;
   m.iterations = spec.get_int_attribute(key("iterations"));
