@@ -129,6 +129,20 @@ TEST(Lut, BadFilesGetOneClearLine) {
   const std::string cut = error_of([&] { read_lut(dir.file("cut.exr")); });
   EXPECT_NE(cut.find("cut.exr: "), std::string::npos) << cut;
   EXPECT_EQ(cut.find('\n'), std::string::npos) << cut;
+  // The integer code of the Smith model contradicting its name (OSL shaders read the code).
+  {
+    auto in = OIIO::ImageInput::open(dir.file("good.exr"));
+    ASSERT_TRUE(in);
+    OIIO::ImageSpec spec = in->spec();
+    std::vector<float> px(std::size_t(spec.width) * std::size_t(spec.height) * std::size_t(spec.nchannels));
+    ASSERT_TRUE(in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, px.data()));
+    EXPECT_EQ(spec.get_int_attribute("facetfit:smith_code", -1), 1);  // correlated
+    spec.attribute("facetfit:smith_code", 0);
+    auto out = OIIO::ImageOutput::create(dir.file("contradicts.exr"));
+    ASSERT_TRUE(out->open(dir.file("contradicts.exr"), spec) && out->write_image(OIIO::TypeDesc::FLOAT, px.data()) && out->close());
+  }
+  EXPECT_NE(error_of([&] { read_lut(dir.file("contradicts.exr")); }).find("contradicts.exr: facetfit LUT whose smith_code"),
+            std::string::npos);
 }
 
 }  // namespace
