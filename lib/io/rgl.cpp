@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "core/error.h"
+#include "fit/quadrature.h"
 
 namespace facetfit {
 
@@ -292,16 +293,11 @@ std::vector<double> phi_average(const Grid& g) {
   return out;
 }
 
-// integral over phi in [0, 2 pi) of max(0, a cos(phi) + b), for a >= 0.
-double positive_cosine_over_phi(double a, double b) {
-  if (a <= std::abs(b)) return b > 0.0 ? 2.0 * kPi * b : 0.0;
-  return 2.0 * (std::sqrt(a * a - b * b) + b * std::acos(-b / a));
-}
-
-// Five-point Gauss-Legendre rule on [-1, 1].
-constexpr double kGaussX[5] = {-0.9061798459386640, -0.5384693101056831, 0.0, 0.5384693101056831, 0.9061798459386640};
-constexpr double kGaussW[5] = {0.2369268850561891, 0.4786286704993665, 0.5688888888888889, 0.4786286704993665,
-                               0.2369268850561891};
+// A five-point Gauss-Legendre rule on [0, 1]: nodes x, weights w.
+struct GaussRule {
+  std::vector<double> x, w;
+  GaussRule() { gauss_legendre(5, x, w); }
+};
 
 // Linear blend of two theta_i slices, as Mitsuba's conditioned Marginal2D interpolates every table
 // (density and CDFs alike) between the bracketing parameter values; clamped outside them.
@@ -494,13 +490,14 @@ RglBsdf RglBsdf::read(const std::string& path) {
   // integral D cos d(omega) = 2 pi int_0^1 D(u) cos(theta) sin(theta) (d theta / du) du, theta = (pi/2) u^2.
   double integral = 0.0;
   const double du = 1.0 / double(g.nx - 1);
+  const GaussRule gauss;
   for (std::size_t x = 0; x + 1 < g.nx; ++x) {
-    for (int q = 0; q < 5; ++q) {
-      const double s = 0.5 * (1.0 + kGaussX[q]);
+    for (std::size_t q = 0; q < gauss.x.size(); ++q) {
+      const double s = gauss.x[q];
       const double u = (double(x) + s) * du;
       const double theta = 0.5 * kPi * u * u;
       const double d = (1.0 - s) * t->ndf_iso[x] + s * t->ndf_iso[x + 1];
-      integral += 0.5 * du * kGaussW[q] * d * std::cos(theta) * std::sin(theta) * kPi * u;
+      integral += du * gauss.w[q] * d * std::cos(theta) * std::sin(theta) * kPi * u;
     }
   }
   t->ndf_integral = 2.0 * kPi * integral;
@@ -531,17 +528,18 @@ RglBsdf::Consistency RglBsdf::self_consistency() const {
   const std::size_t intervals = 4 * (t.ndf_iso.size() - 1);
   const double du = 1.0 / double(intervals);
   const std::size_t nodes = t.sigma_iso.size();
+  const GaussRule gauss;
   for (std::size_t j = 0; j < nodes; ++j) {
     const double u_k = double(j) / double(nodes - 1);
     const double theta_k = 0.5 * kPi * u_k * u_k;
     double sigma = 0.0;
     for (std::size_t x = 0; x < intervals; ++x)
-      for (int q = 0; q < 5; ++q) {
-        const double u = (double(x) + 0.5 * (1.0 + kGaussX[q])) * du;
+      for (std::size_t q = 0; q < gauss.x.size(); ++q) {
+        const double u = (double(x) + gauss.x[q]) * du;
         const double theta = 0.5 * kPi * u * u;
         const double phi_integral =
-            positive_cosine_over_phi(std::sin(theta_k) * std::sin(theta), std::cos(theta_k) * std::cos(theta));
-        sigma += 0.5 * du * kGaussW[q] * lerp_nodes(t.ndf_iso, u) * phi_integral * std::sin(theta) * kPi * u;
+            positive_phi_integral(std::sin(theta_k) * std::sin(theta), std::cos(theta_k) * std::cos(theta));
+        sigma += du * gauss.w[q] * lerp_nodes(t.ndf_iso, u) * phi_integral * std::sin(theta) * kPi * u;
       }
     sigma /= t.ndf_integral;
     c.sigma_error = std::max(c.sigma_error, std::abs(sigma - t.sigma_iso[j]) / t.sigma_iso[j]);
