@@ -26,15 +26,20 @@ struct FacetfitLut {
   int ok;
 };
 
-// The Smith model (0 masking, 1 correlated, 2 separable) of a LUT: the integer attribute, or the string
-// one for renderers that read strings (Cycles' OSL returns string attributes empty); -1 when neither says.
-int facetfit_smith_code(string file) {
+// The LUT's Smith model (0 masking, 1 correlated, 2 separable) and recommended representation (0
+// tabulated, 1 ggx, 2 beckmann): the integer attributes, or the string ones for renderers that read
+// strings (Cycles' OSL returns string attributes empty; LUTs before the integers have only strings); -1
+// when neither says.
+int facetfit_code(string file, string attribute, string name0, string name1, string name2) {
   int code = -1;
-  if (gettextureinfo(file, "facetfit:smith_code", code)) return code;
-  string smith = "";
-  gettextureinfo(file, "facetfit:smith", smith);
-  return smith == "masking" ? 0 : (smith == "correlated" ? 1 : (smith == "separable" ? 2 : -1));
+  if (gettextureinfo(file, concat("facetfit:", attribute, "_code"), code)) return code;
+  string name = "";
+  gettextureinfo(file, concat("facetfit:", attribute), name);
+  return name == name0 ? 0 : (name == name1 ? 1 : (name == name2 ? 2 : -1));
 }
+
+int facetfit_smith_code(string file) { return facetfit_code(file, "smith", "masking", "correlated", "separable"); }
+int facetfit_representation_code(string file) { return facetfit_code(file, "representation", "tabulated", "ggx", "beckmann"); }
 
 // Opens a LUT: its size and metadata. ok = 0 when the file is missing, is not a facetfit LUT, or does
 // not say its Smith model in a way this renderer can read.
@@ -121,11 +126,10 @@ void facetfit_sincos(float x, output float s, output float c) {
   c = q == 0 ? cr : (q == 1 ? -sr : (q == 2 ? -cr : sr));
 }
 
-// 1 - cos(theta) = 2 sin^2(theta / 2) for theta in [0, pi/2], without cancellation near 0 (Taylor series
-// of sin to x^11: error below 1e-11 for x <= pi/4).
+// 1 - cos(theta) = 2 sin^2(theta / 2) for theta in [0, pi/2], without cancellation near 0.
 float facetfit_one_minus_cos(float theta) {
-  float x = 0.5 * theta, x2 = x * x;
-  float s = x * (1.0 + x2 * (-1.0 / 6.0 + x2 * (1.0 / 120.0 + x2 * (-1.0 / 5040.0 + x2 * (1.0 / 362880.0 - x2 / 39916800.0)))));
+  float s, c;
+  facetfit_sincos(0.5 * theta, s, c);
   return 2.0 * s * s;
 }
 
