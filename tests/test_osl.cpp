@@ -80,12 +80,17 @@ void write_vectors(const std::string& path, int size, const std::vector<Vec3>& v
 
 Vec3 as_float(const Vec3& v) { return {double(float(v.x)), double(float(v.y)), double(float(v.z))}; }
 
+// Compiles every .osl of `folder` into `out` with Cycles' compiler (scripts/osl_compile.py).
+RunResult osl_compile(const std::string& folder, const std::string& out) {
+  return python(quoted(kSource + "/scripts/osl_compile.py") + " " + quoted(folder) + " " + quoted(out));
+}
+
 // Compiles the shaders of osl/ and tests/osl/ into `dir`. The renders load these .oso files: a script
 // node given a .osl compiles it into a temporary file of Blender's own, which concurrent test processes
 // would share.
 void compile_shaders(const TempDir& dir) {
   for (const std::string folder : {"/osl", "/tests/osl"}) {
-    const RunResult r = python(quoted(kSource + "/scripts/osl_compile.py") + " " + quoted(kSource + folder) + " " + dir.path().string());
+    const RunResult r = osl_compile(kSource + folder, dir.path().string());
     ASSERT_EQ(r.status, 0) << r.out << r.err;
   }
 }
@@ -94,7 +99,7 @@ void compile_shaders(const TempDir& dir) {
 
 TEST(OslCompile, EveryShaderCompiles) {
   TempDir out;
-  const RunResult r = python(quoted(kSource + "/scripts/osl_compile.py") + " " + quoted(kSource + "/osl") + " " + out.path().string());
+  const RunResult r = osl_compile(kSource + "/osl", out.path().string());
   ASSERT_EQ(r.status, 0) << r.out << r.err;
   int shaders = 0;
   for (const auto& e : std::filesystem::directory_iterator(kSource + "/osl")) {
@@ -105,7 +110,7 @@ TEST(OslCompile, EveryShaderCompiles) {
   }
   EXPECT_GE(shaders, 2);
   // The test probe too: it includes facetfit.h from its own folder.
-  const RunResult probe = python(quoted(kSource + "/scripts/osl_compile.py") + " " + quoted(kSource + "/tests/osl") + " " + out.path().string());
+  const RunResult probe = osl_compile(kSource + "/tests/osl", out.path().string());
   EXPECT_EQ(probe.status, 0) << probe.out << probe.err;
 }
 
@@ -116,7 +121,7 @@ TEST(OslCompile, BrokenShaderFailsWithTheCompilersMessage) {
                     "shader broken(output color c = 0) {\n"
                     "  c = facetfit_no_such_function(1.0);\n"
                     "}\n");
-  const RunResult r = python(quoted(kSource + "/scripts/osl_compile.py") + " " + dir.path().string() + " " + dir.path().string());
+  const RunResult r = osl_compile(dir.path().string(), dir.path().string());
   EXPECT_EQ(r.status, 1) << r.out << r.err;
   EXPECT_NE(r.out.find("FAILED   " + dir.file("broken.osl")), std::string::npos) << r.out;
   // The compiler's own line: file, line number, and what is wrong.
@@ -428,13 +433,8 @@ std::string pictures_dir() {
   return dir && *dir ? dir : "";
 }
 
-struct Comparison {
-  ImageDiff diff;
-  double cycles_seconds = 0.0, reference_seconds = 0.0;
-};
-
 class OslSphere : public ::testing::Test {
- public:
+ public:  // the comparison helper below the class uses the renders
   static void SetUpTestSuite() {
     work_ = new TempDir;
     compile_shaders(*work_);
@@ -452,7 +452,7 @@ class OslSphere : public ::testing::Test {
   }
 
   // The reference renderer: the default view of a unit sphere of `material` (scene-format JSON) under
-  // the test environment, kSphereSize^2, `spp` samples per pixel.
+  // the test environment, sphere_size()^2, `spp` samples per pixel.
   static std::string reference(const std::string& name, const nlohmann::json& material, int spp, double* seconds) {
     const nlohmann::json scene = {
         {"camera", {{"position", {0, 0.6, 4}}, {"look_at", {0, 0, 0}}, {"up", {0, 1, 0}}, {"fov", 30}, {"width", sphere_size()}, {"height", sphere_size()}}},
@@ -504,7 +504,7 @@ class OslSphere : public ::testing::Test {
     return d;
   }
 
-  // One line of docs/osl.md's figures (make osl-docs), appended to FIGURES.md in the pictures folder.
+  // One line of docs/osl.md's figures (make osl-docs), appended to figures.md in the pictures folder.
   static void record(const std::string& line) {
     if (const std::string dir = pictures_dir(); !dir.empty()) std::ofstream(dir + "/figures.md", std::ios::app) << line << "\n";
   }
@@ -513,51 +513,48 @@ class OslSphere : public ::testing::Test {
 };
 TempDir* OslSphere::work_ = nullptr;
 
-// The preview shader integrates the sky against the tabulated model with facetfit.h's sampling; the
-// reference renderer renders the same LUT's tabulated model with its C++ implementation.
+// One comparison: `material` rendered by the reference renderer (`reference_material`, a scene-format
+// material, at `reference_spp`) and by Cycles through `shader` (`cycles_spp` samples per pixel, shader
+// parameters `params`); the mean Delta E 2000 must stay below the 1.0. `what` names the
+// comparison in the log and in docs/osl.md's figures.
+void check_sphere(const std::string& material, const std::string& what, const nlohmann::json& reference_material, int reference_spp,
+                  const std::string& shader, int cycles_spp, const std::string& params) {
+  double ref_s = 0.0, cyc_s = 0.0;
+  const std::string name = shader + "-" + material;
+  const std::string ref = OslSphere::reference("reference-" + name, reference_material, reference_spp, &ref_s);
+  const std::string cyc = OslSphere::cycles_sphere("cycles-" + name, shader, cycles_spp, params, &cyc_s);
+  const ImageDiff d = OslSphere::compare(ref, cyc, shader.substr(shader.find('_') + 1) + "-" + material);
+  EXPECT_LT(d.mean, 1.0) << material << ": max " << d.max;
+  std::cout << material << ", " << what << ": mean Delta E " << d.mean << ", max " << d.max << " over " << d.pixels << " pixels; Cycles "
+            << cyc_s << " s, reference " << ref_s << " s (" << reference_spp << " spp)\n";
+  OslSphere::record("| " + material + " | " + what + " | " + std::to_string(d.mean) + " | " + std::to_string(d.max) + " | " +
+                    std::to_string(cyc_s) + " |");
+}
+
+// The preview shader integrates the environment against the tabulated model with facetfit.h's sampling;
+// the reference renderer renders the same LUT's tabulated model with its C++ implementation. Both images
+// carry Monte Carlo noise, which Delta E adds up pixel by pixel, hence the sample counts.
 TEST_F(OslSphere, PreviewShaderMatchesReferenceTabulated) {
+  constexpr int kPasses = 8, kSamples = 64;  // Cycles samples per pixel x the shader's own samples
   for (const std::string material : {"gold-ggx-0.15", "silver-ggx-0.60", "copper-beckmann-0.30"}) {
     const std::string lut = bake(material);
-    double ref_s = 0.0, cyc_s = 0.0;
-    const std::string ref = reference("ref-tab-" + material, {{"type", "lut"}, {"file", lut}}, 4096, &ref_s);
-    const std::string cyc = cycles_sphere("cycles-preview-" + material, "facetfit_preview", 8,
-                                          "lut=" + lut + " environment_map=" + work_->file("sky.exr") + " samples=64", &cyc_s);
-    const ImageDiff d = compare(ref, cyc, "preview-" + material);
-    // Both images carry Monte Carlo noise, which Delta E adds up pixel by pixel (two reference renders at
-    // 1024 spp differ by 0.77 on silver): hence 4096 spp and 8 x 256 preview samples, at 64 x 64.
-    EXPECT_LT(d.mean, 1.0) << material << ": max " << d.max;
-    std::cout << material << ": preview shader in Cycles against the reference tabulated render: mean Delta E " << d.mean
-              << ", max " << d.max << " over " << d.pixels << " pixels; Cycles " << cyc_s << " s, reference " << ref_s << " s\n";
-    record("| " + material + " | preview (tabulated, 8 x 256 samples) | " + std::to_string(d.mean) + " | " + std::to_string(d.max) +
-           " | " + std::to_string(cyc_s) + " |");
+    check_sphere(material, "preview (tabulated, " + std::to_string(kPasses) + " x " + std::to_string(kSamples) + " samples)",
+                 {{"type", "lut"}, {"file", lut}}, 4096, "facetfit_preview", kPasses,
+                 "lut=" + lut + " environment_map=" + work_->file("sky.exr") + " samples=" + std::to_string(kSamples));
   }
 }
 
 // The material shader hands the fitted alpha and F82-tint Fresnel to Cycles' own microfacet closure;
 // the reference renderer renders the same parametric model (the LUT's alpha, F82 from its f0 and f82).
-void material_comparison(const std::string& material, double bar) {
-  const std::string lut = OslSphere::bake(material);
-  const Lut table = read_lut(lut);
-  const bool beckmann = table.meta.representation == Representation::beckmann;
-  double ref_s = 0.0, cyc_s = 0.0;
-  const std::string ref = OslSphere::reference("ref-param-" + material,
-                                               {{"type", beckmann ? "beckmann" : "ggx"}, {"file", lut}, {"fresnel", "f82"}}, 1024, &ref_s);
-  const std::string cyc = OslSphere::cycles_sphere("cycles-material-" + material, "facetfit_material", 512, "lut=" + lut, &cyc_s);
-  const ImageDiff d = OslSphere::compare(ref, cyc, "material-" + material);
-  EXPECT_LT(d.mean, bar) << material << ": max " << d.max;
-  std::cout << material << " (" << to_string(table.meta.representation) << "): material shader in Cycles against the reference "
-            << "parametric render: mean Delta E " << d.mean << ", max " << d.max << " over " << d.pixels << " pixels; Cycles " << cyc_s
-            << " s, reference " << ref_s << " s\n";
-  OslSphere::record("| " + material + " | material (" + to_string(table.meta.representation) + " closure, 512 spp) | " +
-                    std::to_string(d.mean) + " | " + std::to_string(d.max) + " | " + std::to_string(cyc_s) + " |");
-}
-
 TEST_F(OslSphere, MaterialShaderMatchesReferenceParametric) {
-  material_comparison("gold-ggx-0.15", 1.0);
-  material_comparison("silver-ggx-0.60", 1.0);
-  material_comparison("copper-beckmann-0.30", 1.0);  // the Beckmann closure
+  constexpr int kSpp = 512;
+  for (const std::string material : {"gold-ggx-0.15", "silver-ggx-0.60", "copper-beckmann-0.30"}) {
+    const std::string lut = bake(material);
+    const std::string family = to_string(read_lut(lut).meta.representation);  // ggx or beckmann for these
+    check_sphere(material, "material (" + family + " closure, " + std::to_string(kSpp) + " spp)",
+                 {{"type", family}, {"file", lut}, {"fresnel", "f82"}}, 1024, "facetfit_material", kSpp, "lut=" + lut);
+  }
 }
-
 
 }  // namespace
 }  // namespace facetfit
