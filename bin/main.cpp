@@ -18,7 +18,10 @@ void add_fit_settings(CLI::App* cmd, FitSettings& s) {
   cmd->add_option("--iteration-tolerance", s.iteration_tolerance, "Power-iteration stop: relative L1 change of the NDF")
       ->capture_default_str();
   cmd->add_option("--max-iterations", s.max_iterations, "Power-iteration limit")->capture_default_str();
-  cmd->add_flag("--refine", s.refine, "Refine both alphas by least squares against the tabulated NDF");
+  cmd->add_option("--refine", s.refine,
+                  "full: refine body, NDF and Fresnel, and fit GGX and Beckmann, on the whole measurement; "
+                  "none: the paper's method alone (power iteration on back-scattering, Fresnel pass, moment alphas)")
+      ->capture_default_str();
 }
 
 std::optional<FitOptions> fit_options(const FitSettings& s, int& status) {
@@ -33,7 +36,13 @@ std::optional<FitOptions> fit_options(const FitSettings& s, int& status) {
   options.resolution = s.resolution;
   options.tolerance = s.iteration_tolerance;
   options.max_iterations = s.max_iterations;
-  options.refine = s.refine;
+  const auto refine = parse_refine(s.refine);
+  if (!refine) {
+    report_error("--refine " + s.refine + ": must be none or full");
+    status = 2;
+    return std::nullopt;
+  }
+  options.refine = *refine;
   return options;
 }
 

@@ -8,6 +8,7 @@ find_package(GTest REQUIRED)
 if(FACETFIT_BUILD_TOOLS)
   find_package(benchmark REQUIRED)
 endif()
+find_package(Ceres REQUIRED)  # least-squares refinement of fits on the whole measurement
 find_package(OpenSSL REQUIRED)  # SHA-256 of sources (LUT metadata, bake cache)
 find_package(Imath CONFIG REQUIRED)
 find_package(OpenImageIO CONFIG REQUIRED)

@@ -22,7 +22,7 @@ MicrofacetTables fitted_tables(NdfType type, double alpha, const Fresnel& fresne
   options.smith = smith;
   const FitResult fit = Fitter(options).fit(MerlTable::tabulate(MicrofacetBrdf(Ndf::isotropic(type, alpha), smith, fresnel)));
   EXPECT_TRUE(fit.ok()) << fit.problem;
-  return {fit.ndf(), smith, fit.fresnel};
+  return {fit.ndf(), smith, fit.fresnel(), {}, {}};
 }
 
 Vec3 direction_at(double theta_deg, double phi = 0.3) { return spherical_direction(theta_deg * kPi / 180.0, phi); }

@@ -1,11 +1,19 @@
-// The whole fit of one measured isotropic material: NDF, sigma, RGB Fresnel, GGX and Beckmann alpha.
+// The whole fit of one measured isotropic material: body albedo, NDF, sigma, RGB Fresnel curve; GGX and
+// Beckmann fits; the classical baseline.
+//
+// Steps: the power iteration on back-scattering and the Fresnel pass (Dupuy et al. 2015: the paper's
+// method, `Refine::none`), then, by default, the refinement of body + tabulated lobe on the whole
+// measurement (fit/refine.h) and the parametric fits in the same metric (fit/parametric_fit.h).
 #pragma once
 
+#include <optional>
 #include <string>
 
 #include "fit/extract.h"
 #include "fit/fresnel_fit.h"
+#include "fit/parametric_fit.h"
 #include "fit/quadrature.h"
+#include "fit/refine.h"
 #include "io/merl.h"
 
 namespace facetfit {
@@ -15,21 +23,36 @@ struct FitOptions {
   Smith smith = Smith::correlated;
   double tolerance = 1e-10;
   int max_iterations = 1000;
-  bool refine = false;  // least-squares refinement of both alphas against the tabulated NDF
+  // full: refinement and parametric fits on the whole measurement (fit/refine.h), several seconds a
+  // material; none: the paper's method alone, milliseconds. The default stays none until full meets its
+  // time budget (issue 10).
+  enum class Refine { none, full };
+  Refine refine = Refine::none;
 };
 
+const char* to_string(FitOptions::Refine r);
+std::optional<FitOptions::Refine> parse_refine(const std::string& name);
+
 struct FitResult {
-  Extraction extraction;  // ndf, sigma, eigenvalue, iterations, residual
-  FresnelCurve fresnel;
-  double alpha_ggx = 0.0;
+  Extraction extraction;  // the power iteration: ndf, sigma, eigenvalue, iterations, residual
+  LobeFit lobe;           // body + tabulated lobe: the extraction's, refined unless Refine::none
+  double alpha_ggx = 0.0;       // moment estimates of the tabulated NDF (E|x~|, sqrt(2 E[x~^2]))
   double alpha_beckmann = 0.0;
-  Rgb f0{0.0};   // F(0)
+  Rgb f0{0.0};   // F(0) of the tabulated lobe's curve
   Rgb f82{0.0};  // F(acos(1/7)), for the F82-tint Fresnel model
+  // Parametric fits on the whole measurement (with Refine::none: the moment alphas, no body, f0 and
+  // f82 of the curve); lsq is the classical Lambert + GGX + Schlick baseline.
+  ParametricFit ggx, beckmann, lsq;
+  // Distance from the measurement (fit/measurement.h) of the paper's pure fit and of `lobe`.
+  double error_extraction = 0.0, error = 0.0;
   Smith smith = Smith::correlated;  // the model the NDF is consistent with
+  bool refined = false;             // Refine::full: body, parametric fits and errors are measured
   std::string problem;  // empty for a meaningful fit; otherwise why it is not one
 
   bool ok() const { return problem.empty(); }
-  const TabulatedNdf& ndf() const { return extraction.ndf; }
+  const TabulatedNdf& ndf() const { return lobe.ndf; }
+  const FresnelCurve& fresnel() const { return lobe.fresnel; }
+  const Rgb& body() const { return lobe.body; }
 };
 
 // f(k, k) per theta_h bin: the mean over phi_d of the theta_d = 0 bins (one configuration, stored 180

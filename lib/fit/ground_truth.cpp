@@ -37,7 +37,7 @@ GroundTruthError measure_ground_truth(const GroundTruthCase& c, const Fitter& fi
   for (int j = 0; j < FresnelCurve::kSize; ++j) {
     const double theta_d = FresnelCurve::theta_d(j);
     if (theta_d > 80.0 * kPi / 180.0 + 1e-9) break;
-    const Rgb d = glm::abs(fit.fresnel.value[std::size_t(j)] - c.fresnel.eval(std::cos(theta_d)));
+    const Rgb d = glm::abs(fit.fresnel().value[std::size_t(j)] - c.fresnel.eval(std::cos(theta_d)));
     e.fresnel_abs = std::max({e.fresnel_abs, d.r, d.g, d.b});
   }
   return e;

@@ -28,7 +28,7 @@ std::string bake_cache_key(const std::string& source_sha256, const BakeOptions& 
   k["smith"] = to_string(o.fit.smith);
   k["iteration_tolerance"] = o.fit.tolerance;
   k["max_iterations"] = o.fit.max_iterations;
-  k["refine"] = o.fit.refine;
+  k["refine"] = to_string(o.fit.refine);
   k["tolerance"] = o.tolerance;
   k["sampling"] = o.with_sampling;
   const std::string text = k.dump();

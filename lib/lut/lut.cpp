@@ -76,7 +76,7 @@ Lut make_lut(const FitResult& fit, const Quadrature& quadrature, const std::stri
              double tolerance, bool with_sampling) {
   if (!fit.ok()) fail(source, "no LUT for a meaningless fit: " + fit.problem);
   Lut lut;
-  lut.tables = {fit.ndf(), fit.smith, fit.fresnel};
+  lut.tables = {fit.ndf(), fit.smith, fit.fresnel(), fit.body(), fit.lobe.coat};
   if (with_sampling) lut.sampling = VisibleNormalTables::build(fit.ndf());
   LutMetadata& m = lut.meta;
   m.source = source;
@@ -89,12 +89,31 @@ Lut make_lut(const FitResult& fit, const Quadrature& quadrature, const std::stri
   m.alpha_beckmann = fit.alpha_beckmann;
   m.f0 = fit.f0;
   m.f82 = fit.f82;
-  m.ndf_error_ggx = ndf_distance(quadrature, fit.ndf(), Ndf::isotropic(NdfType::ggx, fit.alpha_ggx));
-  m.ndf_error_beckmann = ndf_distance(quadrature, fit.ndf(), Ndf::isotropic(NdfType::beckmann, fit.alpha_beckmann));
+  m.body = fit.body();
+  m.coat = fit.lobe.coat;
+  const auto parametric = [](const ParametricFit& p) { return LutMetadata::Parametric{p.alpha, p.body, p.f0, p.f82, p.coat}; };
+  m.ggx = parametric(fit.ggx);
+  m.beckmann = parametric(fit.beckmann);
+  m.lsq = parametric(fit.lsq);
+  m.error = fit.error;
+  m.error_ggx = fit.ggx.error;
+  m.error_beckmann = fit.beckmann.error;
+  m.error_lsq = fit.lsq.error;
+  m.error_extraction = fit.error_extraction;
+  m.ndf_error_ggx = ndf_distance(quadrature, fit.ndf(), Ndf::isotropic(NdfType::ggx, fit.ggx.alpha));
+  m.ndf_error_beckmann = ndf_distance(quadrature, fit.ndf(), Ndf::isotropic(NdfType::beckmann, fit.beckmann.alpha));
   m.tolerance = tolerance;
-  const bool ggx_better = m.ndf_error_ggx <= m.ndf_error_beckmann;
-  const double best = ggx_better ? m.ndf_error_ggx : m.ndf_error_beckmann;
-  m.representation = best <= tolerance ? (ggx_better ? Representation::ggx : Representation::beckmann) : Representation::tabulated;
+  // A parametric fit renders with the renderer's own closure: it is recommended when it is nearly as
+  // good. Refined fits compare distances from the measurement (the parametric one at most `tolerance`
+  // farther, relatively, than the tabulated one); the paper's fit compares NDFs (the parametric NDF
+  // within `tolerance` of the tabulated one).
+  const double error_ggx = fit.refined ? m.error_ggx : m.ndf_error_ggx;
+  const double error_beckmann = fit.refined ? m.error_beckmann : m.ndf_error_beckmann;
+  const double bar = fit.refined ? m.error * (1.0 + tolerance) : tolerance;
+  const bool ggx_better = error_ggx <= error_beckmann;
+  m.representation = std::min(error_ggx, error_beckmann) <= bar
+                         ? (ggx_better ? Representation::ggx : Representation::beckmann)
+                         : Representation::tabulated;
   m.sampling = with_sampling;
   return lut;
 }
@@ -141,6 +160,23 @@ void write_lut(const std::string& path, const Lut& lut) {
   spec.attribute(key("smith_code"), smith_code(m.smith));
   spec.attribute(key("representation_code"), representation_code(m.representation));
   spec.attribute(key("tolerance"), float(m.tolerance));
+  set_color(spec, "body", m.body);
+  spec.attribute(key("coat_alpha"), float(m.coat.alpha));
+  spec.attribute(key("coat_f0"), float(m.coat.f0));
+  for (const auto& [name, p] : {std::pair{"ggx", &m.ggx}, {"beckmann", &m.beckmann}, {"lsq", &m.lsq}}) {
+    const std::string n = name;
+    spec.attribute(key((n + "_alpha").c_str()), float(p->alpha));
+    spec.attribute(key((n + "_coat_alpha").c_str()), float(p->coat.alpha));
+    spec.attribute(key((n + "_coat_f0").c_str()), float(p->coat.f0));
+    set_color(spec, (n + "_body").c_str(), p->body);
+    set_color(spec, (n + "_f0").c_str(), p->f0);
+    set_color(spec, (n + "_f82").c_str(), p->f82);
+  }
+  spec.attribute(key("error"), float(m.error));
+  spec.attribute(key("error_ggx"), float(m.error_ggx));
+  spec.attribute(key("error_beckmann"), float(m.error_beckmann));
+  spec.attribute(key("error_lsq"), float(m.error_lsq));
+  spec.attribute(key("error_extraction"), float(m.error_extraction));
   spec.attribute(key("sampling"), m.sampling ? 1 : 0);
 
   write_image_atomic(path, spec, pixels.data());
@@ -151,8 +187,9 @@ Lut read_lut(const std::string& path) {
   const ImageSpec& spec = image->spec();
   const int version = spec.get_int_attribute(key("format_version"), -1);
   if (version < 0) fail(path, "not a facetfit LUT (no facetfit:format_version attribute)");
-  if (version != kLutFormatVersion)
-    fail(path, "LUT format version " + std::to_string(version) + "; this facetfit reads version " + std::to_string(kLutFormatVersion));
+  if (version != 1 && version != kLutFormatVersion)
+    fail(path, "LUT format version " + std::to_string(version) + "; this facetfit reads versions 1 and " +
+                   std::to_string(kLutFormatVersion));
 
   Lut lut;
   LutMetadata& m = lut.meta;
@@ -182,6 +219,30 @@ Lut read_lut(const std::string& path) {
   m.ndf_error_beckmann = spec.get_float_attribute(key("ndf_error_beckmann"));
   m.tolerance = spec.get_float_attribute(key("tolerance"));
   m.sampling = spec.get_int_attribute(key("sampling")) != 0;
+  if (version == 1) {  // no body; the parametric fits are the moment alphas with the curve's f0 and f82
+    m.ggx = {m.alpha_ggx, Rgb(0.0), m.f0, m.f82, {}};
+    m.beckmann = {m.alpha_beckmann, Rgb(0.0), m.f0, m.f82, {}};
+    m.lsq = m.ggx;
+  } else {
+    const auto body = get_color(spec, "body");
+    if (!body) fail(path, "facetfit LUT version 2 without facetfit:body");
+    m.body = *body;
+    m.coat = {spec.get_float_attribute(key("coat_alpha")), spec.get_float_attribute(key("coat_f0"))};
+    for (const auto& [name, p] : {std::pair{"ggx", &m.ggx}, {"beckmann", &m.beckmann}, {"lsq", &m.lsq}}) {
+      const std::string n = name;
+      const auto pb = get_color(spec, (n + "_body").c_str()), pf0 = get_color(spec, (n + "_f0").c_str()),
+                 pf82 = get_color(spec, (n + "_f82").c_str());
+      p->alpha = spec.get_float_attribute(key((n + "_alpha").c_str()), -1.0f);
+      if (!pb || !pf0 || !pf82 || !(p->alpha > 0.0)) fail(path, "facetfit LUT without a valid facetfit:" + n + "_* fit");
+      *p = {p->alpha, *pb, *pf0, *pf82,
+            {spec.get_float_attribute(key((n + "_coat_alpha").c_str())), spec.get_float_attribute(key((n + "_coat_f0").c_str()))}};
+    }
+    m.error = spec.get_float_attribute(key("error"));
+    m.error_ggx = spec.get_float_attribute(key("error_ggx"));
+    m.error_beckmann = spec.get_float_attribute(key("error_beckmann"));
+    m.error_lsq = spec.get_float_attribute(key("error_lsq"));
+    m.error_extraction = spec.get_float_attribute(key("error_extraction"));
+  }
 
   const LutLayout layout = LutLayout::of(m.resolution, m.sampling);
   if (spec.width != layout.width || spec.height != layout.height)
@@ -215,6 +276,8 @@ Lut read_lut(const std::string& path) {
     lut.tables.fresnel.value[std::size_t(x)] = Rgb(get(LutLayout::kFresnelRow, x, 0), get(LutLayout::kFresnelRow, x, 1),
                                                    get(LutLayout::kFresnelRow, x, 2));
   lut.tables.smith = m.smith;
+  lut.tables.body = m.body;
+  lut.tables.coat = m.coat;
   if (m.sampling) {
     lut.sampling.resolution = m.resolution;
     lut.sampling.cdf.resize(std::size_t(nodes) * nodes);

@@ -10,7 +10,9 @@
 
 namespace facetfit {
 
-constexpr int kLutFormatVersion = 1;
+// Version 2 adds the body and the parametric fits on the whole measurement; version 1 LUTs (no body)
+// still read, with a zero body.
+constexpr int kLutFormatVersion = 2;
 
 // Which model a renderer should use for this material.
 enum class Representation { tabulated, ggx, beckmann };
@@ -26,8 +28,20 @@ struct LutMetadata {
   Smith smith = Smith::correlated;
   int iterations = 0;
   double residual = 0.0;
-  double alpha_ggx = 0.0, alpha_beckmann = 0.0;
+  double alpha_ggx = 0.0, alpha_beckmann = 0.0;  // moment estimates of the tabulated NDF
   Rgb f0{0.0}, f82{0.0};
+  Rgb body{0.0};  // Lambertian albedo of the tabulated representation
+  // The parametric representations fitted on the whole measurement (alpha, body, F82-tint f0 and f82),
+  // and the classical baseline (Lambert + GGX + Schlick).
+  Coat coat;      // of the tabulated representation
+  struct Parametric {
+    double alpha = 0.0;
+    Rgb body{0.0}, f0{0.0}, f82{0.0};
+    Coat coat;
+  };
+  Parametric ggx, beckmann, lsq;
+  // Distance of each representation from the measurement (fit/measurement.h), and of the paper's pure fit.
+  double error = 0.0, error_ggx = 0.0, error_beckmann = 0.0, error_lsq = 0.0, error_extraction = 0.0;
   // Relative L1 distance (projected-area weighted) of each parametric NDF from the tabulated one.
   double ndf_error_ggx = 0.0, ndf_error_beckmann = 0.0;
   Representation representation = Representation::tabulated;

@@ -1,9 +1,11 @@
-// A parametric microfacet BRDF dressed with facetfit's fit: GGX or Beckmann alpha, and either the
-// measured RGB Fresnel curve or the F82-tint model from f0 and f82 (what renderers' closures take).
+// A parametric microfacet BRDF dressed with facetfit's fit: GGX or Beckmann alpha, either the measured
+// RGB Fresnel curve or the F82-tint model from f0 and f82 (what renderers' closures take), a body and
+// an optional coat.
 #pragma once
 
 #include "core/brdf.h"
 #include "fit/fresnel_fit.h"
+#include "model/coat.h"
 #include "model/ndf.h"
 #include "model/smith.h"
 
@@ -11,8 +13,11 @@ namespace facetfit {
 
 class ParametricBrdf final : public Brdf {
  public:
-  ParametricBrdf(const Ndf& ndf, Smith smith, const FresnelCurve& curve) : ndf_(ndf), smith_(smith), curve_(curve), use_curve_(true) {}
-  ParametricBrdf(const Ndf& ndf, Smith smith, const Rgb& f0, const Rgb& f82) : ndf_(ndf), smith_(smith), f0_(f0), f82_(f82) {}
+  // `body`: a Lambertian albedo added under the lobe.
+  ParametricBrdf(const Ndf& ndf, Smith smith, const FresnelCurve& curve, const Rgb& body = Rgb(0.0), const Coat& coat = {})
+      : ndf_(ndf), smith_(smith), curve_(curve), body_(body), coat_(coat), use_curve_(true) {}
+  ParametricBrdf(const Ndf& ndf, Smith smith, const Rgb& f0, const Rgb& f82, const Rgb& body = Rgb(0.0), const Coat& coat = {})
+      : ndf_(ndf), smith_(smith), f0_(f0), f82_(f82), body_(body), coat_(coat) {}
 
   std::optional<Rgb> eval(const Vec3& i, const Vec3& o) const override;
   const Ndf& ndf() const { return ndf_; }
@@ -22,6 +27,8 @@ class ParametricBrdf final : public Brdf {
   Smith smith_;
   FresnelCurve curve_;
   Rgb f0_{0.0}, f82_{0.0};
+  Rgb body_{0.0};
+  Coat coat_;
   bool use_curve_ = false;
 };
 

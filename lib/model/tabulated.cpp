@@ -70,7 +70,7 @@ std::optional<Rgb> TabulatedMicrofacet::eval(const Vec3& i, const Vec3& o) const
   if (i.z <= 0.0 || o.z <= 0.0) return Rgb(0.0);
   const Vec3 h = glm::normalize(i + o);
   const double g2 = smith_g2_from_g1(tables_.smith, g1(i), g1(o));
-  return fresnel(glm::dot(i, h)) * (D(h) * g2 / (4.0 * i.z * o.z));
+  return tables_.body * kInvPi + fresnel(glm::dot(i, h)) * (D(h) * g2 / (4.0 * i.z * o.z)) + Rgb(tables_.coat.eval(i, o));
 }
 
 namespace {

@@ -1,6 +1,6 @@
 // The tabulated microfacet BRDF: the fitted tables evaluated, importance-sampled and given a pdf.
 //
-//   f(i, o) = F(theta_d) D(h) G2(i, o) / (4 cos(theta_i) cos(theta_o))
+//   f(i, o) = body / pi + F(theta_d) D(h) G2(i, o) / (4 cos(theta_i) cos(theta_o)) + coat(i, o)
 //
 // with D and sigma (hence G1 = cos / sigma) splines on the theta grid, F the RGB Fresnel curve and G2
 // the Smith model the fit was made with. sample() draws the distribution of visible normals seen from
@@ -13,6 +13,7 @@
 #include "core/brdf.h"
 #include "fit/fresnel_fit.h"
 #include "fit/tabulated_ndf.h"
+#include "model/coat.h"
 #include "model/smith.h"
 
 namespace facetfit {
@@ -22,6 +23,8 @@ struct MicrofacetTables {
   TabulatedNdf ndf;
   Smith smith = Smith::correlated;
   FresnelCurve fresnel;
+  Rgb body{0.0};  // Lambertian albedo under the lobe
+  Coat coat;      // optional clear coat over it
 };
 
 // Tables for sampling visible normals. For each view slice s (theta_o at grid node s) and each u interval

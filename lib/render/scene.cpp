@@ -40,18 +40,18 @@ MaterialDesc parse_material(const std::string& name, const json& j, const std::s
   if (!j.is_object()) fail(path, "material " + name + " must be an object");
   MaterialDesc m;
   m.type = get<std::string>(j, "type", "", path);
-  if (m.type != "measured" && m.type != "lut" && m.type != "ggx" && m.type != "beckmann" && m.type != "lambert" &&
-      m.type != "analytic")
-    fail(path, "material " + name + ": type must be measured, lut, ggx, beckmann, lambert or analytic");
+  if (m.type != "measured" && m.type != "lut" && m.type != "ggx" && m.type != "beckmann" && m.type != "lsq" &&
+      m.type != "lambert" && m.type != "analytic")
+    fail(path, "material " + name + ": type must be measured, lut, ggx, beckmann, lsq, lambert or analytic");
   m.file = get<std::string>(j, "file", "", path);
-  if ((m.type == "measured" || m.type == "lut" || m.type == "analytic") && m.file.empty())
+  if ((m.type == "measured" || m.type == "lut" || m.type == "lsq" || m.type == "analytic") && m.file.empty())
     fail(path, "material " + name + " needs a \"file\"");
   m.alpha = get<double>(j, "alpha", 0.0, path);
   if ((m.type == "ggx" || m.type == "beckmann") && m.file.empty() && !(m.alpha > 0.0))
     fail(path, "material " + name + " needs \"alpha\" > 0 or a LUT \"file\"");
   if (j.contains("f0")) m.f0 = vec3(j["f0"], "f0", path);
   m.f82 = j.contains("f82") ? vec3(j["f82"], "f82", path) : m.f0;
-  m.fresnel = get<std::string>(j, "fresnel", m.file.empty() ? "f82" : "curve", path);
+  m.fresnel = get<std::string>(j, "fresnel", "f82", path);
   if (m.fresnel != "curve" && m.fresnel != "f82") fail(path, "material " + name + ": fresnel must be curve or f82");
   const auto smith = parse_smith(get<std::string>(j, "smith", "correlated", path));
   if (!smith) fail(path, "material " + name + ": smith must be masking, correlated or separable");
@@ -209,16 +209,19 @@ std::shared_ptr<const ShadingModel> load_material(const SceneDesc& scene, const 
     if (!builtin) fail(m.file, "analytic materials are built-ins (builtin:NAME)");
     std::shared_ptr<const TabulatedMicrofacet> proposal;
     if (const auto* mf = dynamic_cast<const MicrofacetBrdf*>(builtin->brdf.get()))
-      proposal = std::make_shared<TabulatedMicrofacet>(MicrofacetTables{tabulate_ndf(mf->ndf()), mf->smith(), {}});
+      proposal = std::make_shared<TabulatedMicrofacet>(MicrofacetTables{tabulate_ndf(mf->ndf()), mf->smith(), {}, {}, {}});
     return std::make_shared<ShadingModel>(builtin->brdf, proposal);
   }
   if (m.type == "measured") {
     // The measurement is what is rendered; its fit only proposes directions.
     auto table = std::make_shared<MerlTable>(load_table(resolve(scene, m.file)));
-    const Fitter fitter{FitOptions{}};
+    // The paper's fit alone: a proposal needs the lobe's shape, not the refinement's accuracy.
+    FitOptions proposal_fit;
+    proposal_fit.refine = FitOptions::Refine::none;
+    const Fitter fitter{proposal_fit};
     const FitResult fit = fitter.fit(*table);
     std::shared_ptr<const TabulatedMicrofacet> proposal;
-    if (fit.ok()) proposal = std::make_shared<TabulatedMicrofacet>(MicrofacetTables{fit.ndf(), fit.smith, fit.fresnel});
+    if (fit.ok()) proposal = std::make_shared<TabulatedMicrofacet>(MicrofacetTables{fit.ndf(), fit.smith, fit.fresnel(), {}, {}});
     return std::make_shared<ShadingModel>(table, proposal);
   }
   if (m.type == "lut") {
@@ -228,15 +231,18 @@ std::shared_ptr<const ShadingModel> load_material(const SceneDesc& scene, const 
       proposal = std::make_shared<TabulatedMicrofacet>(model->tables());
     return std::make_shared<ShadingModel>(model, proposal);
   }
-  // ggx | beckmann
-  const NdfType type = m.type == "ggx" ? NdfType::ggx : NdfType::beckmann;
+  // ggx | beckmann | lsq (the LUT's classical baseline: Lambert + GGX + Schlick)
+  const NdfType type = m.type == "beckmann" ? NdfType::beckmann : NdfType::ggx;
   std::shared_ptr<const Brdf> brdf;
   Ndf ndf;
   if (!m.file.empty()) {
+    // The LUT's fit of this family on the whole measurement: its alpha and body, with its own F82-tint
+    // Fresnel or the tabulated curve.
     const Lut lut = read_lut(resolve(scene, m.file));
-    ndf = Ndf::isotropic(type, type == NdfType::ggx ? lut.meta.alpha_ggx : lut.meta.alpha_beckmann);
-    brdf = m.fresnel == "curve" ? std::make_shared<ParametricBrdf>(ndf, m.smith, lut.tables.fresnel)
-                                : std::make_shared<ParametricBrdf>(ndf, m.smith, lut.meta.f0, lut.meta.f82);
+    const LutMetadata::Parametric& p = m.type == "lsq" ? lut.meta.lsq : type == NdfType::ggx ? lut.meta.ggx : lut.meta.beckmann;
+    ndf = Ndf::isotropic(type, p.alpha);
+    brdf = m.fresnel == "curve" ? std::make_shared<ParametricBrdf>(ndf, m.smith, lut.tables.fresnel, p.body, p.coat)
+                                : std::make_shared<ParametricBrdf>(ndf, m.smith, p.f0, p.f82, p.body, p.coat);
   } else {
     ndf = Ndf::isotropic(type, m.alpha);
     brdf = std::make_shared<ParametricBrdf>(ndf, m.smith, m.f0, m.f82);

@@ -34,7 +34,7 @@ struct LightDesc {
 };
 
 struct MaterialDesc {
-  // measured | lut | ggx | beckmann | lambert
+  // measured | lut | ggx | beckmann | lsq | lambert | analytic
   std::string type = "lambert";
   std::string file;       // measured: any facetfit input; lut: the LUT; ggx/beckmann: optional LUT to take alpha and Fresnel from
   double alpha = 0.0;     // ggx/beckmann without a LUT

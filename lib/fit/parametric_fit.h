@@ -1,0 +1,35 @@
+// Parametric fits on the whole measurement: body + one GGX or Beckmann lobe, in the log metric of
+// fit/measurement.h, from the moment estimates of the tabulated fit.
+//
+//   f(i, o) = body / pi + F(theta_d) D_alpha(h) G2_alpha(i, o) / (4 cos theta_i cos theta_o)
+//
+// Two Fresnel forms: `f82` (Hoffman's F82-tint from RGB f0 and f82, what renderers' closures take:
+// the ggx and beckmann representations) and `schlick` (RGB f0 only: the classical baseline `lsq`, a
+// Lambert + GGX + Schlick fit as users fit measured data today).
+#pragma once
+
+#include <string>
+
+#include "fit/measurement.h"
+#include "model/coat.h"
+#include "model/ndf.h"
+#include "model/smith.h"
+
+namespace facetfit {
+
+struct ParametricFit {
+  enum class FresnelForm { f82, schlick };
+  NdfType type = NdfType::ggx;
+  FresnelForm fresnel = FresnelForm::f82;
+  double alpha = 0.0;
+  Rgb body{0.0};
+  Rgb f0{0.0}, f82{0.0};  // f82 = Schlick(f0, 1/7) for the schlick form
+  Coat coat;              // fitted when the start has one (present()), else none
+  double error = 0.0;     // measurement_error of the fit
+};
+
+// Least squares from the start values (alpha > 0; body, f0, f82 in [0, 1]); with a coat in the start,
+// the coat's alpha and f0 too. max_iterations 0: the start as it is, with its error.
+ParametricFit fit_parametric(const MeasuredBins& bins, Smith smith, const ParametricFit& start, int max_iterations = 50);
+
+}  // namespace facetfit

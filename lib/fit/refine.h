@@ -1,0 +1,50 @@
+// Refinement of a fit on the whole measurement: body + tabulated microfacet lobe.
+//
+// The power iteration sees only back-scattering and a single lobe. Real materials also have a body
+// (subsurface, diffuse reflection) and noise, so starting from the extraction, every parameter is
+// refined against every bin the fit samples (fit/measurement.h), in that file's log metric:
+//
+//   f(i, o) = body / pi + F(theta_d) D(theta_h) G2(i, o) / (4 cos theta_i cos theta_o)
+//
+// with the NDF nodes D, the RGB Fresnel curve F and the RGB body albedo as unknowns, bounded below by
+// zero. G2 depends on every D node through sigma, densely, so it is held fixed within a pass (each bin
+// then depends on one D node, one Fresnel entry and the body: a sparse problem for Ceres'
+// Levenberg-Marquardt with sparse normal equations) and recomputed between passes. That fixed point is
+// not the joint optimum (docs/extraction.md): the caller keeps the start where it ends farther from the
+// measurement. The NDF keeps its normalization through a stiff residual, the Fresnel curve is kept
+// smooth by a small second-difference penalty.
+#pragma once
+
+#include "fit/fresnel_fit.h"
+#include "fit/measurement.h"
+#include "fit/quadrature.h"
+#include "fit/tabulated_ndf.h"
+#include "model/coat.h"
+#include "model/smith.h"
+
+namespace facetfit {
+
+// What a body + tabulated-lobe fit holds.
+struct LobeFit {
+  TabulatedNdf ndf;
+  FresnelCurve fresnel;
+  Rgb body{0.0};  // Lambertian albedo
+  Coat coat;      // held as it is by the refinement
+};
+
+struct RefineOptions {
+  int passes = 2;           // G2 recomputed from D between passes
+  int max_iterations = 15;  // Levenberg-Marquardt iterations per pass
+  double fresnel_smoothness = 1e-3;
+  int threads = 1;
+};
+
+// sigma(theta_j) of the NDF nodes (the projected-area integral), and the NDF renormalized to unit
+// projected area. Returns the area before renormalization.
+double normalize_ndf(TabulatedNdf& ndf, const Quadrature& quadrature);
+
+// Refines `start` (its ndf on `quadrature`'s grid) on `bins`; its coat, if any, is held.
+LobeFit refine_lobe(const MeasuredBins& bins, const Quadrature& quadrature, Smith smith, const LobeFit& start,
+                    const RefineOptions& options);
+
+}  // namespace facetfit
