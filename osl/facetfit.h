@@ -41,7 +41,8 @@ int facetfit_code(string file, string attribute, string name0, string name1, str
 int facetfit_smith_code(string file) { return facetfit_code(file, "smith", "masking", "correlated", "separable"); }
 int facetfit_representation_code(string file) { return facetfit_code(file, "representation", "tabulated", "ggx", "beckmann"); }
 
-// Opens a LUT: its size and metadata. ok = 0 when the file is missing, is not a facetfit LUT, or does
+// Opens a LUT (format 1 or 2; the body and coat of format 2, written by --refine full, are not read yet:
+// issue 10): its size and metadata. ok = 0 when the file is missing, is not a facetfit LUT, or does
 // not say its Smith model in a way this renderer can read.
 FacetfitLut facetfit_open(string file) {
   FacetfitLut lut;
@@ -50,7 +51,7 @@ FacetfitLut facetfit_open(string file) {
   int res[2] = {0, 0};
   int version = 0, resolution = 0, sampling = 0;
   if (gettextureinfo(file, "resolution", res) && gettextureinfo(file, "facetfit:format_version", version) &&
-      gettextureinfo(file, "facetfit:resolution", resolution) && version == 1) {
+      gettextureinfo(file, "facetfit:resolution", resolution) && (version == 1 || version == 2)) {
     gettextureinfo(file, "facetfit:sampling", sampling);
     lut.width = res[0];
     lut.height = res[1];
