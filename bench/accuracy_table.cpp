@@ -31,7 +31,7 @@ std::string format(const char* fmt, ...) {
 }
 
 Fitter fitter_for(Smith smith, int resolution = 90, int max_iterations = 1000) {
-  FitOptions options;
+  FitOptions options = FitOptions::paper();
   options.smith = smith;
   options.resolution = resolution;
   options.max_iterations = max_iterations;
@@ -129,7 +129,7 @@ Backscatter green_backscatter(const MerlTable& table) {
     double sum = 0.0;
     int n = 0;
     for (int k = 0; k < MerlTable::kPhiD; ++k)
-      if (row[k] >= 0.0f) sum += row[k], ++n;
+      if (!MerlTable::missing(row[k])) sum += row[k], ++n;
     if (n == 0) continue;
     back.theta.push_back(MerlTable::theta_h(i));
     back.value.push_back(sum / n);

@@ -3,11 +3,15 @@
 #include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
 
+#include <cstdlib>
 #include <filesystem>
+#include <map>
 #include <memory>
+#include <optional>
 
 #include "fit/fit.h"
 #include "fit/roughness.h"
+#include "io/input.h"
 #include "io/merl.h"
 #include "io/sha256.h"
 #include "lut/bake.h"
@@ -42,13 +46,46 @@ BENCHMARK(BM_ReadMerl)->Unit(benchmark::kMillisecond);
 // Extraction + Fresnel pass + both alphas: what `fit` costs per material once the table is loaded.
 void BM_Fit(benchmark::State& state) {
   const auto threads = limit_threads(state);
-  FitOptions options;
+  FitOptions options = FitOptions::paper();
   options.resolution = int(state.range(1));
   const Fitter fitter(options);
   for (auto _ : state) benchmark::DoNotOptimize(fitter.fit(gold()));
 }
 BENCHMARK(BM_Fit)->ArgNames({"threads", "resolution"})
     ->Args({0, 90})->Args({1, 90})->Args({0, 32})->Args({0, 64})->Args({0, 128})->Args({0, 256})
+    ->Unit(benchmark::kMillisecond);
+
+// A real measurement: one RGL material, from FACETFIT_RGL_DIR or ../shared/data/rgl (run from the
+// repository's root, as make bench does).
+const MerlTable* rgl_material(const char* name) {
+  static std::map<std::string, std::optional<MerlTable>> cache;
+  auto [it, added] = cache.try_emplace(name);
+  if (added) {
+    const char* env = std::getenv("FACETFIT_RGL_DIR");
+    const std::filesystem::path file = std::filesystem::path(env ? env : "../shared/data/rgl") / (std::string(name) + ".bsdf");
+    if (std::filesystem::exists(file)) it->second = load_table(file.string());
+  }
+  return it->second ? &*it->second : nullptr;
+}
+
+// The default fit (--refine full) of real materials against the paper's method alone on the same
+// table (the anchor): extraction, parametric fits, refinement, every distance.
+void BM_FitRgl(benchmark::State& state) {
+  const char* name = state.range(1) == 0 ? "acrylic_felt_green_rgb" : "ilm_l3_37_metallic_rgb";
+  const MerlTable* table = rgl_material(name);
+  if (!table) {
+    state.SkipWithError("no RGL data: set FACETFIT_RGL_DIR");
+    return;
+  }
+  const auto threads = limit_threads(state);
+  FitOptions options;
+  options.refine = state.range(2) ? FitOptions::Refine::full : FitOptions::Refine::none;
+  const Fitter fitter(options);
+  for (auto _ : state) benchmark::DoNotOptimize(fitter.fit(*table));
+  state.SetLabel(std::string(name) + (state.range(2) ? ", refine full" : ", refine none"));
+}
+BENCHMARK(BM_FitRgl)->ArgNames({"threads", "material", "refine"})
+    ->Args({1, 0, 0})->Args({1, 0, 1})->Args({0, 0, 1})->Args({1, 1, 0})->Args({1, 1, 1})->Args({0, 1, 1})
     ->Unit(benchmark::kMillisecond);
 
 void BM_Extraction(benchmark::State& state) {
@@ -60,7 +97,7 @@ BENCHMARK(BM_Extraction)->ArgName("resolution")->Arg(90)->Arg(256)->Unit(benchma
 
 void BM_FresnelPass(benchmark::State& state) {
   const auto threads = limit_threads(state);
-  const Fitter fitter(FitOptions{});
+  const Fitter fitter(FitOptions::paper());
   const FitResult fit = fitter.fit(gold());
   for (auto _ : state) benchmark::DoNotOptimize(fit_fresnel(gold(), fit.ndf(), Smith::correlated, nullptr));
   state.SetBytesProcessed(int64_t(state.iterations()) * int64_t(3 * MerlTable::kBins * sizeof(float)));
@@ -74,7 +111,7 @@ void BM_Quadrature(benchmark::State& state) {
 BENCHMARK(BM_Quadrature)->ArgName("resolution")->Arg(90)->Arg(256)->Unit(benchmark::kMillisecond);
 
 void BM_RefineAlpha(benchmark::State& state) {
-  const Fitter fitter(FitOptions{});
+  const Fitter fitter(FitOptions::paper());
   const FitResult fit = fitter.fit(gold());
   for (auto _ : state)
     benchmark::DoNotOptimize(refine_alpha(fitter.quadrature(), fit.ndf(), NdfType::ggx, fit.alpha_ggx));
@@ -120,13 +157,13 @@ BENCHMARK(BM_Sha256File)->Unit(benchmark::kMillisecond);
 
 void BM_VisibleNormalTables(benchmark::State& state) {
   const auto threads = limit_threads(state);
-  const FitResult fit = Fitter(FitOptions{}).fit(gold());
+  const FitResult fit = Fitter(FitOptions::paper()).fit(gold());
   for (auto _ : state) benchmark::DoNotOptimize(VisibleNormalTables::build(fit.ndf()));
 }
 BENCHMARK(BM_VisibleNormalTables)->ArgName("threads")->Arg(1)->Unit(benchmark::kMillisecond);
 
 void BM_WriteLut(benchmark::State& state) {
-  const Fitter fitter(FitOptions{});
+  const Fitter fitter(FitOptions::paper());
   const Lut lut = make_lut(fitter.fit(gold()), fitter.quadrature(), "gold", "", 0.02, true);
   const std::string path = (std::filesystem::temp_directory_path() / "facetfit-bench-lut.exr").string();
   for (auto _ : state) write_lut(path, lut);
@@ -143,6 +180,7 @@ void BM_BakeBatch(benchmark::State& state) {
   std::filesystem::create_directories(dir);
   BakeOptions options;
   options.force = true;
+  options.fit = FitOptions::paper();  // the pipeline's overhead, not the solves (BM_FitRgl)
   const Fitter fitter(options.fit);
   for (auto _ : state) {
     tbb::parallel_for(0, 8, [&](int k) { bake_material(gold_file(), "m" + std::to_string(k), dir, options, fitter); },

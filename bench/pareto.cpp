@@ -55,7 +55,7 @@ int main(int argc, char** argv) {
     std::vector<Point> points;
     for (int resolution : {16, 32, 64, 90, 128})
       for (int spp : {4, 16, 64, 256}) {
-        FitOptions options;
+        FitOptions options = FitOptions::paper();
         options.resolution = resolution;
         const Fitter fitter(options);
         const auto start = std::chrono::steady_clock::now();

@@ -16,7 +16,7 @@ struct FitSettings {
   int resolution = 90;
   double iteration_tolerance = 1e-10;
   int max_iterations = 1000;
-  std::string refine = "none";
+  std::string refine = "full";
 };
 void add_fit_settings(CLI::App* cmd, FitSettings& settings);
 // The FitOptions they name, or nullopt after reporting a usage error (status 2).

@@ -13,13 +13,25 @@ namespace {
 nlohmann::json info_json(const Lut& lut) {
   const LutMetadata& m = lut.meta;
   const auto rgb = [](const Rgb& c) { return nlohmann::json{c.r, c.g, c.b}; };
+  const auto coat = [](const Coat& c) {
+    return c.present() ? nlohmann::json{{"alpha", c.alpha}, {"f0", c.f0}} : nlohmann::json(nullptr);
+  };
   nlohmann::json j;
   j["metadata"] = {{"format_version", m.format_version}, {"facetfit_version", m.facetfit_version}, {"source", m.source},
                    {"source_sha256", m.source_sha256}, {"resolution", m.resolution}, {"smith", to_string(m.smith)},
                    {"iterations", m.iterations}, {"residual", m.residual}, {"alpha_ggx", m.alpha_ggx},
                    {"alpha_beckmann", m.alpha_beckmann}, {"f0", rgb(m.f0)}, {"f82", rgb(m.f82)},
                    {"ndf_error_ggx", m.ndf_error_ggx}, {"ndf_error_beckmann", m.ndf_error_beckmann},
-                   {"representation", to_string(m.representation)}, {"tolerance", m.tolerance}, {"sampling", m.sampling}};
+                   {"representation", to_string(m.representation)}, {"tolerance", m.tolerance}, {"sampling", m.sampling},
+                   {"body", rgb(m.body)}, {"coat", coat(m.coat)}, {"error", m.error},
+                   {"error_extraction", m.error_extraction}};
+  const auto parametric = [&](const LutMetadata::Parametric& p, double error) {
+    return nlohmann::json{{"alpha", p.alpha}, {"body", rgb(p.body)}, {"f0", rgb(p.f0)}, {"f82", rgb(p.f82)},
+                          {"coat", coat(p.coat)}, {"error", error}};
+  };
+  j["metadata"]["ggx"] = parametric(m.ggx, m.error_ggx);
+  j["metadata"]["beckmann"] = parametric(m.beckmann, m.error_beckmann);
+  j["metadata"]["lsq"] = parametric(m.lsq, m.error_lsq);
   const TabulatedNdf& ndf = lut.tables.ndf;
   nlohmann::json& t = j["ndf"];
   for (int k = 0; k < ndf.grid.size(); ++k) {
@@ -47,6 +59,20 @@ void print_info(const Lut& lut) {
               m.ndf_error_ggx, m.alpha_beckmann, m.ndf_error_beckmann);
   std::printf("f0              %.4f %.4f %.4f\nf82             %.4f %.4f %.4f\n", m.f0.r, m.f0.g, m.f0.b, m.f82.r, m.f82.g,
               m.f82.b);
+  std::printf("body            %.4f %.4f %.4f\n", m.body.r, m.body.g, m.body.b);
+  if (m.coat.present()) std::printf("coat            GGX alpha %.5f, f0 %.4f\n", m.coat.alpha, m.coat.f0);
+  // Distances from the measurement (0: the paper's method alone, which measures none).
+  std::printf("distance        tabulated %.4f (paper's fit %.4f), ggx %.4f, beckmann %.4f, lsq %.4f\n", m.error,
+              m.error_extraction, m.error_ggx, m.error_beckmann, m.error_lsq);
+  const auto parametric = [](const char* name, const LutMetadata::Parametric& p) {
+    std::printf("%-15s alpha %.5f, body %.4f %.4f %.4f, f0 %.4f %.4f %.4f, f82 %.4f %.4f %.4f", name, p.alpha, p.body.r,
+                p.body.g, p.body.b, p.f0.r, p.f0.g, p.f0.b, p.f82.r, p.f82.g, p.f82.b);
+    if (p.coat.present()) std::printf(", coat alpha %.5f f0 %.4f", p.coat.alpha, p.coat.f0);
+    std::printf("\n");
+  };
+  parametric("ggx", m.ggx);
+  parametric("beckmann", m.beckmann);
+  parametric("lsq", m.lsq);
   std::printf("representation  %s (tolerance %.4f)\nsampling tables %s\n\n", to_string(m.representation), m.tolerance,
               m.sampling ? "yes" : "no (--eval-only)");
   std::printf("%4s %8s %10s %14s %14s %10s\n", "node", "u", "theta_deg", "ndf", "slope_pdf", "sigma");

@@ -7,17 +7,18 @@ import tempfile
 
 NOTES = {
     "BM_ReadMerl": "read a MERL .binary (35 MB of doubles) into the in-memory table",
-    "BM_Fit": "extraction + Fresnel pass + both alphas on a loaded table (the `fit` cost per material)",
+    "BM_Fit": "the paper's method (`--refine none`): extraction + Fresnel pass + both alphas on a loaded table",
+    "BM_FitRgl": "a real RGL material (felt, metallic): the paper's method alone (anchor) and the default fit (`--refine full`: three parametric fits, two coat trials, two refinements of the tabulated lobe, every distance)",
     "BM_Extraction": "power iteration alone",
     "BM_FresnelPass": "one pass over every bin of the table",
     "BM_Quadrature": "quadrature weights of one resolution (once per batch, shared by every material)",
     "BM_RefineAlpha": "optional least-squares refinement of one alpha (`--refine`)",
     "BM_TabulateAnalytic": "tabulate an analytic BRDF into MERL layout (tests, `convert builtin:`)",
-    "BM_Bake": "bake one MERL file: SHA-256, read, fit, sampling tables, EXR, sidecar (hash overlapped with the read)",
+    "BM_Bake": "bake one MERL file with the default fit: SHA-256, read, fit, sampling tables, EXR, sidecar (hash overlapped with the read)",
     "BM_Sha256File": "SHA-256 of the 35 MB MERL file (OpenSSL; provenance in the LUT, bake cache key)",
     "BM_VisibleNormalTables": "the sampling tables of one material",
     "BM_WriteLut": "write one LUT EXR (float32, zip)",
-    "BM_BakeBatch": "8 materials baked at once, as `bake --jobs`",
+    "BM_BakeBatch": "8 materials baked at once, as `bake --jobs` (the paper's method: the pipeline's overhead)",
 }
 
 

@@ -19,10 +19,10 @@ namespace {
 
 class GroundTruth : public testing::TestWithParam<GroundTruthCase> {};
 
-TEST_P(GroundTruth, WithinTheBar) {
-  const GroundTruthCase& c = GetParam();
+void expect_within_the_bar(const GroundTruthCase& c, FitOptions::Refine refine) {
   FitOptions options;
   options.smith = c.smith;
+  options.refine = refine;
   const Fitter fitter(options);
   test::TempDir dir;
   const GroundTruthError e = measure_ground_truth(c, fitter, dir.file("case.binary"));
@@ -32,6 +32,10 @@ TEST_P(GroundTruth, WithinTheBar) {
   EXPECT_LT(e.ndf_l1, 0.01);
   EXPECT_LT(e.fresnel_abs, 0.005);
 }
+
+// The paper's method alone, and the default fit (refinement on the whole measurement).
+TEST_P(GroundTruth, WithinTheBar) { expect_within_the_bar(GetParam(), FitOptions::Refine::none); }
+TEST_P(GroundTruth, WithinTheBarRefined) { expect_within_the_bar(GetParam(), FitOptions::Refine::full); }
 
 std::string case_name(const testing::TestParamInfo<GroundTruthCase>& info) {
   std::string alpha = std::to_string(int(info.param.alpha * 1000 + 0.5));

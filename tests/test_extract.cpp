@@ -16,7 +16,7 @@ MerlTable table_of(NdfType type, double alpha, Smith smith, const Fresnel& fresn
 }
 
 FitResult fit_with(const MerlTable& table, Smith smith, int max_iterations = 1000) {
-  FitOptions options;
+  FitOptions options = FitOptions::paper();
   options.smith = smith;
   options.max_iterations = max_iterations;
   return Fitter(options).fit(table);
@@ -32,7 +32,7 @@ TEST(Extract, ConvergesToToleranceAndReportsIt) {
 }
 
 TEST(Extract, NormalizedAndSigmaConsistent) {
-  FitOptions options;
+  FitOptions options = FitOptions::paper();
   const Fitter fitter(options);
   const FitResult r = fitter.fit(table_of(NdfType::beckmann, 0.25, Smith::correlated));
   ASSERT_TRUE(r.ok());
@@ -78,7 +78,7 @@ TEST(Extract, FourIterationsAreNotEnoughForRoughMaterials) {
 TEST(Extract, ResolutionsAgree) {
   const MerlTable table = table_of(NdfType::ggx, 0.3, Smith::correlated);
   for (int resolution : {32, 64, 90, 128, 256}) {
-    FitOptions options;
+    FitOptions options = FitOptions::paper();
     options.resolution = resolution;
     const FitResult r = Fitter(options).fit(table);
     ASSERT_TRUE(r.ok()) << resolution;
@@ -88,7 +88,7 @@ TEST(Extract, ResolutionsAgree) {
 
 TEST(Extract, RefinedAlphaOfTheOtherFamilyFitsDBest) {
   // A Beckmann material: the GGX moment estimate is biased, refine_alpha's GGX alpha fits D best.
-  const Fitter fitter{FitOptions{}};
+  const Fitter fitter{FitOptions::paper()};
   const FitResult r = fitter.fit(table_of(NdfType::beckmann, 0.3, Smith::correlated));
   EXPECT_NEAR(r.alpha_beckmann, 0.3, 0.3 * 0.005);
   const double alpha = refine_alpha(fitter.quadrature(), r.ndf(), NdfType::ggx, r.alpha_ggx);
@@ -98,7 +98,7 @@ TEST(Extract, RefinedAlphaOfTheOtherFamilyFitsDBest) {
 }
 
 TEST(Extract, BadResolutionIsAClearError) {
-  FitOptions options;
+  FitOptions options = FitOptions::paper();
   options.resolution = 1;
   EXPECT_THROW(Fitter{options}, Error);
 }

@@ -18,12 +18,12 @@ using test::error_of;
 using test::TempDir;
 
 struct Baked {
-  Fitter fitter{FitOptions{}};
+  Fitter fitter{FitOptions::paper()};
   FitResult fit;
 };
 
 Baked fit_of(const Brdf& brdf, Smith smith = Smith::correlated) {
-  FitOptions options;
+  FitOptions options = FitOptions::paper();
   options.smith = smith;
   Baked b{Fitter(options), {}};
   b.fit = b.fitter.fit(MerlTable::tabulate(brdf));

@@ -32,8 +32,8 @@ TEST(Merl, WriteReadRoundTripIsExactToFloat) {
   for (int c = 0; c < 3; ++c)
     for (std::size_t n = 0; n < MerlTable::kBins; n += 97) {
       const float a = table.channel(c)[n], b = back.channel(c)[n];
-      if (a < 0.0f) {
-        EXPECT_LT(b, 0.0f);
+      if (MerlTable::missing(a)) {
+        EXPECT_TRUE(MerlTable::missing(b));
       } else {
         EXPECT_NEAR(a, b, 1e-6f * std::max(1.0f, a));
       }
@@ -94,7 +94,8 @@ TEST(Merl, LinearLookupInterpolatesAndSkipsMissingBins) {
   EXPECT_FALSE(table.eval(i, o).has_value());
 }
 
-TEST(Merl, NegativeEntriesAreMissing) {
+// MERL files mark missing bins with negative numbers; in memory a missing bin is NaN.
+TEST(Merl, NegativeFileEntriesAreMissing) {
   TempDir dir;
   MerlTable table = gold_table();
   table.write(dir.file("a.binary"));
@@ -103,8 +104,17 @@ TEST(Merl, NegativeEntriesAreMissing) {
   std::memcpy(bytes.data() + 12 + MerlTable::index(5, 6, 7) * 8, &minus_one, 8);
   test::write_bytes(dir.file("b.binary"), bytes);
   const MerlTable back = MerlTable::read(dir.file("b.binary"));
-  EXPECT_LT(back.value(0, 5, 6, 7), 0.0f);
-  EXPECT_GE(back.value(1, 5, 6, 7), 0.0f);
+  EXPECT_TRUE(MerlTable::missing(back.value(0, 5, 6, 7)));
+  EXPECT_FALSE(MerlTable::missing(back.value(1, 5, 6, 7)));
+}
+
+// A negative value tabulated in memory (RGL noise) is a measurement: kept, read back by eval.
+TEST(Merl, NegativeMeasurementsStay) {
+  MerlTable table = gold_table();
+  table.set(5, 6, 7, Rgb(-0.01, 0.2, -0.02));
+  EXPECT_FALSE(MerlTable::missing(table.value(0, 5, 6, 7)));
+  EXPECT_FLOAT_EQ(table.value(0, 5, 6, 7), -0.01f);
+  EXPECT_FLOAT_EQ(table.value(2, 5, 6, 7), -0.02f);
 }
 
 class MerlBadFile : public testing::Test {

@@ -64,9 +64,10 @@ TEST(Refine, CoatOverLambertPlusGgx) {
   EXPECT_NEAR(r.ggx.alpha, 0.3, 0.3 * 0.01);
   for (int c = 0; c < 3; ++c) EXPECT_NEAR(r.ggx.body[c], albedo[c], 0.01 * albedo[c]) << "channel " << c;
   EXPECT_NEAR(r.ggx.f0.g, 0.5, 0.005);
-  // The tabulated representation carries the coat and is no farther from the measurement.
+  // The tabulated representation carries the coat and is no farther from the measurement than the
+  // GGX fit, up to the tabulation of that fit on the NDF grid.
   EXPECT_TRUE(r.lobe.coat.present());
-  EXPECT_LE(r.error, r.ggx.error + 1e-9);
+  EXPECT_LE(r.error, r.ggx.error + 1e-4);
 }
 
 TEST(Refine, LutCarriesBodyCoatAndParametricFits) {
@@ -109,7 +110,7 @@ TEST(RefineRgl, NeverWorseThanTheExtraction) {
     if (entry.path().extension() != ".bsdf") continue;
     ++files;
     const MerlTable table = load_table(entry.path().string());
-    const MeasuredBins bins = measured_bins(table);
+    const MeasuredBins bins = error_bins(table);
     const auto distance = [&](const FitResult& r) {
       return measurement_error(bins, TabulatedMicrofacet(MicrofacetTables{r.ndf(), r.smith, r.fresnel(), r.body(), r.lobe.coat}, {}));
     };
@@ -119,7 +120,8 @@ TEST(RefineRgl, NeverWorseThanTheExtraction) {
     EXPECT_LE(d_after, d_before) << entry.path();
     EXPECT_NEAR(d_after, after.error, 1e-9) << entry.path();
     EXPECT_NEAR(d_before, after.error_extraction, 1e-9) << entry.path();
-    EXPECT_LT(after.lsq.error, 2.0 * d_before) << entry.path();  // the baseline is a real fit
+    // The tabulated model holds the classical fit (up to its tabulation): never farther than it.
+    EXPECT_LE(after.error, 1.01 * after.lsq.error) << entry.path();
   }
   EXPECT_GT(files, 0);
 }

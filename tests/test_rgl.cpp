@@ -448,8 +448,10 @@ Rgb albedo(const RglBsdf& b, const Vec3& i) {
   return sum;
 }
 
-TEST(RglReal, LoadAndEvalFiniteNonNegativeIncludingGrazing) {
+// Finite everywhere; negative entries (noise around zero) are kept as Mitsuba keeps them, not clipped.
+TEST(RglReal, LoadAndEvalFiniteIncludingGrazing) {
   REQUIRE_RGL_DATA();
+  int negative = 0;
   const double degrees[] = {0, 1, 5, 15, 30, 45, 60, 70, 80, 85, 88, 89, 89.9, 89.99};
   for (const RealFile& f : kRealFiles) {
     SCOPED_TRACE(f.name);
@@ -464,13 +466,16 @@ TEST(RglReal, LoadAndEvalFiniteNonNegativeIncludingGrazing) {
             const Vec3 i = spherical_direction(ti * kPi / 180.0, 0.2), o = spherical_direction(to * kPi / 180.0, 0.2 + phi);
             const auto v = b.eval(i, o);
             ASSERT_TRUE(v.has_value());
-            for (int c = 0; c < 3; ++c)
-              ASSERT_TRUE(std::isfinite((*v)[c]) && (*v)[c] >= 0.0)
+            for (int c = 0; c < 3; ++c) {
+              ASSERT_TRUE(std::isfinite((*v)[c]))
                   << "f = " << (*v)[c] << " at theta_i " << ti << ", theta_o " << to << ", dphi " << phi;
+              negative += (*v)[c] < 0.0;
+            }
           }
     }
     EXPECT_EQ(*b.eval(Vec3(0, 0, 1), spherical_direction(1.6, 0.0)), Rgb(0.0));
   }
+  EXPECT_GT(negative, 0);
 }
 
 TEST(RglReal, Reciprocity) {

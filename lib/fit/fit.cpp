@@ -1,5 +1,8 @@
 #include "fit/fit.h"
 
+#include <tbb/parallel_invoke.h>
+
+#include <array>
 #include <cmath>
 
 #include "core/error.h"
@@ -19,7 +22,7 @@ Backscatter backscatter_of(const MerlTable& table) {
       double sum = 0.0;
       int n = 0;
       for (int k = 0; k < MerlTable::kPhiD; ++k) {
-        if (row[k] < 0.0f) continue;
+        if (MerlTable::missing(row[k])) continue;
         sum += row[k];
         ++n;
       }
@@ -28,7 +31,7 @@ Backscatter backscatter_of(const MerlTable& table) {
     }
     if (!complete) continue;
     back.theta.push_back(MerlTable::theta_h(i));
-    back.value.push_back(luminance(mean));
+    back.value.push_back(std::max(0.0, luminance(mean)));  // below zero: noise on a zero measurement
   }
   return back;
 }
@@ -53,6 +56,60 @@ std::optional<FitOptions::Refine> parse_refine(const std::string& name) {
   return std::nullopt;
 }
 
+void Fitter::refine_on_measurement(const MerlTable& table, FitResult& result) const {
+  const MeasuredBins fit_bins = solve_bins(table), bins = error_bins(table);
+  const Smith smith = options_.smith;
+  const auto error_of = [&](const LobeFit& lobe) {
+    return measurement_error(bins, TabulatedMicrofacet(MicrofacetTables{lobe.ndf, smith, lobe.fresnel, lobe.body, lobe.coat}, {}));
+  };
+  result.error_extraction = result.error = error_of(result.lobe);
+
+  // Parametric fits from the moment estimates (fit() set them), a grey body to start.
+  const auto start = [](ParametricFit p) {
+    p.body = Rgb(0.05);
+    return p;
+  };
+  const auto fit = [&](const ParametricFit& p) { return fit_parametric(fit_bins, bins, smith, p); };
+  // With a coat (a second, sharper GGX lobe) where it brings the fit 5% nearer.
+  const auto fit_coated = [&](const ParametricFit& p) {
+    const ParametricFit bare = fit(p);
+    ParametricFit coated = bare;
+    coated.coat = Coat{0.5 * std::min(bare.alpha, 0.3), 0.04};
+    coated = fit(coated);
+    return coated.error < 0.95 * bare.error ? coated : bare;
+  };
+  LobeFit from_extraction;
+  // Independent solves, run concurrently.
+  tbb::parallel_invoke(
+      [&] { result.ggx = fit_coated(start(result.ggx)); },
+      [&] { result.beckmann = fit_coated(start(result.beckmann)); },
+      [&] { result.lsq = fit(start(result.lsq)); },
+      [&] { from_extraction = refine_lobe(fit_bins, quadrature_, smith, result.lobe, RefineOptions{}); });
+
+  // The tabulated lobe refined from a second start too: the nearer of the GGX and lsq fits, tabulated
+  // (the tabulated model holds either exactly, so it can end no farther than they are).
+  const ParametricFit& best = result.ggx.error <= result.lsq.error ? result.ggx : result.lsq;
+  LobeFit tabulated;
+  tabulated.ndf = tabulate_ndf(Ndf::isotropic(NdfType::ggx, best.alpha), quadrature_.grid());
+  normalize_ndf(tabulated.ndf, quadrature_);
+  for (int j = 0; j < FresnelCurve::kSize; ++j)  // F82-tint with f82 = Schlick(f0, 1/7) is Schlick
+    tabulated.fresnel.value[std::size_t(j)] = fresnel_f82_tint(best.f0, best.f82, std::cos(FresnelCurve::theta_d(j)));
+  tabulated.body = best.body;
+  tabulated.coat = best.coat;
+  const LobeFit from_best = refine_lobe(fit_bins, quadrature_, smith, tabulated, RefineOptions{});
+
+  // The nearest of the starts and the refinements: a refinement that ends farther than its start (a G2
+  // update it could not follow, a bound) is not taken.
+  const LobeFit* choice = &result.lobe;
+  for (const LobeFit* candidate : std::array<const LobeFit*, 3>{&from_extraction, &tabulated, &from_best}) {
+    const double error = error_of(*candidate);
+    if (error < result.error) result.error = error, choice = candidate;
+  }
+  result.lobe = *choice;
+  result.alpha_ggx = alpha_ggx_from_moments(result.ndf(), quadrature_);
+  result.alpha_beckmann = alpha_beckmann_from_moments(result.ndf(), quadrature_);
+}
+
 FitResult Fitter::fit(const MerlTable& table) const {
   FitResult result;
   result.smith = options_.smith;
@@ -68,70 +125,26 @@ FitResult Fitter::fit(const MerlTable& table) const {
 
   const bool refine = options_.refine == FitOptions::Refine::full;
   result.refined = refine;
-  // The paper's method alone measures nothing else: no bins, no errors (they stay 0).
-  const MeasuredBins bins = refine ? measured_bins(table) : MeasuredBins{};
-  const auto error_of = [&](const LobeFit& lobe) {
-    return measurement_error(
-        bins, TabulatedMicrofacet(MicrofacetTables{lobe.ndf, options_.smith, lobe.fresnel, lobe.body, lobe.coat}, {}));
-  };
-  if (refine) result.error_extraction = result.error = error_of(result.lobe);
   result.alpha_ggx = alpha_ggx_from_moments(result.ndf(), quadrature_);
   result.alpha_beckmann = alpha_beckmann_from_moments(result.ndf(), quadrature_);
-  const Rgb f0 = result.fresnel().value[0], f82 = result.fresnel().eval(f82_theta());
-
-  // Parametric fits, from the moments and the extraction's Fresnel, on a sparser set of bins (ten
-  // parameters need far fewer than the tabulated lobe's hundreds).
-  const auto start = [&](NdfType type, double alpha, ParametricFit::FresnelForm form) {
+  // The parametric representations of the paper's method: the moment alphas with the extraction's
+  // Fresnel at 0 and 82 degrees (Schlick's for lsq), no body.
+  const Rgb f0 = glm::clamp(result.fresnel().value[0], Rgb(0.0), Rgb(1.0));
+  const Rgb f82 = glm::clamp(result.fresnel().eval(f82_theta()), Rgb(0.0), Rgb(1.0));
+  const auto moments = [&](NdfType type, double alpha, ParametricFit::FresnelForm form) {
     ParametricFit p;
     p.type = type;
     p.fresnel = form;
     p.alpha = alpha;
-    p.f0 = glm::clamp(f0, Rgb(0.0), Rgb(1.0));
-    p.f82 = form == ParametricFit::FresnelForm::f82 ? glm::clamp(f82, Rgb(0.0), Rgb(1.0)) : fresnel_schlick(p.f0, 1.0 / 7.0);
+    p.f0 = f0;
+    p.f82 = form == ParametricFit::FresnelForm::f82 ? f82 : fresnel_schlick(f0, 1.0 / 7.0);
     return p;
   };
-  result.ggx = start(NdfType::ggx, result.alpha_ggx, ParametricFit::FresnelForm::f82);
-  result.beckmann = start(NdfType::beckmann, result.alpha_beckmann, ParametricFit::FresnelForm::f82);
-  result.lsq = start(NdfType::ggx, result.alpha_ggx, ParametricFit::FresnelForm::schlick);
-  const MeasuredBins sparse = refine ? measured_bins(table, 3, 12) : MeasuredBins{};
-  const auto fit_on = [&](const ParametricFit& p, int iterations) {
-    ParametricFit f = fit_parametric(iterations > 0 ? sparse : bins, options_.smith, p, iterations);
-    if (iterations > 0) f.error = fit_parametric(bins, options_.smith, f, 0).error;  // on the same bins as the rest
-    return f;
-  };
-  if (refine) {
-    result.ggx.body = result.beckmann.body = result.lsq.body = Rgb(0.05);
-    result.ggx = fit_on(result.ggx, 50);
-    result.beckmann = fit_on(result.beckmann, 50);
-    result.lsq = fit_on(result.lsq, 50);
-    // A coat: a second, sharper GGX lobe over each fit, kept where it brings the fit 5% nearer.
-    for (ParametricFit* p : {&result.ggx, &result.beckmann}) {
-      ParametricFit coated = *p;
-      coated.coat = Coat{0.5 * std::min(p->alpha, 0.3), 0.04};
-      coated = fit_on(coated, 50);
-      if (coated.error < 0.95 * p->error) *p = coated;
-    }
-    // The tabulated lobe refined from the better start: the extraction, or the GGX fit tabulated.
-    LobeFit from_ggx;
-    from_ggx.ndf.grid = quadrature_.grid();
-    const Ndf ggx = Ndf::isotropic(NdfType::ggx, result.ggx.alpha);
-    for (int j = 0; j < quadrature_.size(); ++j) from_ggx.ndf.ndf.push_back(ggx.D(spherical_direction(quadrature_.grid().theta(j), 0.0)));
-    normalize_ndf(from_ggx.ndf, quadrature_);
-    for (int j = 0; j < FresnelCurve::kSize; ++j)
-      from_ggx.fresnel.value[std::size_t(j)] = fresnel_f82_tint(result.ggx.f0, result.ggx.f82, std::cos(FresnelCurve::theta_d(j)));
-    from_ggx.body = result.ggx.body;
-    from_ggx.coat = result.ggx.coat;
-    const LobeFit& base = result.ggx.error < result.error_extraction ? from_ggx : result.lobe;
-    const double base_error = std::min(result.ggx.error, result.error_extraction);
-    LobeFit refined = refine_lobe(bins, quadrature_, options_.smith, base, RefineOptions{});
-    const double error = error_of(refined);
-    // The refinement descends from its start; a pass that ends worse (a G2 update it could not follow,
-    // the clamp to nonnegative values) is not taken.
-    result.lobe = error <= base_error ? refined : base;
-    result.error = std::min(error, base_error);
-    result.alpha_ggx = alpha_ggx_from_moments(result.ndf(), quadrature_);
-    result.alpha_beckmann = alpha_beckmann_from_moments(result.ndf(), quadrature_);
-  }
+  result.ggx = moments(NdfType::ggx, result.alpha_ggx, ParametricFit::FresnelForm::f82);
+  result.beckmann = moments(NdfType::beckmann, result.alpha_beckmann, ParametricFit::FresnelForm::f82);
+  result.lsq = moments(NdfType::ggx, result.alpha_ggx, ParametricFit::FresnelForm::schlick);
+  // The paper's method alone measures nothing else: no bins, no errors (they stay 0).
+  if (refine) refine_on_measurement(table, result);
   result.f0 = result.fresnel().value[0];
   result.f82 = result.fresnel().eval(f82_theta());
 

@@ -85,8 +85,9 @@ FresnelCurve fit_fresnel(const MerlTable& table, const TabulatedNdf& ndf, Smith 
               float measured = 0.0f, model = 0.0f, count = 0.0f;
 #pragma omp simd reduction(+ : measured, model, count)
               for (int k = 0; k < kP; ++k) {
-                const float w = values[k] >= 0.0f ? above_row[k] : 0.0f;
-                measured += w * values[k];
+                const bool valid = !MerlTable::missing(values[k]);  // a missing bin is NaN: select, not multiply
+                const float w = valid ? above_row[k] : 0.0f;
+                measured += w * (valid ? values[k] : 0.0f);
                 model += w * model_row[k];
                 count += w;
               }

@@ -26,7 +26,7 @@ MeasuredBins measured_bins(const MerlTable& table, int stride_d, int stride_phi)
         Rgb v(0.0);
         for (int c = 0; c < 3; ++c) {
           const float x = table.value(c, i, j, k);
-          if (x >= 0.0f) valid |= std::uint8_t(1u << c), v[c] = x;
+          if (!MerlTable::missing(x)) valid |= std::uint8_t(1u << c), v[c] = x;
         }
         if (!valid) continue;
         bins.i.push_back(wi);
@@ -53,7 +53,7 @@ double measurement_error(const MeasuredBins& bins, const Brdf& model) {
     const Rgb m = f ? *f : Rgb(0.0);
     for (int c = 0; c < 3; ++c) {
       if (!(bins.valid[b] >> c & 1u)) continue;
-      const double r = log_residual(m[c], bins.value[b][c], bins.cos_mean[b]);
+      const double r = metric_residual(m[c], bins.value[b][c], bins.cos_mean[b]);
       sum += bins.weight[b] * r * r;
       norm += bins.weight[b];
     }

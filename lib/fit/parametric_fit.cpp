@@ -51,13 +51,10 @@ struct RowResiduals {
   bool with_coat;
 
   template <class T>
-  bool operator()(T const* const* p, T* r) const {
-    const T* body = p[0];
-    const T alpha = exp(p[1][0]);
-    const T* f0 = p[2];
-    const T* f82 = p[3];
-    const T coat_alpha = exp(p[4][0]);
-    const T coat_f0 = p[4][1];
+  bool operator()(const T* body, const T* log_alpha, const T* f0, const T* f82, const T* coat_p, T* r) const {
+    const T alpha = exp(log_alpha[0]);
+    const T coat_alpha = exp(coat_p[0]);
+    const T coat_f0 = coat_p[1];
     constexpr double mu82 = 1.0 / 7.0;
     const double basis82 = mu82 * std::pow(1.0 - mu82, 6.0);
     for (std::size_t k = row->begin; k < row->end; ++k) {
@@ -80,7 +77,7 @@ struct RowResiduals {
         if (m < 0.0) m = T(0.0);  // F82-tint can dip below zero for extreme f82: no negative reflectance
         T& out = r[3 * (k - row->begin) + std::size_t(ch)];
         if (bins->valid[k] >> ch & 1u)
-          out = s * (log(1.0 + m * c) - std::log1p(std::max(bins->value[k][ch] * c, -0.5)));
+          out = s * (metric_transform(m * c) - metric_transform(bins->value[k][ch] * c));
         else
           out = T(0.0);
       }
@@ -101,7 +98,12 @@ struct RowResiduals {
 
 }  // namespace
 
-ParametricFit fit_parametric(const MeasuredBins& bins, Smith smith, const ParametricFit& start, int max_iterations) {
+double parametric_error(const MeasuredBins& bins, Smith smith, const ParametricFit& fit) {
+  return measurement_error(bins, ParametricBrdf(Ndf::isotropic(fit.type, fit.alpha), smith, fit.f0, fit.f82, fit.body, fit.coat));
+}
+
+ParametricFit fit_parametric(const MeasuredBins& bins, const MeasuredBins& error_bins, Smith smith,
+                             const ParametricFit& start, int max_iterations) {
   ParametricFit fit = start;
   double body[3] = {start.body.r, start.body.g, start.body.b};
   double log_alpha[1] = {std::log(std::max(start.alpha, 1e-3))};
@@ -111,11 +113,10 @@ ParametricFit fit_parametric(const MeasuredBins& bins, Smith smith, const Parame
   double coat[2] = {std::log(with_coat ? start.coat.alpha : 0.1), start.coat.f0};
   ceres::Problem problem;
   for (const MeasuredBins::Row& row : bins.rows) {
-    auto* cost = new ceres::DynamicAutoDiffCostFunction<RowResiduals, 8>(
-        new RowResiduals{&bins, &row, start.type, smith, start.fresnel, with_coat});
-    for (int n : {3, 1, 3, 3, 2}) cost->AddParameterBlock(n);
-    cost->SetNumResiduals(int(3 * (row.end - row.begin)));
-    problem.AddResidualBlock(cost, nullptr, std::vector<double*>{body, log_alpha, f0, f82, coat});
+    // Fixed parameter sizes: one pass of 12-wide Jets per row (a dynamic cost needs two).
+    auto* cost = new ceres::AutoDiffCostFunction<RowResiduals, ceres::DYNAMIC, 3, 1, 3, 3, 2>(
+        new RowResiduals{&bins, &row, start.type, smith, start.fresnel, with_coat}, int(3 * (row.end - row.begin)));
+    problem.AddResidualBlock(cost, nullptr, body, log_alpha, f0, f82, coat);
   }
   if (bins.rows.empty()) return fit;
   problem.SetParameterLowerBound(log_alpha, 0, std::log(1e-3));
@@ -135,7 +136,7 @@ ParametricFit fit_parametric(const MeasuredBins& bins, Smith smith, const Parame
   ceres::Solver::Options options;
   options.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
   options.max_num_iterations = max_iterations;
-  options.function_tolerance = 1e-8;
+  options.function_tolerance = 1e-6;
   options.logging_type = ceres::SILENT;
   ceres::Solver::Summary summary;
   if (max_iterations > 0) ceres::Solve(options, &problem, &summary);
@@ -145,9 +146,8 @@ ParametricFit fit_parametric(const MeasuredBins& bins, Smith smith, const Parame
   fit.f0 = Rgb(f0[0], f0[1], f0[2]);
   fit.f82 = fit.fresnel == ParametricFit::FresnelForm::f82 ? Rgb(f82[0], f82[1], f82[2])
                                                            : fresnel_schlick(fit.f0, 1.0 / 7.0);
-  const Ndf ndf = Ndf::isotropic(fit.type, fit.alpha);
   if (with_coat) fit.coat = Coat{std::exp(coat[0]), coat[1]};
-  fit.error = measurement_error(bins, ParametricBrdf(ndf, smith, fit.f0, fit.f82, fit.body, fit.coat));
+  fit.error = parametric_error(error_bins, smith, fit);
   return fit;
 }
 

@@ -1,4 +1,4 @@
-// Parametric fits on the whole measurement: body + one GGX or Beckmann lobe, in the log metric of
+// Parametric fits on the whole measurement: body + one GGX or Beckmann lobe, in the metric of
 // fit/measurement.h, from the moment estimates of the tabulated fit.
 //
 //   f(i, o) = body / pi + F(theta_d) D_alpha(h) G2_alpha(i, o) / (4 cos theta_i cos theta_o)
@@ -28,8 +28,12 @@ struct ParametricFit {
   double error = 0.0;     // measurement_error of the fit
 };
 
-// Least squares from the start values (alpha > 0; body, f0, f82 in [0, 1]); with a coat in the start,
-// the coat's alpha and f0 too. max_iterations 0: the start as it is, with its error.
-ParametricFit fit_parametric(const MeasuredBins& bins, Smith smith, const ParametricFit& start, int max_iterations = 50);
+// Least squares on `bins` from the start values (alpha > 0; body, f0, f82 in [0, 1]); with a coat in
+// the start, the coat's alpha and f0 too. The fit's error is measured on `error_bins`.
+ParametricFit fit_parametric(const MeasuredBins& bins, const MeasuredBins& error_bins, Smith smith,
+                             const ParametricFit& start, int max_iterations = 50);
+
+// The fit's distance from the measurement (measurement_error of its BRDF).
+double parametric_error(const MeasuredBins& bins, Smith smith, const ParametricFit& fit);
 
 }  // namespace facetfit

@@ -2,7 +2,7 @@
 //
 // The power iteration sees only back-scattering and a single lobe. Real materials also have a body
 // (subsurface, diffuse reflection) and noise, so starting from the extraction, every parameter is
-// refined against every bin the fit samples (fit/measurement.h), in that file's log metric:
+// refined against every bin the fit samples (fit/measurement.h), in that file's metric:
 //
 //   f(i, o) = body / pi + F(theta_d) D(theta_h) G2(i, o) / (4 cos theta_i cos theta_o)
 //

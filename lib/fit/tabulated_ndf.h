@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "fit/grid.h"
+#include "model/ndf.h"
 
 namespace facetfit {
 
@@ -48,5 +49,17 @@ class G1Table {
   std::vector<double> values_;
   double scale_ = 1.0;
 };
+
+// An analytic NDF on `grid`: its D and sigma at the nodes.
+inline TabulatedNdf tabulate_ndf(const Ndf& ndf, const ThetaGrid& grid = ThetaGrid{90}) {
+  TabulatedNdf t;
+  t.grid = grid;
+  for (int j = 0; j < grid.size(); ++j) {
+    const Vec3 w = spherical_direction(grid.theta(j), 0.0);
+    t.ndf.push_back(ndf.D(w));
+    t.sigma.push_back(ndf.sigma(w));
+  }
+  return t;
+}
 
 }  // namespace facetfit

@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
+#include <limits>
 #include <filesystem>
 #include <memory>
 
@@ -23,7 +24,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-constexpr float kMissing = -1.0f;
+constexpr float kMissing = std::numeric_limits<float>::quiet_NaN();
 
 struct FileCloser {
   void operator()(std::FILE* f) const { std::fclose(f); }
@@ -158,7 +159,7 @@ MerlTable MerlTable::tabulate(const Brdf& brdf) {
         if (wi.z <= 0.0 || wo.z <= 0.0) continue;  // stays missing: no measurement below the horizon
         const auto f = brdf.eval(wi, wo);
         if (!f || !std::isfinite(f->r) || !std::isfinite(f->g) || !std::isfinite(f->b)) continue;
-        table.set(i, j, k, glm::max(*f, Rgb(0.0)));
+        table.set(i, j, k, *f);  // negative measurements stay (RGL noise around zero)
       }
     }
   });
@@ -177,7 +178,7 @@ void MerlTable::write(const std::string& path) const {
     for (std::size_t done = 0; done < kBins && ok; done += buf.size()) {
       for (std::size_t t = 0; t < buf.size(); ++t) {
         const float v = in[done + t];
-        buf[t] = v < 0.0f ? -1.0 : double(v) / kScale[c];
+        buf[t] = missing(v) ? -1.0 : double(v) / kScale[c];  // a negative measurement reads back as missing
       }
       ok = std::fwrite(buf.data(), sizeof(double), buf.size(), file.get()) == buf.size();
     }
@@ -199,7 +200,7 @@ std::optional<Rgb> MerlTable::eval_nearest(double x_h, double x_d, double x_p) c
   const std::size_t n = index(i, j, k);
   Rgb v;
   for (int c = 0; c < 3; ++c) {
-    if (channel(c)[n] < 0.0f) return std::nullopt;
+    if (missing(channel(c)[n])) return std::nullopt;
     v[c] = channel(c)[n];
   }
   return v;
@@ -228,7 +229,7 @@ std::optional<Rgb> MerlTable::eval_linear(double x_h, double x_d, double x_p) co
     const std::size_t n = index((corner & 1) ? ah.i1 : ah.i0, (corner & 2) ? ad.i1 : ad.i0, (corner & 4) ? ap.i1 : ap.i0);
     for (int c = 0; c < 3; ++c) {
       const float v = channel(c)[n];
-      if (v < 0.0f) continue;
+      if (missing(v)) continue;
       sum[c] += w * v;
       weight[c] += w;
     }

@@ -2,10 +2,13 @@
 //
 // Bin positions (docs/conventions.md): theta_h bin i sits at theta_h = (i / 90)^2 pi/2, theta_d bin j
 // at j/90 pi/2, phi_d bin k at k/180 pi, the inverse of the index maps of MERL's reference reader
-// (which truncates). Values are held in 1/sr, already multiplied by MERL's channel scales. A negative
-// value is a missing measurement: no computation reads it as zero.
+// (which truncates). Values are held in 1/sr, already multiplied by MERL's channel scales. A missing
+// measurement is NaN (missing()): no computation reads it as zero. Negative values are measurements
+// (RGL's noise around zero, tabulated as it is); MERL files mark missing bins with negative numbers, so
+// the reader makes those missing and the writer writes missing bins as -1.
 #pragma once
 
+#include <cmath>
 #include <cstddef>
 #include <memory>
 #include <string>
@@ -53,6 +56,7 @@ class MerlTable final : public Brdf {
   const float* channel(int c) const { return data_.data() + std::size_t(c) * kBins; }
   float* channel(int c) { return data_.data() + std::size_t(c) * kBins; }
   float value(int c, int i, int j, int k) const { return channel(c)[index(i, j, k)]; }
+  static bool missing(float v) { return std::isnan(v); }
   void set(int i, int j, int k, const Rgb& v);
   void set_missing(int i, int j, int k);
 

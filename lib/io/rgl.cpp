@@ -468,7 +468,7 @@ RglBsdf RglBsdf::read(const std::string& path) {
                " (theta_i) x 3 x rows x columns, at least 2 x 2");
   t->ry = static_cast<std::size_t>(rgb.shape[3]);
   t->rx = static_cast<std::size_t>(rgb.shape[4]);
-  t->rgb = in.floats("rgb", rgb);  // slightly negative values are out-of-gamut colour, clipped in eval
+  t->rgb = in.floats("rgb", rgb);  // negative values (noise, out-of-gamut colour) are kept
 
   // Unused by eval (it drives importance sampling), but a file whose luminance disagrees with its
   // RGB table is inconsistent.
@@ -595,7 +595,7 @@ Rgb RglBsdf::table_value(const Vec3& p, const Vec3& q) const {
       return bilinear(t.rgb.data() + (slice * 3 + std::size_t(c)) * plane, t.rx, t.ry, s[0], s[1]);
     };
     const double a = at(b.s0);
-    v[c] = std::max(0.0, b.w1 == 0.0 ? a : a + b.w1 * (at(b.s1) - a));
+    v[c] = b.w1 == 0.0 ? a : a + b.w1 * (at(b.s1) - a);  // negative entries kept, as Mitsuba does
   }
   if (!t.jacobian) return v;
   const double u_p1 = (phi_p + kPi) / (2.0 * kPi);

@@ -20,8 +20,9 @@
 // `rgb` table, however, does not reproduce `ndf` through the 2015 power iteration (docs/accuracy.md):
 // the acquisition measured `ndf` separately, and the files do not say how.
 //
-// Only isotropic files (phi_i with a single entry) are supported. Negative (out-of-gamut) RGB values
-// of the colour-converted spectra are clipped to zero, as powitacq_rgb does.
+// Only isotropic files (phi_i with a single entry) are supported. Negative RGB values (measurement
+// noise around zero, out-of-gamut colour of the converted spectra) are kept, as Mitsuba's `measured`
+// does: clipping them biases dark channels upward (docs/conventions.md).
 #pragma once
 
 #include <memory>

@@ -104,12 +104,13 @@ Lut make_lut(const FitResult& fit, const Quadrature& quadrature, const std::stri
   m.ndf_error_beckmann = ndf_distance(quadrature, fit.ndf(), Ndf::isotropic(NdfType::beckmann, fit.beckmann.alpha));
   m.tolerance = tolerance;
   // A parametric fit renders with the renderer's own closure: it is recommended when it is nearly as
-  // good. Refined fits compare distances from the measurement (the parametric one at most `tolerance`
-  // farther, relatively, than the tabulated one); the paper's fit compares NDFs (the parametric NDF
-  // within `tolerance` of the tabulated one).
+  // good. Refined fits compare distances from the measurement: the parametric one at most `tolerance`
+  // farther, relatively, or 0.005 (the metric is CIE L*'s lightness / 116: 0.005 is ~0.6 L* units, under
+  // a just-noticeable difference); the paper's fit compares NDFs (the parametric NDF within `tolerance`
+  // of the tabulated one).
   const double error_ggx = fit.refined ? m.error_ggx : m.ndf_error_ggx;
   const double error_beckmann = fit.refined ? m.error_beckmann : m.ndf_error_beckmann;
-  const double bar = fit.refined ? m.error * (1.0 + tolerance) : tolerance;
+  const double bar = fit.refined ? std::max(m.error * (1.0 + tolerance), m.error + 0.005) : tolerance;
   const bool ggx_better = error_ggx <= error_beckmann;
   m.representation = std::min(error_ggx, error_beckmann) <= bar
                          ? (ggx_better ? Representation::ggx : Representation::beckmann)

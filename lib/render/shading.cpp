@@ -10,8 +10,9 @@ ShadingModel::ShadingModel(std::shared_ptr<const Brdf> brdf, std::shared_ptr<con
     : brdf_(std::move(brdf)), proposal_(std::move(proposal)), lobe_weight_(proposal_ && proposal_->can_sample() ? 0.85 : 0.0) {}
 
 Rgb ShadingModel::f(const Vec3& i, const Vec3& o) const {
+  // Negative values (a measurement's noise around zero) are rendered as they are, as Mitsuba does.
   const auto v = brdf_->eval(i, o);
-  return v ? glm::max(*v, Rgb(0.0)) : Rgb(0.0);
+  return v ? *v : Rgb(0.0);
 }
 
 double ShadingModel::pdf(const Vec3& o, const Vec3& i) const {
@@ -45,17 +46,6 @@ std::optional<ShadingModel::Sample> ShadingModel::sample(const Vec3& o, double u
   const double p = pdf(o, i);
   if (!(p > 0.0)) return std::nullopt;
   return Sample{i, f(i, o) * (i.z / p), p};
-}
-
-TabulatedNdf tabulate_ndf(const Ndf& ndf, int resolution) {
-  TabulatedNdf t;
-  t.grid = ThetaGrid{resolution};
-  for (int j = 0; j < t.grid.size(); ++j) {
-    const Vec3 w = spherical_direction(t.grid.theta(j), 0.0);
-    t.ndf.push_back(ndf.D(w));
-    t.sigma.push_back(ndf.sigma(w));
-  }
-  return t;
 }
 
 }  // namespace facetfit

@@ -39,7 +39,4 @@ class ShadingModel {
   double lobe_weight_;  // probability of sampling the microfacet proposal
 };
 
-// The tabulated twin of an analytic NDF: its node values and projected areas, for sampling.
-TabulatedNdf tabulate_ndf(const Ndf& ndf, int resolution = 90);
-
 }  // namespace facetfit

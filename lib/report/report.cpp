@@ -20,7 +20,8 @@ namespace fs = std::filesystem;
 using nlohmann::json;
 
 const std::vector<std::string>& report_representations() {
-  static const std::vector<std::string> names{"tabulated", "ggx", "beckmann"};
+  // lsq: the classical Lambert + GGX + Schlick least-squares fit, what users get today.
+  static const std::vector<std::string> names{"tabulated", "ggx", "beckmann", "lsq"};
   return names;
 }
 
