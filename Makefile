@@ -4,11 +4,12 @@
 
 BUILD      ?= build/release
 BPY_VENV   ?= build/bpy-venv
+MITSUBA_VENV ?= build/mitsuba-venv
 ASAN_BUILD ?= build/asan
 JOBS       ?= $(shell nproc)
 CMAKE_GEN  := -G Ninja
 
-.PHONY: all deps build demo test asan osl-host osl-docs bench accuracy clean
+.PHONY: all deps build demo test asan osl-host mitsuba-host osl-docs bench accuracy clean
 
 all: build
 
@@ -17,7 +18,7 @@ deps:
 
 build: deps
 	@cmake -S . -B $(BUILD) $(CMAKE_GEN) -DCMAKE_BUILD_TYPE=Release -DFACETFIT_WERROR=ON \
-	  -DFACETFIT_BPY_PYTHON=$(CURDIR)/$(BPY_VENV)/bin/python >/dev/null
+	  -DFACETFIT_BPY_PYTHON=$(CURDIR)/$(BPY_VENV)/bin/python -DFACETFIT_MITSUBA_PYTHON=$(CURDIR)/$(MITSUBA_VENV)/bin/python >/dev/null
 	@cmake --build $(BUILD) -j $(JOBS)
 
 demo: build
@@ -36,7 +37,11 @@ asan: deps
 osl-host:
 	@scripts/setup-bpy.sh $(BPY_VENV) >/dev/null
 
-test: build asan osl-host
+# Mitsuba 3's wheel in a venv: the reference evaluation of RGL files (label mitsuba).
+mitsuba-host:
+	@scripts/setup-mitsuba.sh $(MITSUBA_VENV) >/dev/null
+
+test: build asan osl-host mitsuba-host
 	cd $(BUILD) && ctest --output-on-failure -j $(JOBS)
 	cd $(ASAN_BUILD) && ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1 \
 	  ctest --output-on-failure -j $(JOBS) -L 'unit|stress'

@@ -614,4 +614,11 @@ std::optional<Rgb> RglBsdf::eval(const Vec3& i_in, const Vec3& o_in) const {
   return (table_value(i, o) + table_value(o, i)) / (i.z + o.z);
 }
 
+std::optional<RglBsdf::Slices> parse_slices(const std::string& name) {
+  if (name == "view") return RglBsdf::Slices::view;
+  if (name == "symmetric") return RglBsdf::Slices::symmetric;
+  if (name == "light") return RglBsdf::Slices::light;
+  return std::nullopt;
+}
+
 }  // namespace facetfit

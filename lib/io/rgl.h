@@ -106,4 +106,7 @@ class RglBsdf final : public Brdf {
   Slices slices_ = Slices::symmetric;
 };
 
+// "view", "symmetric" or "light"; nullopt otherwise.
+std::optional<RglBsdf::Slices> parse_slices(const std::string& name);
+
 }  // namespace facetfit

@@ -8,6 +8,7 @@
 #include "core/error.h"
 #include "fit/fit.h"
 #include "io/input.h"
+#include "io/rgl.h"
 #include "lut/lut.h"
 #include "model/analytic.h"
 #include "model/builtin.h"
@@ -53,6 +54,8 @@ MaterialDesc parse_material(const std::string& name, const json& j, const std::s
   m.f82 = j.contains("f82") ? vec3(j["f82"], "f82", path) : m.f0;
   m.fresnel = get<std::string>(j, "fresnel", "f82", path);
   if (m.fresnel != "curve" && m.fresnel != "f82") fail(path, "material " + name + ": fresnel must be curve or f82");
+  m.slices = get<std::string>(j, "slices", "view", path);
+  if (!parse_slices(m.slices)) fail(path, "material " + name + ": slices must be view, symmetric or light");
   const auto smith = parse_smith(get<std::string>(j, "smith", "correlated", path));
   if (!smith) fail(path, "material " + name + ": smith must be masking, correlated or separable");
   m.smith = *smith;
@@ -214,14 +217,20 @@ std::shared_ptr<const ShadingModel> load_material(const SceneDesc& scene, const 
   }
   if (m.type == "measured") {
     // The measurement is what is rendered; its fit only proposes directions.
-    auto table = std::make_shared<MerlTable>(load_table(resolve(scene, m.file)));
+    const std::string source = resolve(scene, m.file);
+    auto table = std::make_shared<MerlTable>(load_table(source));
     // The paper's fit alone: a proposal needs the lobe's shape, not the refinement's accuracy.
-    FitOptions proposal_fit;
-    proposal_fit.refine = FitOptions::Refine::none;
-    const Fitter fitter{proposal_fit};
+    const Fitter fitter{FitOptions::paper()};
     const FitResult fit = fitter.fit(*table);
     std::shared_ptr<const TabulatedMicrofacet> proposal;
     if (fit.ok()) proposal = std::make_shared<TabulatedMicrofacet>(MicrofacetTables{fit.ndf(), fit.smith, fit.fresnel(), {}, {}});
+    // RGL files render through their own evaluation (the renderer's o is the viewer's side), not the
+    // MERL-layout table: with view slices this is Mitsuba's `measured` (tests/test_mitsuba.cpp).
+    if (std::filesystem::path(source).extension() == ".bsdf") {
+      auto rgl = std::make_shared<RglBsdf>(RglBsdf::read(source));
+      rgl->set_slices(*parse_slices(m.slices));
+      return std::make_shared<ShadingModel>(rgl, proposal);
+    }
     return std::make_shared<ShadingModel>(table, proposal);
   }
   if (m.type == "lut") {

@@ -39,7 +39,10 @@ struct MaterialDesc {
   std::string file;       // measured: any facetfit input; lut: the LUT; ggx/beckmann: optional LUT to take alpha and Fresnel from
   double alpha = 0.0;     // ggx/beckmann without a LUT
   Rgb f0{0.04}, f82{0.04};
-  std::string fresnel = "curve";  // ggx/beckmann with a LUT: "curve" (the LUT's RGB curve) or "f82" (F82-tint from f0, f82)
+  std::string fresnel = "f82";  // ggx/beckmann with a LUT: "f82" (the fit's F82-tint) or "curve" (the LUT's RGB curve)
+  // measured RGL files: which direction picks the file's slices (io/rgl.h): "view" (Mitsuba's
+  // evaluation, the reference), "symmetric" (both one-sided estimates, reciprocal) or "light".
+  std::string slices = "view";
   Smith smith = Smith::correlated;
   Rgb albedo{0.8};
 };
