@@ -17,6 +17,7 @@ struct FitSettings {
   double iteration_tolerance = 1e-10;
   int max_iterations = 1000;
   std::string refine = "full";
+  std::string merl_bins = "start";
 };
 void add_fit_settings(CLI::App* cmd, FitSettings& settings);
 // The FitOptions they name, or nullopt after reporting a usage error (status 2).

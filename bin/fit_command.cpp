@@ -51,12 +51,13 @@ void run_fit(const FitArgs& args, int& status) {
   for (const std::string& source : inputs) {
     try {
       const auto start = std::chrono::steady_clock::now();
-      const FitResult result = fitter.fit(load_table(source));
+      const FitResult result = fitter.fit(load_table(source, fitter.options().merl_bins));
       const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       if (!result.ok()) {
         report_error(source + ": meaningless fit: " + result.problem);
         ++failures;
       }
+      for (const std::string& w : result.warnings) std::fprintf(stderr, "facetfit: warning: %s: %s\n", source.c_str(), w.c_str());
       if (args.json)
         std::printf("%s\n", fit_record(source, result, seconds).dump().c_str());
       else

@@ -4,6 +4,7 @@
 
 #include "commands.h"
 #include "core/error.h"
+#include "lut/record.h"
 #include "lut/lut.h"
 
 namespace facetfit::cli {
@@ -13,9 +14,6 @@ namespace {
 nlohmann::json info_json(const Lut& lut) {
   const LutMetadata& m = lut.meta;
   const auto rgb = [](const Rgb& c) { return nlohmann::json{c.r, c.g, c.b}; };
-  const auto coat = [](const Coat& c) {
-    return c.present() ? nlohmann::json{{"alpha", c.alpha}, {"f0", c.f0}} : nlohmann::json(nullptr);
-  };
   nlohmann::json j;
   j["metadata"] = {{"format_version", m.format_version}, {"facetfit_version", m.facetfit_version}, {"source", m.source},
                    {"source_sha256", m.source_sha256}, {"resolution", m.resolution}, {"smith", to_string(m.smith)},
@@ -23,11 +21,10 @@ nlohmann::json info_json(const Lut& lut) {
                    {"alpha_beckmann", m.alpha_beckmann}, {"f0", rgb(m.f0)}, {"f82", rgb(m.f82)},
                    {"ndf_error_ggx", m.ndf_error_ggx}, {"ndf_error_beckmann", m.ndf_error_beckmann},
                    {"representation", to_string(m.representation)}, {"tolerance", m.tolerance}, {"sampling", m.sampling},
-                   {"body", rgb(m.body)}, {"coat", coat(m.coat)}, {"error", m.error},
-                   {"error_extraction", m.error_extraction}};
-  const auto parametric = [&](const LutMetadata::Parametric& p, double error) {
-    return nlohmann::json{{"alpha", p.alpha}, {"body", rgb(p.body)}, {"f0", rgb(p.f0)}, {"f82", rgb(p.f82)},
-                          {"coat", coat(p.coat)}, {"error", error}};
+                   {"body", rgb(m.body)}, {"coat", coat_json(m.coat)}, {"error", m.error},
+                   {"error_extraction", m.error_extraction}, {"warnings", m.warnings}};
+  const auto parametric = [](const LutMetadata::Parametric& p, double error) {
+    return parametric_json(p.alpha, p.body, p.f0, p.f82, p.coat, error);
   };
   j["metadata"]["ggx"] = parametric(m.ggx, m.error_ggx);
   j["metadata"]["beckmann"] = parametric(m.beckmann, m.error_beckmann);
@@ -73,8 +70,10 @@ void print_info(const Lut& lut) {
   parametric("ggx", m.ggx);
   parametric("beckmann", m.beckmann);
   parametric("lsq", m.lsq);
-  std::printf("representation  %s (tolerance %.4f)\nsampling tables %s\n\n", to_string(m.representation), m.tolerance,
+  std::printf("representation  %s (tolerance %.4f)\nsampling tables %s\n", to_string(m.representation), m.tolerance,
               m.sampling ? "yes" : "no (--eval-only)");
+  for (const std::string& w : m.warnings) std::printf("warning         %s\n", w.c_str());
+  std::printf("\n");
   std::printf("%4s %8s %10s %14s %14s %10s\n", "node", "u", "theta_deg", "ndf", "slope_pdf", "sigma");
   const TabulatedNdf& ndf = lut.tables.ndf;
   for (int k = 0; k < ndf.grid.size(); ++k) {

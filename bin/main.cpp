@@ -3,6 +3,7 @@
 
 #include "commands.h"
 #include "core/error.h"
+#include "io/input.h"
 
 namespace facetfit::cli {
 
@@ -22,6 +23,10 @@ void add_fit_settings(CLI::App* cmd, FitSettings& s) {
                   "full: refine body, NDF and Fresnel, and fit GGX and Beckmann, on the whole measurement; "
                   "none: the paper's method alone (power iteration on back-scattering, Fresnel pass, moment alphas)")
       ->capture_default_str();
+  cmd->add_option("--merl-bins", s.merl_bins,
+                  "Which point of its bin a MERL file's value stands for: start (the lower edge, what facetfit "
+                  "writes) or center")
+      ->capture_default_str();
 }
 
 std::optional<FitOptions> fit_options(const FitSettings& s, int& status) {
@@ -36,6 +41,13 @@ std::optional<FitOptions> fit_options(const FitSettings& s, int& status) {
   options.resolution = s.resolution;
   options.tolerance = s.iteration_tolerance;
   options.max_iterations = s.max_iterations;
+  const auto merl_bins = parse_bin_point(s.merl_bins);
+  if (!merl_bins) {
+    report_error("--merl-bins " + s.merl_bins + ": must be start or center");
+    status = 2;
+    return std::nullopt;
+  }
+  options.merl_bins = *merl_bins;
   const auto refine = parse_refine(s.refine);
   if (!refine) {
     report_error("--refine " + s.refine + ": must be none or full");

@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include "fit/ground_truth.h"
+#include "io/input.h"
+#include "model/analytic.h"
 #include "test_util.h"
 
 namespace facetfit {
@@ -43,6 +45,36 @@ std::string case_name(const testing::TestParamInfo<GroundTruthCase>& info) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Standard, GroundTruth, testing::ValuesIn(standard_ground_truth_cases()), case_name);
+
+// MERL files written at the bins' lower edges or at their centres come back within 1% of alpha and
+// 0.005 of F0 when read with the matching --merl-bins; read with the other one, they do not (the
+// convention matters: docs/conventions.md).
+TEST(MerlBins, GroundTruthWrittenEitherWayComesBack) {
+  test::TempDir dir;
+  const Fitter fitter(FitOptions::paper());
+  for (const double alpha : {0.1, 0.4, 0.7}) {
+    const MicrofacetBrdf truth(Ndf::isotropic(NdfType::ggx, alpha), Smith::correlated, Fresnel::schlick(Rgb(0.04)));
+    for (const auto written : {MerlTable::BinPoint::start, MerlTable::BinPoint::center}) {
+      const std::string file = dir.file(std::string(to_string(written)) + ".binary");
+      MerlTable::tabulate(truth, written).write(file);
+      for (const auto read : {MerlTable::BinPoint::start, MerlTable::BinPoint::center}) {
+        const FitResult r = fitter.fit(load_table(file, read));
+        ASSERT_TRUE(r.ok()) << r.problem;
+        const double error = std::abs(r.alpha_ggx / alpha - 1.0);
+        SCOPED_TRACE(std::string("alpha ") + std::to_string(alpha) + ", written at " + to_string(written) +
+                     ", read at " + to_string(read));
+        if (read == written) {
+          EXPECT_LT(error, 0.01) << "alpha " << r.alpha_ggx;
+          EXPECT_NEAR(r.f0.g, 0.04, 0.005);
+        } else if (alpha >= 0.4) {
+          EXPECT_GT(error, 0.02) << "alpha " << r.alpha_ggx;
+        }
+        std::printf("alpha %.2f written %-6s read %-6s: alpha %.4f (%+.1f%%), F0 %.4f\n", alpha, to_string(written),
+                    to_string(read), r.alpha_ggx, 100.0 * (r.alpha_ggx / alpha - 1.0), r.f0.g);
+      }
+    }
+  }
+}
 
 }  // namespace
 }  // namespace facetfit

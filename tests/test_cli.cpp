@@ -69,7 +69,14 @@ TEST(Cli, JsonHasExactlyTheDocumentedKeys) {
   const auto j = nlohmann::json::parse(r.out);
   std::vector<std::string> keys;
   for (const auto& item : j.items()) keys.push_back(item.key());
-  EXPECT_EQ(keys, (std::vector<std::string>{"alpha_beckmann", "alpha_ggx", "f0", "f82", "iterations", "residual", "seconds", "source"}));
+  EXPECT_EQ(keys, (std::vector<std::string>{"alpha_beckmann", "alpha_ggx", "beckmann", "body", "coat", "error",
+                                            "error_extraction", "f0", "f82", "ggx", "iterations", "lsq", "refine",
+                                            "residual", "seconds", "source", "warnings"}));
+  for (const char* fit : {"ggx", "beckmann", "lsq"}) {
+    std::vector<std::string> sub;
+    for (const auto& item : j[fit].items()) sub.push_back(item.key());
+    EXPECT_EQ(sub, (std::vector<std::string>{"alpha", "body", "coat", "error", "f0", "f82"})) << fit;
+  }
   EXPECT_NEAR(j["alpha_beckmann"].get<double>(), 0.30, 0.30 * 0.005);
   EXPECT_EQ(j["f0"].size(), 3u);
   EXPECT_EQ(j["source"], "builtin:copper-beckmann-0.30");

@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "core/error.h"
+#include "fit/plausibility.h"
 #include "fit/roughness.h"
 #include "model/fresnel.h"
 #include "model/tabulated.h"
@@ -152,6 +153,7 @@ FitResult Fitter::fit(const MerlTable& table) const {
   if (!std::isfinite(result.alpha_ggx) || !std::isfinite(result.alpha_beckmann) || !finite(result.f0) ||
       !finite(result.f82) || !finite(result.body()))
     result.problem = "the fit produced non-finite parameters";
+  if (result.ok()) result.warnings = plausibility_warnings(table, result);
   return result;
 }
 

@@ -7,6 +7,7 @@
 #pragma once
 
 #include <optional>
+#include <vector>
 #include <string>
 
 #include "fit/extract.h"
@@ -27,6 +28,8 @@ struct FitOptions {
   // material; none: the paper's method alone, a few milliseconds.
   enum class Refine { none, full };
   Refine refine = Refine::full;
+  // Which point of its bins a MERL file's values stand for, when the input is read (io/merl.h).
+  MerlTable::BinPoint merl_bins = MerlTable::BinPoint::start;
 
   // The paper's method alone (Refine::none), otherwise the defaults.
   static FitOptions paper() {
@@ -54,6 +57,7 @@ struct FitResult {
   Smith smith = Smith::correlated;  // the model the NDF is consistent with
   bool refined = false;             // Refine::full: body, parametric fits and errors are measured
   std::string problem;  // empty for a meaningful fit; otherwise why it is not one
+  std::vector<std::string> warnings;  // implausible values in the measurement or the fit (fit/plausibility.h)
 
   bool ok() const { return problem.empty(); }
   const TabulatedNdf& ndf() const { return lobe.ndf; }

@@ -26,7 +26,15 @@ std::string resolve_source(const std::string& base_dir, const std::string& sourc
   return (fs::path(base_dir) / source).lexically_normal().string();
 }
 
-MerlTable load_table(const std::string& source) {
+std::optional<MerlTable::BinPoint> parse_bin_point(const std::string& name) {
+  if (name == "start") return MerlTable::BinPoint::start;
+  if (name == "center") return MerlTable::BinPoint::center;
+  return std::nullopt;
+}
+
+const char* to_string(MerlTable::BinPoint at) { return at == MerlTable::BinPoint::start ? "start" : "center"; }
+
+MerlTable load_table(const std::string& source, MerlTable::BinPoint merl_bins) {
   if (is_builtin(source)) {
     const std::string name = source.substr(std::string(kBuiltinPrefix).size());
     const auto material = find_builtin(name);
@@ -34,7 +42,7 @@ MerlTable load_table(const std::string& source) {
     return MerlTable::tabulate(*material->brdf);
   }
   const fs::path path(source);
-  if (path.extension() == ".binary") return MerlTable::read(source);
+  if (path.extension() == ".binary") return MerlTable::read(source, merl_bins);
   if (path.extension() == ".bsdf") return MerlTable::tabulate(RglBsdf::read(source));
   std::error_code ec;
   if (fs::is_directory(path, ec)) fail(source, "is a folder with no supported material file");

@@ -5,6 +5,7 @@
 // supported files they hold, sorted by name.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -14,8 +15,13 @@ namespace facetfit {
 
 constexpr const char* kBuiltinPrefix = "builtin:";
 
-// Loads one source. Throws Error("<source>: <problem>").
-MerlTable load_table(const std::string& source);
+// Loads one source. Throws Error("<source>: <problem>"). `merl_bins`: which point of its bins a MERL
+// file's values stand for (io/merl.h).
+MerlTable load_table(const std::string& source, MerlTable::BinPoint merl_bins = MerlTable::BinPoint::start);
+
+// "start" or "center"; nullopt otherwise.
+std::optional<MerlTable::BinPoint> parse_bin_point(const std::string& name);
+const char* to_string(MerlTable::BinPoint at);
 
 // Folders become the supported files inside them, globs their matches; `builtin:` alone becomes every
 // built-in material.

@@ -34,12 +34,22 @@ class MerlTable final : public Brdf {
     linear,   // trilinear in (sqrt(theta_h), theta_d, phi_d) bin coordinates, periodic in phi_d
   };
 
+  // Which point of its bin a value stands for. MERL's format does not fix it: its reference reader
+  // truncates (a value covers [i, i+1) in bin coordinates), and writers tabulate either at the lower
+  // edge or at the centre. In memory a table is always at the lower edges (theta_h(i), theta_d(j),
+  // phi_d(k) below); a file written at centres is resampled on reading (docs/conventions.md).
+  enum class BinPoint { start, center };
+
   MerlTable();  // every bin missing
 
   // Throws Error("<path>: <problem>") for anything that is not a complete, finite MERL table.
-  static MerlTable read(const std::string& path);
-  // Tabulates any BRDF at the bin positions; pairs below the horizon become missing bins.
-  static MerlTable tabulate(const Brdf& brdf);
+  static MerlTable read(const std::string& path, BinPoint at = BinPoint::start);
+  // Tabulates any BRDF at the bins' lower edges (`center`: at their centres, as a table for a file of
+  // that convention); pairs below the horizon become missing bins.
+  static MerlTable tabulate(const Brdf& brdf, BinPoint at = BinPoint::start);
+  // The table of values at the bins' centres moved to their lower edges: each value the mean of the
+  // valid centre values around it (2 per axis; theta axes clamp at 0, phi_d wraps with period pi).
+  MerlTable centres_to_edges() const;
   // Writes MERL layout through a temporary file; missing bins are written as -1.
   void write(const std::string& path) const;
 
@@ -47,9 +57,10 @@ class MerlTable final : public Brdf {
   Lookup lookup() const { return lookup_; }
   void set_lookup(Lookup lookup) { lookup_ = lookup; }
 
-  static double theta_h(int i);
-  static double theta_d(int j);
-  static double phi_d(int k);
+  // Positions in bin coordinates (i + 0.5: a bin's centre).
+  static double theta_h(double i);
+  static double theta_d(double j);
+  static double phi_d(double k);
   static std::size_t index(int i, int j, int k) { return std::size_t(k) + kPhiD * (std::size_t(j) + kThetaD * std::size_t(i)); }
 
   // Channel c (0 red, 1 green, 2 blue) as kBins contiguous values in index() order.

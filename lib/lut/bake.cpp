@@ -29,6 +29,7 @@ std::string bake_cache_key(const std::string& source_sha256, const BakeOptions& 
   k["iteration_tolerance"] = o.fit.tolerance;
   k["max_iterations"] = o.fit.max_iterations;
   k["refine"] = to_string(o.fit.refine);
+  k["merl_bins"] = to_string(o.fit.merl_bins);
   k["tolerance"] = o.tolerance;
   k["sampling"] = o.with_sampling;
   const std::string text = k.dump();
@@ -78,7 +79,7 @@ BakeOutcome bake_material(const std::string& source, const std::string& name, co
       }
     });
     try {
-      table = load_table(source);
+      table = load_table(source, options.fit.merl_bins);
     } catch (const Error&) {
       hashing.wait();
       throw;

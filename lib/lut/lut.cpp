@@ -116,6 +116,7 @@ Lut make_lut(const FitResult& fit, const Quadrature& quadrature, const std::stri
                          ? (ggx_better ? Representation::ggx : Representation::beckmann)
                          : Representation::tabulated;
   m.sampling = with_sampling;
+  m.warnings = fit.warnings;
   return lut;
 }
 
@@ -179,6 +180,12 @@ void write_lut(const std::string& path, const Lut& lut) {
   spec.attribute(key("error_lsq"), float(m.error_lsq));
   spec.attribute(key("error_extraction"), float(m.error_extraction));
   spec.attribute(key("sampling"), m.sampling ? 1 : 0);
+  // One line per warning; absent when there is none.
+  if (!m.warnings.empty()) {
+    std::string text;
+    for (const std::string& w : m.warnings) text += (text.empty() ? "" : "\n") + w;
+    spec.attribute(key("warnings"), text);
+  }
 
   write_image_atomic(path, spec, pixels.data());
 }
@@ -220,6 +227,11 @@ Lut read_lut(const std::string& path) {
   m.ndf_error_beckmann = spec.get_float_attribute(key("ndf_error_beckmann"));
   m.tolerance = spec.get_float_attribute(key("tolerance"));
   m.sampling = spec.get_int_attribute(key("sampling")) != 0;
+  for (std::string text = spec.get_string_attribute(key("warnings")); !text.empty();) {
+    const std::size_t end = text.find('\n');
+    m.warnings.push_back(text.substr(0, end));
+    text = end == std::string::npos ? "" : text.substr(end + 1);
+  }
   if (version == 1) {  // no body; the parametric fits are the moment alphas with the curve's f0 and f82
     m.ggx = {m.alpha_ggx, Rgb(0.0), m.f0, m.f82, {}};
     m.beckmann = {m.alpha_beckmann, Rgb(0.0), m.f0, m.f82, {}};

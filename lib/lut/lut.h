@@ -47,6 +47,7 @@ struct LutMetadata {
   Representation representation = Representation::tabulated;
   double tolerance = 0.0;  // the NDF error a parametric fit was allowed when choosing the representation
   bool sampling = true;    // sampling tables present (absent with --eval-only)
+  std::vector<std::string> warnings;  // implausible values found when fitting (fit/plausibility.h)
 };
 
 // Row layout of the texture; texel x of row y is at s = (x + 0.5) / width, t = (y + 0.5) / height.

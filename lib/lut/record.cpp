@@ -2,6 +2,15 @@
 
 namespace facetfit {
 
+nlohmann::json coat_json(const Coat& coat) {
+  return coat.present() ? nlohmann::json{{"alpha", coat.alpha}, {"f0", coat.f0}} : nlohmann::json(nullptr);
+}
+
+nlohmann::json parametric_json(double alpha, const Rgb& body, const Rgb& f0, const Rgb& f82, const Coat& coat, double error) {
+  const auto rgb = [](const Rgb& c) { return nlohmann::json{c.r, c.g, c.b}; };
+  return {{"alpha", alpha}, {"body", rgb(body)}, {"f0", rgb(f0)}, {"f82", rgb(f82)}, {"coat", coat_json(coat)}, {"error", error}};
+}
+
 nlohmann::json fit_record(const std::string& source, const FitResult& fit, double seconds) {
   const auto rgb = [](const Rgb& c) { return nlohmann::json{c.r, c.g, c.b}; };
   nlohmann::json j;
@@ -11,6 +20,14 @@ nlohmann::json fit_record(const std::string& source, const FitResult& fit, doubl
     j["alpha_beckmann"] = fit.alpha_beckmann;
     j["f0"] = rgb(fit.f0);
     j["f82"] = rgb(fit.f82);
+    j["refine"] = fit.refined ? "full" : "none";
+    j["body"] = rgb(fit.body());
+    j["coat"] = coat_json(fit.lobe.coat);
+    j["error"] = fit.error;
+    j["error_extraction"] = fit.error_extraction;
+    for (const auto& [name, p] : {std::pair<const char*, const ParametricFit*>{"ggx", &fit.ggx}, {"beckmann", &fit.beckmann}, {"lsq", &fit.lsq}})
+      j[name] = parametric_json(p->alpha, p->body, p->f0, p->f82, p->coat, p->error);
+    j["warnings"] = fit.warnings;
   } else {
     for (const char* k : {"alpha_ggx", "alpha_beckmann", "f0", "f82"}) j[k] = nullptr;
   }

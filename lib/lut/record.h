@@ -8,8 +8,13 @@
 
 namespace facetfit {
 
-// Keys: source, alpha_ggx, alpha_beckmann, f0, f82, iterations, residual, seconds. A meaningless fit
-// has null parameters (JSON has no NaN).
+// Keys: source, alpha_ggx, alpha_beckmann, f0, f82 (of the tabulated representation), refine, body,
+// coat, error, error_extraction, ggx / beckmann / lsq (parametric_json), warnings, iterations, residual,
+// seconds. A meaningless fit has null parameters (JSON has no NaN).
 nlohmann::json fit_record(const std::string& source, const FitResult& fit, double seconds);
+
+// A coat as {alpha, f0}, null when absent; a parametric fit as {alpha, body, f0, f82, coat, error}.
+nlohmann::json coat_json(const Coat& coat);
+nlohmann::json parametric_json(double alpha, const Rgb& body, const Rgb& f0, const Rgb& f82, const Coat& coat, double error);
 
 }  // namespace facetfit

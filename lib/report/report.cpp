@@ -159,6 +159,15 @@ std::string report_html(const json& report) {
     h << "</tr>";
   }
   h << "</table>";
+  // Implausible measurements and fits (fit/plausibility.h), per material.
+  bool any_warning = false;
+  for (const json& m : report["materials"])
+    for (const json& w : m.value("warnings", json::array())) {
+      if (!any_warning) h << "<h2>Warnings</h2><ul>";
+      any_warning = true;
+      h << "<li>" << html_escape(m["name"].get<std::string>()) << ": " << html_escape(w.get<std::string>()) << "</li>";
+    }
+  if (any_warning) h << "</ul>";
   if (!report["failures"].empty()) {
     h << "<h2 class='bad'>Failures</h2><ul>";
     for (const json& f : report["failures"]) h << "<li>" << html_escape(f["error"].get<std::string>()) << "</li>";
@@ -245,6 +254,7 @@ json run_report(const ReportOptions& o) {
         entry["source"] = source;
         entry["key"] = key;
         entry["representation"] = baked.record["representation"];
+        entry["warnings"] = baked.record.value("warnings", json::array());
         entry["seconds"]["bake"] = bake_seconds;
         const auto render_as = [&](const std::string& type, const std::string& file) {
           MaterialDesc m;

@@ -1,0 +1,89 @@
+#include "fit/plausibility.h"
+
+#include <cmath>
+#include <cstdio>
+
+#include "fit/fit.h"
+#include "model/parametric.h"
+#include "model/tabulated.h"
+
+namespace facetfit {
+
+namespace {
+
+std::string format(const char* fmt, double a, double b = 0.0, double c = 0.0) {
+  char buf[200];
+  std::snprintf(buf, sizeof buf, fmt, a, b, c);
+  return buf;
+}
+
+const char* kChannel[3] = {"red", "green", "blue"};
+
+// The largest channel value of `v` above `limit`: (channel, value), or channel -1.
+std::pair<int, double> above(const Rgb& v, double limit) {
+  int c = -1;
+  double worst = limit;
+  for (int k = 0; k < 3; ++k)
+    if (v[k] > worst) worst = v[k], c = k;
+  return {c, worst};
+}
+
+}  // namespace
+
+Rgb directional_albedo(const Brdf& brdf, const Vec3& o, int n) {
+  Rgb sum(0.0);
+  for (int a = 0; a < n; ++a)
+    for (int b = 0; b < n; ++b) {
+      // Cosine-weighted: r = sqrt(u1) on the unit disk, so each cell holds cos(theta) d(omega) = pi / n^2.
+      const double r = std::sqrt((a + 0.5) / n), phi = 2.0 * kPi * (b + 0.5) / n;
+      const Vec3 i(r * std::cos(phi), r * std::sin(phi), std::sqrt(std::max(0.0, 1.0 - r * r)));
+      if (const auto f = brdf.eval(i, o)) sum += *f;
+    }
+  return sum * (kPi / double(n * n));
+}
+
+std::vector<std::string> plausibility_warnings(const MerlTable& table, const FitResult& fit) {
+  std::vector<std::string> out;
+  // Negative measurements, per channel.
+  for (int c = 0; c < 3; ++c) {
+    std::size_t negative = 0, valid = 0;
+    const float* v = table.channel(c);
+    for (std::size_t n = 0; n < MerlTable::kBins; ++n) {
+      if (MerlTable::missing(v[n])) continue;
+      ++valid;
+      negative += v[n] < 0.0f;
+    }
+    if (negative > 0)
+      out.push_back(format("%.1f%% of the measured values are negative in the ", 100.0 * double(negative) / double(valid)) +
+                    kChannel[c] + " channel (noise around zero, kept as measurements)");
+  }
+  // The Fresnel curve of the tabulated representation.
+  for (int j = 0; j < FresnelCurve::kSize; ++j) {
+    const auto [c, v] = above(fit.fresnel().value[std::size_t(j)], 1.0);
+    if (c < 0) continue;
+    out.push_back(format("Fresnel factor above 1: %.3f at theta_d %.0f degrees", v, FresnelCurve::theta_d(j) * 180.0 / kPi) +
+                  " (" + kChannel[c] + "; first such angle)");
+    break;
+  }
+  if (fit.refined)
+    for (const auto& [name, p] : {std::pair<const char*, const ParametricFit*>{"ggx", &fit.ggx}, {"beckmann", &fit.beckmann}, {"lsq", &fit.lsq}}) {
+      const auto [c0, f0] = above(p->f0, 1.0);
+      const auto [c82, f82] = above(p->f82, 1.0);
+      if (c0 >= 0) out.push_back(std::string(name) + format(" fit: f0 above 1 (%.3f, ", f0) + kChannel[c0] + ")");
+      if (c82 >= 0) out.push_back(std::string(name) + format(" fit: f82 above 1 (%.3f, ", f82) + kChannel[c82] + ")");
+    }
+  // Directional albedo of the measurement and of the tabulated representation.
+  const TabulatedMicrofacet model(MicrofacetTables{fit.ndf(), fit.smith, fit.fresnel(), fit.body(), fit.lobe.coat}, {});
+  for (const auto& [what, brdf] : {std::pair<const char*, const Brdf*>{"measurement", &table}, {"tabulated fit", &model}}) {
+    for (const double degrees : {0.0, 30.0, 60.0, 80.0}) {
+      const auto [c, v] = above(directional_albedo(*brdf, spherical_direction(degrees * kPi / 180.0, 0.0)), 1.0);
+      if (c < 0) continue;
+      out.push_back(std::string("directional albedo of the ") + what + format(" above 1: %.3f at theta %.0f degrees", v, degrees) +
+                    " (" + kChannel[c] + ")");
+      break;
+    }
+  }
+  return out;
+}
+
+}  // namespace facetfit
