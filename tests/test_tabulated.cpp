@@ -185,6 +185,54 @@ TEST_P(Sampling, ChiSquareAgainstPdf) {
 INSTANTIATE_TEST_SUITE_P(Incidence, Sampling,
                          testing::Combine(testing::Values(0.05, 0.5), testing::Values(0.0, 30.0, 60.0, 85.0)));
 
+// The mixture of a model with a body and a coat (lobe, cosine, GGX visible normals), in the space of i:
+// the samples against pdf(), bins uniform in cos(theta_i) and phi_i, integrated 8 x 8 finer.
+TEST(Sampling, ChiSquareOfTheBodyLobeCoatMixture) {
+  MicrofacetTables tables = fitted_tables(NdfType::ggx, 0.5, Fresnel::schlick(Rgb(0.04)));
+  tables.body = Rgb(0.4, 0.2, 0.1);
+  tables.coat = Coat{0.25, 0.05};
+  const TabulatedMicrofacet model(tables);
+  ASSERT_GT(model.body_weight(), 0.3);
+  ASSERT_GT(model.coat_weight(), 0.1);
+  for (const double theta_o : {0.0, 40.0, 75.0}) {
+    SCOPED_TRACE(theta_o);
+    const Vec3 o = direction_at(theta_o);
+    constexpr int kCos = 32, kPhi = 48, kSub = 8;
+    const std::size_t outside = std::size_t(kCos) * kPhi;
+    std::vector<double> observed(outside + 1, 0.0), expected(outside + 1, 0.0);
+    std::mt19937 rng(9);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    const int n = 300000;
+    for (int k = 0; k < n; ++k) {
+      const auto s = model.sample(o, u(rng), u(rng));
+      if (!s) {
+        observed[outside] += 1;
+        continue;
+      }
+      double phi = std::atan2(s->i.y, s->i.x);
+      if (phi < 0) phi += 2 * kPi;
+      const int a = std::min(kCos - 1, int(s->i.z * kCos)), b = std::min(kPhi - 1, int(phi / (2 * kPi) * kPhi));
+      observed[std::size_t(a * kPhi + b)] += 1;
+    }
+    double total = 0.0;
+    for (int a = 0; a < kCos; ++a)
+      for (int b = 0; b < kPhi; ++b) {
+        double sum = 0.0;
+        const double dc = 1.0 / (kCos * kSub), dphi = 2 * kPi / (kPhi * kSub);
+        for (int p = 0; p < kSub; ++p)
+          for (int q = 0; q < kSub; ++q) {
+            const double c = (a * kSub + p + 0.5) * dc, sn = std::sqrt(1 - c * c), phi = (b * kSub + q + 0.5) * dphi;
+            sum += model.pdf(o, Vec3(sn * std::cos(phi), sn * std::sin(phi), c)) * dc * dphi;
+          }
+        expected[std::size_t(a * kPhi + b)] = sum * n;
+        total += sum;
+      }
+    expected[outside] = std::max(0.0, (1.0 - total) * n);
+    const test::ChiSquareResult r = test::chi_square(observed, expected);
+    EXPECT_GT(r.p_value, 1e-3) << "chi2 " << r.statistic << " dof " << r.dof;
+  }
+}
+
 TEST(Sampling, ChiSquareRejectsAWrongPdf) {
   // Negative control: samples of one material against the pdf of a 10% rougher one must fail.
   const TabulatedMicrofacet sampler(fitted_tables(NdfType::ggx, 0.30, Fresnel::one()));

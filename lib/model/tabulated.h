@@ -3,8 +3,10 @@
 //   f(i, o) = body / pi + F(theta_d) D(h) G2(i, o) / (4 cos(theta_i) cos(theta_o)) + coat(i, o)
 //
 // with D and sigma (hence G1 = cos / sigma) splines on the theta grid, F the RGB Fresnel curve and G2
-// the Smith model the fit was made with. sample() draws the distribution of visible normals seen from
-// o, D_o(h) = max(0, o.h) D(h) / sigma(o), and reflects o about h; docs/sampling.md says why and how.
+// the Smith model the fit was made with. sample() picks one of the three parts with probabilities set
+// by their albedos (lobe_weight() and the rest), then draws: for the lobe the distribution of visible
+// normals seen from o, D_o(h) = max(0, o.h) D(h) / sigma(o), reflecting o about h (docs/sampling.md);
+// for the body the cosine; for the coat its GGX visible normals. pdf() is the mixture's.
 #pragma once
 
 #include <optional>
@@ -54,7 +56,8 @@ class TabulatedMicrofacet final : public Brdf {
     Rgb weight;  // f(i, o) cos(theta_i) / pdf
     double pdf;  // per steradian of i
   };
-  // Samples a light direction i for the view direction o from two uniform numbers in [0, 1). nullopt
+  // Samples a light direction i for the view direction o from two uniform numbers in [0, 1) (u1 also
+  // picks the part: its first lobe_weight() selects the lobe, the next body_weight() the body). nullopt
   // when the reflected direction falls below the horizon (the sample carries no energy), when o is at
   // or below the horizon, or when the model has no sampling tables.
   std::optional<Sample> sample(const Vec3& o, double u1, double u2) const;
@@ -67,8 +70,15 @@ class TabulatedMicrofacet final : public Brdf {
   double D(const Vec3& h) const;
   double g1(const Vec3& w) const;
   Rgb fresnel(double cos_d) const;
-  // Density of visible normals h seen from o, as sample() draws them, per steradian of h.
+  // Density of the lobe's visible normals h seen from o, per steradian of h.
   double visible_normal_pdf(const Vec3& o, const Vec3& h) const;
+  // Density of the lobe's part of sample() alone, per steradian of i.
+  double lobe_pdf(const Vec3& o, const Vec3& i) const;
+  // The probabilities of the three parts (they sum to 1): luminance of the body albedo, of F(0) for
+  // the lobe and the coat's f0, the last two at least 0.1 so that a dark lobe is still found.
+  double lobe_weight() const { return weight_lobe_; }
+  double body_weight() const { return weight_body_; }
+  double coat_weight() const { return 1.0 - weight_lobe_ - weight_body_; }
 
   const MicrofacetTables& tables() const { return tables_; }
   const VisibleNormalTables& sampling() const { return sampling_; }
@@ -78,6 +88,9 @@ class TabulatedMicrofacet final : public Brdf {
   MicrofacetTables tables_;
   VisibleNormalTables sampling_;
   std::vector<double> cos_nodes_;  // cos(theta_j)
+  double weight_lobe_ = 1.0, weight_body_ = 0.0;
+
+  std::optional<Vec3> lobe_direction(const Vec3& o, double u1, double u2) const;
 };
 
 }  // namespace facetfit
