@@ -23,6 +23,11 @@ struct FacetfitLut {
   int resolution;  // R: nodes 0..R
   int smith;       // 0 masking, 1 correlated, 2 separable
   int sampling;    // sampling rows present
+  color body;      // Lambertian albedo under the lobe (format 2; black in format 1)
+  float coat_alpha;  // GGX clear coat over it, grey Schlick f0; alpha 0: none
+  float coat_f0;
+  float weight_lobe;  // probabilities of the sampler's parts: lobe, body, then coat (lib/model/tabulated.h)
+  float weight_body;
   int ok;
 };
 
@@ -41,13 +46,17 @@ int facetfit_code(string file, string attribute, string name0, string name1, str
 int facetfit_smith_code(string file) { return facetfit_code(file, "smith", "masking", "correlated", "separable"); }
 int facetfit_representation_code(string file) { return facetfit_code(file, "representation", "tabulated", "ggx", "beckmann"); }
 
-// Opens a LUT (format 1 or 2; the body and coat of format 2, written by --refine full, are not read yet:
-// issue 10): its size and metadata. ok = 0 when the file is missing, is not a facetfit LUT, or does
-// not say its Smith model in a way this renderer can read.
+// Opens a LUT (format 1 or 2): its size and metadata, the body and coat of format 2. ok = 0 when the
+// file is missing, is not a facetfit LUT, or does not say its Smith model in a way this renderer can read.
 FacetfitLut facetfit_open(string file) {
   FacetfitLut lut;
   lut.file = file;
   lut.ok = 0;
+  lut.body = color(0);
+  lut.coat_alpha = 0.0;
+  lut.coat_f0 = 0.0;
+  lut.weight_lobe = 1.0;
+  lut.weight_body = 0.0;
   int res[2] = {0, 0};
   int version = 0, resolution = 0, sampling = 0;
   if (gettextureinfo(file, "resolution", res) && gettextureinfo(file, "facetfit:format_version", version) &&
@@ -59,6 +68,21 @@ FacetfitLut facetfit_open(string file) {
     lut.sampling = sampling;
     lut.smith = facetfit_smith_code(file);
     lut.ok = lut.smith >= 0 && lut.smith <= 2;
+    if (version == 2) {
+      gettextureinfo(file, "facetfit:body", lut.body);
+      gettextureinfo(file, "facetfit:coat_alpha", lut.coat_alpha);
+      gettextureinfo(file, "facetfit:coat_f0", lut.coat_f0);
+      if (!(lut.coat_alpha > 0.0 && lut.coat_f0 > 0.0)) lut.coat_alpha = lut.coat_f0 = 0.0;
+    }
+    // The sampler's parts by albedo, as the library weighs them: lobe F(0), body, coat f0; the lobe and
+    // the coat at least 0.1.
+    color f0 = texture(file, 0.5 / lut.width, (FACETFIT_FRESNEL_ROW + 0.5) / lut.height, "interp", "linear", "wrap", "clamp",
+                       "width", 0.0);  // F(0): the Fresnel row's first texel
+    float lobe = max(0.2126 * f0[0] + 0.7152 * f0[1] + 0.0722 * f0[2], 0.1);
+    float body = max(0.2126 * lut.body[0] + 0.7152 * lut.body[1] + 0.0722 * lut.body[2], 0.0);
+    float coat = lut.coat_alpha > 0.0 ? max(lut.coat_f0, 0.1) : 0.0;
+    lut.weight_lobe = lobe / (lobe + body + coat);
+    lut.weight_body = body / (lobe + body + coat);
   }
   return lut;
 }
@@ -188,13 +212,37 @@ color facetfit_fresnel(FacetfitLut lut, float theta_d) {
   return texture(lut.file, s, t, "interp", "linear", "wrap", "clamp", "width", 0.0);
 }
 
-// f(i, o) in 1/sr.
+// ---- the clear coat: GGX, grey Schlick Fresnel, height-correlated Smith (lib/model/coat.h) ----
+
+// sin^2 as x^2 + y^2, not 1 - z^2: near the normal, where a sharp coat lives, float has no digits left
+// in 1 - z^2 (the arguments are unit vectors).
+float facetfit_coat_D(float alpha, vector h) {
+  if (h[2] <= 0.0) return 0.0;
+  float a2 = alpha * alpha, den = a2 * h[2] * h[2] + (h[0] * h[0] + h[1] * h[1]);  // cos^2 (a^2 + tan^2)
+  return a2 / (FACETFIT_PI * den * den);
+}
+
+float facetfit_coat_lambda(float alpha, vector w) {
+  return 0.5 * (sqrt(1.0 + alpha * alpha * (w[0] * w[0] + w[1] * w[1]) / (w[2] * w[2])) - 1.0);
+}
+
+float facetfit_coat_eval(FacetfitLut lut, vector i, vector o) {
+  if (lut.coat_alpha <= 0.0 || i[2] <= 0.0 || o[2] <= 0.0) return 0.0;
+  vector h = normalize(i + o);
+  float m = 1.0 - clamp(dot(i, h), 0.0, 1.0), m5 = m * m * m * m * m;
+  float fresnel = lut.coat_f0 + (1.0 - lut.coat_f0) * m5;
+  float g2 = 1.0 / (1.0 + facetfit_coat_lambda(lut.coat_alpha, i) + facetfit_coat_lambda(lut.coat_alpha, o));
+  return fresnel * facetfit_coat_D(lut.coat_alpha, h) * g2 / (4.0 * i[2] * o[2]);
+}
+
+// f(i, o) in 1/sr: body + lobe + coat.
 color facetfit_eval(FacetfitLut lut, vector i, vector o) {
   if (i[2] <= 0.0 || o[2] <= 0.0) return color(0);
   vector h = normalize(i + o);
   float g2 = facetfit_G2(lut, facetfit_G1(lut, i), facetfit_G1(lut, o));
   float theta_d = facetfit_angle(length(cross(i, h)), dot(i, h));
-  return facetfit_fresnel(lut, theta_d) * (facetfit_D(lut, h) * g2 / (4.0 * i[2] * o[2]));
+  return lut.body / FACETFIT_PI + facetfit_fresnel(lut, theta_d) * (facetfit_D(lut, h) * g2 / (4.0 * i[2] * o[2])) +
+         color(facetfit_coat_eval(lut, i, o));
 }
 
 // ---- sampling the visible normals (docs/sampling.md) ----
@@ -238,11 +286,27 @@ float facetfit_visible_normal_pdf(FacetfitLut lut, vector o, vector h) {
   return total > 0.0 ? mass / band * oh / total : 0.0;
 }
 
-float facetfit_pdf(FacetfitLut lut, vector o, vector i) {
+// Density of the lobe's part of facetfit_sample alone, per steradian of i.
+float facetfit_lobe_pdf(FacetfitLut lut, vector o, vector i) {
   if (i[2] <= 0.0 || o[2] <= 0.0) return 0.0;
   vector h = normalize(o + i);
   float oh = dot(o, h);
   return oh > 0.0 ? facetfit_visible_normal_pdf(lut, o, h) / (4.0 * oh) : 0.0;
+}
+
+// The coat's visible normals: G1(o) D(h) / (4 cos(theta_o)) per steradian of i.
+float facetfit_coat_pdf(FacetfitLut lut, vector o, vector i) {
+  if (lut.coat_alpha <= 0.0 || i[2] <= 0.0 || o[2] <= 0.0) return 0.0;
+  vector h = normalize(o + i);
+  if (dot(o, h) <= 0.0) return 0.0;
+  return facetfit_coat_D(lut.coat_alpha, h) / ((1.0 + facetfit_coat_lambda(lut.coat_alpha, o)) * 4.0 * o[2]);
+}
+
+// Density of facetfit_sample per steradian of i: the mixture of its three parts.
+float facetfit_pdf(FacetfitLut lut, vector o, vector i) {
+  if (i[2] <= 0.0 || o[2] <= 0.0 || !lut.sampling) return 0.0;
+  return lut.weight_lobe * facetfit_lobe_pdf(lut, o, i) + lut.weight_body * i[2] / FACETFIT_PI +
+         (1.0 - lut.weight_lobe - lut.weight_body) * facetfit_coat_pdf(lut, o, i);
 }
 
 // phi in (-pi, pi] with density proportional to max(0, a cos(phi) + b).
@@ -269,9 +333,8 @@ float facetfit_sample_phi(float a, float b, float u_in) {
   return sgn * phi;
 }
 
-// Draws i for o from two uniform numbers; returns 0 when no direction (below the horizon, no tables).
-int facetfit_sample(FacetfitLut lut, vector o, float u1_in, float u2, output vector i, output float pdf) {
-  if (o[2] <= 0.0 || !lut.sampling) return 0;
+// The lobe's part: its visible normals, o reflected about them.
+int facetfit_sample_lobe(FacetfitLut lut, vector o, float u1_in, float u2, output vector i) {
   int vj;
   float vt;
   facetfit_locate(lut, o, vj, vt);
@@ -302,7 +365,44 @@ int facetfit_sample(FacetfitLut lut, vector o, float u1_in, float u2, output vec
   facetfit_sincos(phi, sin_phi, cos_phi);
   vector h = vector(sin_h * cos_phi, sin_h * sin_phi, cos_h);
   i = 2.0 * dot(o, h) * h - o;
-  if (i[2] <= 0.0) return 0;
+  return i[2] > 0.0;
+}
+
+// The coat's part: GGX visible normals (Heitz 2018, as lib/model/coat.h), o reflected about them.
+int facetfit_sample_coat(FacetfitLut lut, vector o, float u1, float u2, output vector i) {
+  float a = lut.coat_alpha;
+  vector v = normalize(vector(a * o[0], a * o[1], o[2]));
+  float len2 = v[0] * v[0] + v[1] * v[1];
+  vector t1 = len2 > 0.0 ? vector(-v[1], v[0], 0.0) / sqrt(len2) : vector(1, 0, 0);
+  vector t2 = cross(v, t1);
+  float sp, cp;
+  facetfit_sincos(2.0 * FACETFIT_PI * u2, sp, cp);
+  float r = sqrt(u1), p1 = r * cp, s = 0.5 * (1.0 + v[2]);
+  float p2 = (1.0 - s) * sqrt(max(0.0, 1.0 - p1 * p1)) + s * r * sp;
+  vector n = p1 * t1 + p2 * t2 + sqrt(max(0.0, 1.0 - p1 * p1 - p2 * p2)) * v;
+  vector h = normalize(vector(a * n[0], a * n[1], max(0.0, n[2])));
+  i = 2.0 * dot(o, h) * h - o;
+  return i[2] > 0.0;
+}
+
+// Draws i for o from two uniform numbers: u1 picks the part (lobe, body, coat) with the LUT's weights
+// and is rescaled within it. Returns 0 when no direction (below the horizon, no tables).
+int facetfit_sample(FacetfitLut lut, vector o, float u1_in, float u2, output vector i, output float pdf) {
+  if (o[2] <= 0.0 || !lut.sampling) return 0;
+  float u1 = u1_in;
+  int found = 0;
+  if (u1 < lut.weight_lobe) {
+    found = facetfit_sample_lobe(lut, o, u1 / lut.weight_lobe, u2, i);
+  } else if (u1 - lut.weight_lobe < lut.weight_body) {
+    float r = sqrt((u1 - lut.weight_lobe) / lut.weight_body), sp, cp;  // the cosine
+    facetfit_sincos(2.0 * FACETFIT_PI * u2, sp, cp);
+    i = vector(r * cp, r * sp, sqrt(max(0.0, 1.0 - r * r)));
+    found = i[2] > 0.0;
+  } else {
+    float w = 1.0 - lut.weight_lobe - lut.weight_body;
+    found = facetfit_sample_coat(lut, o, clamp((u1 - lut.weight_lobe - lut.weight_body) / w, 0.0, 0.99999994), u2, i);
+  }
+  if (!found) return 0;
   pdf = facetfit_pdf(lut, o, i);
   return pdf > 0.0;
 }

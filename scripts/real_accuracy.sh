@@ -35,7 +35,7 @@ delta_e() {
     echo "$row | $(delta_e measured "$bsdf" "$name") |"
   done
   echo
-  echo "facetfit renders at $spp samples per pixel; \`measured\` renders the file itself (its MERL-layout table, both one-sided estimates averaged), the floor of what any fit can reach. Baking the six with \`--refine full\` took ${seconds} s on this machine (2 cores)."
+  echo "facetfit renders at $spp samples per pixel; \`measured\` renders the file itself through its own evaluation (view slices, negative entries kept: what Mitsuba renders), the floor of what any fit can reach. Baking the six with \`--refine full\` took ${seconds} s on this machine (2 cores)."
 } > "$work/table.md"
 {
   echo "# Accuracy on real measurements"

@@ -33,8 +33,14 @@ TEST(Report, WritesEveryOutputAndTheRightOrder) {
   EXPECT_TRUE(r["failures"].empty());
   for (const json& m : r["materials"]) {
     const std::string name = m["name"];
-    for (const char* f : {"measured.png", "tabulated.png", "ggx.png", "beckmann.png", "ggx_delta_e.png"})
+    for (const char* f : {"measured.png", "tabulated.png", "ggx.png", "beckmann.png", "lsq.png", "ggx_delta_e.png",
+                          "lobes_0.svg", "lobes_30.svg", "lobes_60.svg", "ndf.svg", "fresnel.svg"})
       EXPECT_TRUE(std::filesystem::exists(dir.path() / "images" / name / f)) << name << "/" << f;
+    // A lobe figure holds one curve per representation and the measurement.
+    const std::string lobes = test::read_bytes((dir.path() / "images" / name / "lobes_30.svg").string());
+    std::size_t curves = 0;
+    for (std::size_t at = lobes.find("<polyline"); at != std::string::npos; at = lobes.find("<polyline", at + 1)) ++curves;
+    EXPECT_EQ(curves, 5u) << name;
     EXPECT_TRUE(std::filesystem::exists(dir.path() / "luts" / (name + ".exr")));
   }
   // Each family fits its own material; Beckmann cannot fit a GGX lobe (the worst entry of all).

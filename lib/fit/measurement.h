@@ -48,20 +48,22 @@ inline MeasuredBins solve_bins(const MerlTable& table) { return measured_bins(ta
 inline MeasuredBins error_bins(const MerlTable& table) { return measured_bins(table, 3, 12); }
 
 // The metric's transform of x = f c: CIE L*'s lightness function of pi x (cube root, linear near
-// black), written once for doubles and Ceres Jets. Linear below (6/29)^3, so it takes negative
-// measurements (RGL noise around zero) as they are and has a bounded slope at zero.
+// black, so its slope at zero is bounded), written once for doubles and Ceres Jets. Negative values
+// (RGL noise around zero) take the same function mirrored about zero: without the mirror, the linear
+// part would let a handful of large negative entries (one-sided estimates divided by grazing cosines)
+// outweigh everything else, which doubled the distance of every fit on one material.
 template <class T>
 T metric_transform(const T& x) {
   constexpr double kDelta = 6.0 / 29.0, kDelta3 = kDelta * kDelta * kDelta;
+  const auto lightness = [&](const T& t) -> T { return t > kDelta3 ? T(cbrt(t)) : T(t / (3.0 * kDelta * kDelta) + 4.0 / 29.0); };
   const T t = kPi * x;
-  if (t > kDelta3) return cbrt(t);
-  return t / (3.0 * kDelta * kDelta) + 4.0 / 29.0;
+  return t >= 0.0 ? lightness(t) : T(8.0 / 29.0 - lightness(-t));
 }
 
 // d metric_transform / dx.
 inline double metric_slope(double x) {
   constexpr double kDelta = 6.0 / 29.0, kDelta3 = kDelta * kDelta * kDelta;
-  const double t = kPi * x;
+  const double t = kPi * std::abs(x);
   return t > kDelta3 ? kPi / (3.0 * std::cbrt(t * t)) : kPi / (3.0 * kDelta * kDelta);
 }
 

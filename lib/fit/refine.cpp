@@ -103,6 +103,16 @@ class NormalizationCost final : public ceres::CostFunction {
   double weight_;
 };
 
+// weight (D_{j-1} - 2 D_j + D_{j+1}) / scale: a relative second difference of the NDF nodes.
+struct NdfSecondDifference {
+  double weight;  // already divided by the scale
+  template <class T>
+  bool operator()(const T* a, const T* b, const T* c, T* r) const {
+    r[0] = weight * (a[0] - 2.0 * b[0] + c[0]);
+    return true;
+  }
+};
+
 // weight (F_{j-1} - 2 F_j + F_{j+1}) per channel.
 struct SecondDifference {
   double weight;
@@ -171,6 +181,12 @@ LobeFit refine_lobe(const MeasuredBins& bins, const Quadrature& quad, Smith smit
       problem.AddResidualBlock(
           new ceres::AutoDiffCostFunction<SecondDifference, 3, 3, 3, 3>(new SecondDifference{options.fresnel_smoothness}),
           nullptr, fresnel[std::size_t(j - 1)].data(), fresnel[std::size_t(j)].data(), fresnel[std::size_t(j + 1)].data());
+    for (std::size_t j = 1; j + 1 < d.size(); ++j) {
+      const double scale = std::max(d[j], 1e-3 * d[0] + 1e-6);
+      problem.AddResidualBlock(new ceres::AutoDiffCostFunction<NdfSecondDifference, 1, 1, 1, 1>(
+                                   new NdfSecondDifference{options.ndf_smoothness / scale}),
+                               nullptr, &d[j - 1], &d[j], &d[j + 1]);
+    }
     // Bounds, not a clamp afterwards: left free, the solve trades negative nodes against each other.
     for (int c = 0; c < 3; ++c) problem.SetParameterLowerBound(body.data(), c, 0.0);
     for (auto& f : fresnel)

@@ -36,6 +36,10 @@ struct RefineOptions {
   int passes = 2;           // G2 recomputed from D between passes
   int max_iterations = 15;  // Levenberg-Marquardt iterations per pass
   double fresnel_smoothness = 1e-3;
+  // Weight of the NDF's second differences over the nodes, relative to the start's D at the node: keeps
+  // the lobe from trading kinks near the peak against a coat or noise (a spline through kinks is also
+  // what a float renderer evaluates least accurately).
+  double ndf_smoothness = 0.01;
   int threads = 1;
 };
 

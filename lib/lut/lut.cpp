@@ -190,6 +190,13 @@ void write_lut(const std::string& path, const Lut& lut) {
   write_image_atomic(path, spec, pixels.data());
 }
 
+std::optional<ParametricBrdf> Lut::parametric(const std::string& family, Smith smith) const {
+  const LutMetadata::Parametric* p = family == "ggx" ? &meta.ggx : family == "beckmann" ? &meta.beckmann : family == "lsq" ? &meta.lsq : nullptr;
+  if (!p) return std::nullopt;
+  const NdfType type = family == "beckmann" ? NdfType::beckmann : NdfType::ggx;
+  return ParametricBrdf(Ndf::isotropic(type, p->alpha), smith, p->f0, p->f82, p->body, p->coat);
+}
+
 Lut read_lut(const std::string& path) {
   auto image = open_image(path);
   const ImageSpec& spec = image->spec();

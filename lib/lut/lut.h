@@ -6,6 +6,7 @@
 #include <string>
 
 #include "fit/fit.h"
+#include "model/parametric.h"
 #include "model/tabulated.h"
 
 namespace facetfit {
@@ -66,6 +67,9 @@ struct Lut {
   LutMetadata meta;
 
   TabulatedMicrofacet model() const { return TabulatedMicrofacet(tables, sampling); }
+  // One of the parametric fits it carries ("ggx", "beckmann" or "lsq"): alpha, body, coat and its
+  // F82-tint Fresnel (Schlick for lsq), evaluated with `smith`. nullopt for another name.
+  std::optional<ParametricBrdf> parametric(const std::string& family, Smith smith) const;
 };
 
 // Builds the LUT of a fit and chooses its representation: the parametric NDF with the smaller error

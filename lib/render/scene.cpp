@@ -251,7 +251,7 @@ std::shared_ptr<const ShadingModel> load_material(const SceneDesc& scene, const 
     const LutMetadata::Parametric& p = m.type == "lsq" ? lut.meta.lsq : type == NdfType::ggx ? lut.meta.ggx : lut.meta.beckmann;
     ndf = Ndf::isotropic(type, p.alpha);
     brdf = m.fresnel == "curve" ? std::make_shared<ParametricBrdf>(ndf, m.smith, lut.tables.fresnel, p.body, p.coat)
-                                : std::make_shared<ParametricBrdf>(ndf, m.smith, p.f0, p.f82, p.body, p.coat);
+                                : std::make_shared<ParametricBrdf>(*lut.parametric(m.type, m.smith));
   } else {
     ndf = Ndf::isotropic(type, m.alpha);
     brdf = std::make_shared<ParametricBrdf>(ndf, m.smith, m.f0, m.f82);

@@ -12,7 +12,9 @@
 #include "io/atomic_file.h"
 #include "io/input.h"
 #include "io/sha256.h"
+#include "lut/lut.h"
 #include "render/renderer.h"
+#include "report/plots.h"
 
 namespace facetfit {
 
@@ -83,7 +85,7 @@ std::string html_escape(const std::string& s) {
 
 // Run time against error: one point per material and representation, log-scaled time.
 std::string time_error_plot(const json& report) {
-  const char* colours[] = {"#1f77b4", "#d62728", "#2ca02c"};
+  const char* colours[] = {"#1f77b4", "#d62728", "#2ca02c", "#9467bd"};  // one per report_representations()
   double max_de = 0.1, min_t = 1e9, max_t = 1e-9;
   for (const json& m : report["materials"])
     for (const std::string& r : report_representations())
@@ -159,6 +161,15 @@ std::string report_html(const json& report) {
     h << "</tr>";
   }
   h << "</table>";
+  // Per material: the BRDF in the plane of incidence (measured solid, fits dashed), NDF, Fresnel.
+  h << "<h2>Lobes, NDF and Fresnel</h2>";
+  for (const json& m : report["materials"]) {
+    const std::string name = html_escape(m["name"].get<std::string>());
+    h << "<h3>" << name << "</h3><p>";
+    for (const char* f : {"lobes_0", "lobes_30", "lobes_60", "ndf", "fresnel"})
+      h << "<img style='width:360px;image-rendering:auto' src='images/" << name << "/" << f << ".svg'>";
+    h << "</p>";
+  }
   // Implausible measurements and fits (fit/plausibility.h), per material.
   bool any_warning = false;
   for (const json& m : report["materials"])
@@ -276,6 +287,10 @@ json run_report(const ReportOptions& o) {
           entry["max_delta_e"][r] = diff.max;
           write_heatmap_png((images / (r + "_delta_e.png")).string(), img.width, img.height, diff.delta_e, mask);
         }
+        // The figures the paper validates fits with: lobes in the plane of incidence, NDF, Fresnel.
+        const MerlTable table = load_table(source, o.bake.fit.merl_bins);
+        for (const auto& [file, svg] : material_figures(table, read_lut(lut)))
+          write_file_atomic((images / file).string(), svg);
         report["materials"].push_back(entry);
       }
     } catch (const Error& e) {
