@@ -244,6 +244,9 @@ std::shared_ptr<const ShadingModel> load_material(const SceneDesc& scene, const 
   const NdfType type = m.type == "beckmann" ? NdfType::beckmann : NdfType::ggx;
   std::shared_ptr<const Brdf> brdf;
   Ndf ndf;
+  // The proposal samples the lobe, the body and the coat (model/tabulated.h), weighted by f0 and the body.
+  MicrofacetTables tables;
+  tables.smith = m.smith;
   if (!m.file.empty()) {
     // The LUT's fit of this family on the whole measurement: its alpha and body, with its own F82-tint
     // Fresnel or the tabulated curve.
@@ -252,13 +255,15 @@ std::shared_ptr<const ShadingModel> load_material(const SceneDesc& scene, const 
     ndf = Ndf::isotropic(type, p.alpha);
     brdf = m.fresnel == "curve" ? std::make_shared<ParametricBrdf>(ndf, m.smith, lut.tables.fresnel, p.body, p.coat)
                                 : std::make_shared<ParametricBrdf>(*lut.parametric(m.type, m.smith));
+    std::fill(tables.fresnel.value.begin(), tables.fresnel.value.end(), p.f0);
+    tables.body = p.body;
+    tables.coat = p.coat;
   } else {
     ndf = Ndf::isotropic(type, m.alpha);
     brdf = std::make_shared<ParametricBrdf>(ndf, m.smith, m.f0, m.f82);
+    std::fill(tables.fresnel.value.begin(), tables.fresnel.value.end(), m.f0);
   }
-  MicrofacetTables tables;
   tables.ndf = tabulate_ndf(ndf);
-  tables.smith = m.smith;
   return std::make_shared<ShadingModel>(brdf, std::make_shared<TabulatedMicrofacet>(tables));
 }
 
