@@ -15,7 +15,7 @@ struct FitResult;
 
 // Directional albedo rho(o) = integral of f(i, o) cos(theta_i) d(omega_i), per channel, by a stratified
 // cosine-weighted grid of `n` x `n` directions. Missing values count as zero.
-Rgb directional_albedo(const Brdf& brdf, const Vec3& o, int n = 32);
+Rgb directional_albedo(const Brdf& brdf, const Vec3& o, int n = 16);
 
 // One line per finding, each naming the quantity, its value and where: empty when all is plausible.
 // `fit` may be the paper's alone (then its parametric fits are not checked: they are moment estimates).
