@@ -29,31 +29,28 @@ void add_fit_settings(CLI::App* cmd, FitSettings& s) {
       ->capture_default_str();
 }
 
-std::optional<FitOptions> fit_options(const FitSettings& s, int& status) {
-  const auto smith = parse_smith(s.smith);
-  if (!smith) {
-    report_error("--smith " + s.smith + ": must be masking, correlated or separable");
+// A flag's parsed value; nullopt after a usage error (status 2) naming the flag, its value and what it takes.
+template <class T>
+std::optional<T> flag_value(std::optional<T> parsed, const std::string& flag, const std::string& value, const char* accepted,
+                            int& status) {
+  if (!parsed) {
+    report_error(flag + " " + value + ": must be " + accepted);
     status = 2;
-    return std::nullopt;
   }
+  return parsed;
+}
+
+std::optional<FitOptions> fit_options(const FitSettings& s, int& status) {
+  const auto smith = flag_value(parse_smith(s.smith), "--smith", s.smith, "masking, correlated or separable", status);
+  const auto merl_bins = flag_value(parse_bin_point(s.merl_bins), "--merl-bins", s.merl_bins, "start or center", status);
+  const auto refine = flag_value(parse_refine(s.refine), "--refine", s.refine, "none or full", status);
+  if (!smith || !merl_bins || !refine) return std::nullopt;
   FitOptions options;
   options.smith = *smith;
   options.resolution = s.resolution;
   options.tolerance = s.iteration_tolerance;
   options.max_iterations = s.max_iterations;
-  const auto merl_bins = parse_bin_point(s.merl_bins);
-  if (!merl_bins) {
-    report_error("--merl-bins " + s.merl_bins + ": must be start or center");
-    status = 2;
-    return std::nullopt;
-  }
   options.merl_bins = *merl_bins;
-  const auto refine = parse_refine(s.refine);
-  if (!refine) {
-    report_error("--refine " + s.refine + ": must be none or full");
-    status = 2;
-    return std::nullopt;
-  }
   options.refine = *refine;
   return options;
 }

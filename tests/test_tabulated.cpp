@@ -70,6 +70,21 @@ double pdf_integral(const TabulatedMicrofacet& model, const Vec3& o, int n_cos =
 
 class Sampling : public testing::TestWithParam<std::tuple<double, double>> {};
 
+// n samples of `model` seen from o, counted in `bins` bins by bin_of(i) (-1: in none); the last entry of
+// the result (index `bins`) counts the samples in no bin and the draws that returned nothing.
+std::vector<double> sample_histogram(const TabulatedMicrofacet& model, const Vec3& o, int n, unsigned seed, std::size_t bins,
+                                     const std::function<int(const Vec3&)>& bin_of) {
+  std::vector<double> observed(bins + 1, 0.0);
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (int k = 0; k < n; ++k) {
+    const auto s = model.sample(o, u(rng), u(rng));
+    const int bin = s ? bin_of(s->i) : -1;
+    observed[bin < 0 ? bins : std::size_t(bin)] += 1;
+  }
+  return observed;
+}
+
 // Integral of the visible-normal density over the half vectors whose reflection of o is above the
 // horizon: the same quantity as the integral of pdf(o, .) over i, computed where even a sharp lobe is
 // wide, on bins aligned with the model's grid (the density is constant in cos(theta) inside them).
@@ -134,16 +149,10 @@ TEST_P(Sampling, ChiSquareAgainstPdf) {
     return a * kPhi + std::min(kPhi - 1, int(phi / (2 * kPi) * kPhi));
   };
   const std::size_t outside = std::size_t(n_theta) * kPhi;
-  std::vector<double> observed(outside + 1, 0.0), expected(outside + 1, 0.0);
-  std::mt19937 rng(6);
-  std::uniform_real_distribution<double> u(0.0, 1.0);
   const int n = 400000;
-  for (int k = 0; k < n; ++k) {
-    const auto s = model.sample(o, u(rng), u(rng));
-    if (!s) continue;
-    const int bin = bin_of(glm::normalize(s->i + o));
-    observed[bin < 0 ? outside : std::size_t(bin)] += 1;
-  }
+  std::vector<double> observed =
+      sample_histogram(model, o, n, 6, outside, [&](const Vec3& i) { return bin_of(glm::normalize(i + o)); });
+  std::vector<double> expected(outside + 1, 0.0);
   // Expected: n times the integral over the bin of the visible-normal density (per steradian of h) of
   // the samples whose reflection is above the horizon; d(omega) = d(cos theta) d(phi).
   // Bins that the horizon of the reflected direction (i.z = 0) cuts through are integrated 16x finer.
@@ -174,9 +183,6 @@ TEST_P(Sampling, ChiSquareAgainstPdf) {
     }
   // The last category holds every sample not in a bin: reflected below the horizon (sample() returns
   // nothing) or beyond theta_max. Its expectation follows from n, since the visible normals integrate to one.
-  double binned = 0.0;
-  for (std::size_t k = 0; k < outside; ++k) binned += observed[k];
-  observed[outside] = n - binned;
   expected[outside] = std::max(0.0, (1.0 - total) * n);
   const test::ChiSquareResult r = test::chi_square(observed, expected);
   EXPECT_GT(r.p_value, 1e-3) << "chi2 " << r.statistic << " dof " << r.dof;
@@ -199,21 +205,13 @@ TEST(Sampling, ChiSquareOfTheBodyLobeCoatMixture) {
     const Vec3 o = direction_at(theta_o);
     constexpr int kCos = 32, kPhi = 48, kSub = 8;
     const std::size_t outside = std::size_t(kCos) * kPhi;
-    std::vector<double> observed(outside + 1, 0.0), expected(outside + 1, 0.0);
-    std::mt19937 rng(9);
-    std::uniform_real_distribution<double> u(0.0, 1.0);
     const int n = 300000;
-    for (int k = 0; k < n; ++k) {
-      const auto s = model.sample(o, u(rng), u(rng));
-      if (!s) {
-        observed[outside] += 1;
-        continue;
-      }
-      double phi = std::atan2(s->i.y, s->i.x);
+    const std::vector<double> observed = sample_histogram(model, o, n, 9, outside, [&](const Vec3& i) {
+      double phi = std::atan2(i.y, i.x);
       if (phi < 0) phi += 2 * kPi;
-      const int a = std::min(kCos - 1, int(s->i.z * kCos)), b = std::min(kPhi - 1, int(phi / (2 * kPi) * kPhi));
-      observed[std::size_t(a * kPhi + b)] += 1;
-    }
+      return std::min(kCos - 1, int(i.z * kCos)) * kPhi + std::min(kPhi - 1, int(phi / (2 * kPi) * kPhi));
+    });
+    std::vector<double> expected(outside + 1, 0.0);
     double total = 0.0;
     for (int a = 0; a < kCos; ++a)
       for (int b = 0; b < kPhi; ++b) {
