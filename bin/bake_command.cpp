@@ -5,7 +5,9 @@
 
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <map>
+#include <set>
 #include <thread>
 
 #include "commands.h"
@@ -121,6 +123,19 @@ void run_bake(const BakeArgs& args, int& status) {
   index["facetfit_version"] = FACETFIT_VERSION;
   index["materials"] = nlohmann::json::array();
   index["failures"] = nlohmann::json::array();
+  // The index accumulates across batches: earlier entries stay while their LUT exists and this batch did
+  // not bake it again; the failures are this batch's.
+  std::set<std::string> luts_now;
+  for (const auto& o : outcomes)
+    if (o.status != BakeOutcome::Status::failed) luts_now.insert(o.record.value("lut", ""));
+  std::ifstream previous_file(fs::path(args.out_dir) / "index.json");
+  const nlohmann::json previous = nlohmann::json::parse(previous_file, nullptr, false);
+  if (previous.is_object() && previous.contains("materials") && previous["materials"].is_array())
+    for (const auto& m : previous["materials"]) {
+      const std::string lut = m.is_object() ? m.value("lut", "") : "";
+      std::error_code exists_error;
+      if (!lut.empty() && !luts_now.count(lut) && fs::exists(fs::path(args.out_dir) / lut, exists_error)) index["materials"].push_back(m);
+    }
   int baked = 0, cached = 0, failed = 0;
   for (const auto& o : outcomes) {
     if (o.status == BakeOutcome::Status::failed) {

@@ -1,5 +1,6 @@
 // The facetfit subcommands. Each registers itself on the app and reports its exit status through
-// `status` (0 success, 1 some input failed, 2 usage).
+// `status`: 0 success, 1 some input failed, 2 usage (parser errors included), 3 `report
+// --fail-on-regression` found regressions (and nothing failed).
 #pragma once
 
 #include <CLI/CLI.hpp>

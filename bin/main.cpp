@@ -1,5 +1,8 @@
 // facetfit: turn measured BRDFs into microfacet components.
+#include <tbb/global_control.h>
+
 #include <cstdio>
+#include <memory>
 
 #include "commands.h"
 #include "core/error.h"
@@ -62,6 +65,16 @@ int main(int argc, char** argv) {
   CLI::App app{"facetfit: measured BRDFs to microfacet components (Dupuy et al. 2015, power iterations)", "facetfit"};
   app.require_subcommand(1);
   app.set_version_flag("--version", FACETFIT_VERSION);
+  // --threads N caps every parallel part of every command (TBB's global limit), set as soon as parsed.
+  std::unique_ptr<tbb::global_control> threads;
+  app.add_option_function<int>(
+         "--threads",
+         [&](int n) {
+           if (n > 0) threads = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, std::size_t(n));
+         },
+         "Threads to use (default: all cores)")
+      ->check(CLI::PositiveNumber)
+      ->trigger_on_parse();
   int status = 0;
   add_fit_command(app, status);
   add_bake_command(app, status);
@@ -75,7 +88,8 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    // Help and --version exit 0; every usage error exits 2, as bin/commands.h promises.
+    return app.exit(e) == 0 ? 0 : 2;
   } catch (const facetfit::Error& e) {
     report_error(e.what());
     return 1;

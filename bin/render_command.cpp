@@ -2,16 +2,21 @@
 #include <unistd.h>
 
 #include <cstdio>
+#include <filesystem>
+#include <memory>
 
 #include "commands.h"
-#include "core/error.h"
 #include "color/image_diff.h"
+#include "core/error.h"
+#include "lut/bake.h"
 #include "render/environment.h"
 #include "render/renderer.h"
 
 namespace facetfit::cli {
 
 namespace {
+
+namespace fs = std::filesystem;
 
 struct RenderArgs {
   std::string scene;
@@ -37,10 +42,25 @@ void run_render(const RenderArgs& args, int& status) {
       write_exr(args.save_sky, img, {{"environment", "builtin sky"}});
     }
     SceneDesc scene;
+    // A measurement rendered as one of the LUT's representations is baked first, into a temporary folder.
+    std::unique_ptr<fs::path, void (*)(fs::path*)> baked_dir(nullptr, [](fs::path* p) {
+      std::error_code ec;
+      fs::remove_all(*p, ec);
+      delete p;
+    });
     if (args.scene.empty()) {
       MaterialDesc subject;
       subject.type = args.material_type;
       subject.file = args.material;
+      const bool needs_lut = subject.type == "lut" || subject.type == "ggx" || subject.type == "beckmann" || subject.type == "lsq";
+      if (needs_lut && fs::path(subject.file).extension() != ".exr") {
+        baked_dir.reset(new fs::path(fs::temp_directory_path() / ("facetfit-render-" + std::to_string(::getpid()))));
+        fs::create_directories(*baked_dir);
+        const BakeOptions bake_options;
+        const BakeOutcome baked = bake_material(subject.file, "subject", baked_dir->string(), bake_options, Fitter(bake_options.fit));
+        if (baked.status == BakeOutcome::Status::failed) throw Error(baked.error);
+        subject.file = (*baked_dir / "subject.exr").string();
+      }
       scene = default_scene(subject);
     } else {
       scene = parse_scene(args.scene);
@@ -80,7 +100,7 @@ void add_render_command(CLI::App& app, int& status) {
   cmd->add_option("--width", args->width, "Image width (default: the scene's)");
   cmd->add_option("--height", args->height, "Image height (default: the scene's)");
   cmd->add_option("--material", args->material, "Default scene only: the sphere's material file")->capture_default_str();
-  cmd->add_option("--material-type", args->material_type, "Default scene only: measured, lut, ggx or beckmann")
+  cmd->add_option("--material-type", args->material_type, "Default scene only: measured, lut, ggx, beckmann or lsq (a measurement is baked first for the last four)")
       ->capture_default_str();
   cmd->callback([args, &status] { run_render(*args, status); });
 }

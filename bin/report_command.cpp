@@ -31,7 +31,10 @@ void finish(const nlohmann::json& report, const std::string& out_dir, bool fail_
   for (const auto& g : report["regressions"])
     std::fprintf(stderr, "facetfit: regression: %s %s %.4f -> %.4f\n", g["name"].get<std::string>().c_str(),
                  g["representation"].get<std::string>().c_str(), g["before"].get<double>(), g["after"].get<double>());
-  if (!report["failures"].empty() || (fail_on_regression && !report["regressions"].empty())) status = 1;
+  if (!report["failures"].empty())
+    status = 1;
+  else if (fail_on_regression && !report["regressions"].empty())
+    status = 3;
 }
 
 void run_report_command(const ReportArgs& args, int& status) {
@@ -79,7 +82,7 @@ void add_report_command(CLI::App& app, int& status) {
   cmd->add_option("--spp", args->spp, "Samples per pixel")->capture_default_str();
   cmd->add_option("--shard", args->shard, "K/N: render the K-th of N deterministic subsets (merge them with report merge)")
       ->capture_default_str();
-  cmd->add_flag("--fail-on-regression", args->fail_on_regression, "Exit 1 when a material got worse than in the previous report");
+  cmd->add_flag("--fail-on-regression", args->fail_on_regression, "Exit 3 when a material got worse than in the previous report");
   cmd->add_flag("--force", args->force, "Render even the materials whose previous entry is current");
   cmd->add_option("--tolerance", args->tolerance, "Representation tolerance of the bake")->capture_default_str();
   add_fit_settings(cmd, args->settings);
@@ -90,7 +93,7 @@ void add_report_command(CLI::App& app, int& status) {
   CLI::App* merge = cmd->add_subcommand("merge", "Join shard reports into one");
   merge->add_option("parts", *parts, "Report folders written with --shard")->required();
   merge->add_option("-o,--output", *merged, "Merged report folder")->required();
-  merge->add_flag("--fail-on-regression", *fail_merge, "Exit 1 on regressions against the previous merged report");
+  merge->add_flag("--fail-on-regression", *fail_merge, "Exit 3 on regressions against the previous merged report");
   merge->callback([parts, merged, fail_merge, &status] {
     try {
       finish(merge_reports(*parts, *merged), *merged, *fail_merge, status);

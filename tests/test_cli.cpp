@@ -104,6 +104,18 @@ TEST(Cli, UsageErrors) {
   EXPECT_EQ(facetfit("fit builtin:gold-ggx-0.15 --smith wrong").status, 2);
   EXPECT_NE(facetfit("fit").status, 0);
   EXPECT_NE(facetfit("fit builtin:gold-ggx-0.15 --resolution 1").status, 0);
+  // Parser errors are usage errors too: exit 2, not the parser library's own codes (104-109).
+  for (const char* args : {"fit --no-such-flag builtin:gold-ggx-0.15", "no-such-command", "", "--threads 0 fit builtin:gold-ggx-0.15",
+                           "bake builtin:gold-ggx-0.15", "render --spp abc -o x.exr"})
+    EXPECT_EQ(facetfit(args).status, 2) << args;
+  EXPECT_EQ(facetfit("--help").status, 0);
+  const RunResult version = facetfit("--version");
+  EXPECT_EQ(version.status, 0);
+  EXPECT_NE(version.out.find(FACETFIT_VERSION), std::string::npos) << version.out;
+  // --threads caps the work, it does not change it.
+  const RunResult one = facetfit("--threads 1 fit builtin:gold-ggx-0.15 --refine none --json");
+  ASSERT_EQ(one.status, 0) << one.err;
+  EXPECT_NEAR(nlohmann::json::parse(one.out)["alpha_ggx"].get<double>(), 0.15, 0.15 * 0.005);
   const RunResult unknown = facetfit("fit builtin:no-such-material");
   EXPECT_EQ(unknown.status, 1);
   EXPECT_NE(unknown.err.find("no such built-in material"), std::string::npos);
