@@ -101,6 +101,7 @@ void add_render_command(CLI::App& app, int& status) {
   cmd->add_option("--height", args->height, "Image height (default: the scene's)");
   cmd->add_option("--material", args->material, "Default scene only: the sphere's material file")->capture_default_str();
   cmd->add_option("--material-type", args->material_type, "Default scene only: measured, lut, ggx, beckmann or lsq (a measurement is baked first for the last four)")
+      ->check(CLI::IsMember({"measured", "lut", "ggx", "beckmann", "lsq", "analytic", "lambert"}))
       ->capture_default_str();
   cmd->callback([args, &status] { run_render(*args, status); });
 }

@@ -99,6 +99,12 @@ TEST(Render, BadScenesGetOneClearLine) {
                     R"({"materials": {"m": {"type": "measured", "file": "missing.binary"}}, "objects": [{"type": "sphere", "material": "m"}]})");
   const std::string missing = test::error_of([&] { render(parse_scene(dir.file("c.json"))); });
   EXPECT_NE(missing.find("missing.binary: cannot open"), std::string::npos) << missing;
+  // A material built in code with an unknown type fails instead of rendering as some other type.
+  MaterialDesc odd;
+  odd.type = "velvet";
+  odd.alpha = 0.3;
+  const std::string unknown = test::error_of([&] { load_material(SceneDesc{}, odd); });
+  EXPECT_NE(unknown.find("material type 'velvet'"), std::string::npos) << unknown;
 }
 
 TEST(Render, ObjMeshes) {

@@ -240,7 +240,9 @@ std::shared_ptr<const ShadingModel> load_material(const SceneDesc& scene, const 
       proposal = std::make_shared<TabulatedMicrofacet>(model->tables());
     return std::make_shared<ShadingModel>(model, proposal);
   }
-  // ggx | beckmann | lsq (the LUT's classical baseline: Lambert + GGX + Schlick)
+  // ggx | beckmann | lsq (the LUT's classical baseline: Lambert + GGX + Schlick); nothing else renders as them
+  if (m.type != "ggx" && m.type != "beckmann" && m.type != "lsq")
+    fail("material type '" + m.type + "'", "must be measured, lut, ggx, beckmann, lsq, lambert or analytic");
   const NdfType type = m.type == "beckmann" ? NdfType::beckmann : NdfType::ggx;
   std::shared_ptr<const Brdf> brdf;
   Ndf ndf;
