@@ -123,6 +123,8 @@ ParametricFit fit_parametric(const MeasuredBins& bins, const MeasuredBins& error
   problem.SetParameterUpperBound(log_alpha, 0, std::log(4.0));
   for (double* p : {body, f0, f82})
     for (int c = 0; c < 3; ++c) problem.SetParameterLowerBound(p, c, 0.0);
+  for (double* p : {f0, f82})  // reflectances: at most 1 (the start is clamped to [0, 1] by the caller)
+    for (int c = 0; c < 3; ++c) problem.SetParameterUpperBound(p, c, 1.0);
   if (start.fresnel == ParametricFit::FresnelForm::schlick) problem.SetParameterBlockConstant(f82);
   if (with_coat) {
     problem.SetParameterLowerBound(coat, 0, std::log(1e-3));

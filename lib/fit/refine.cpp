@@ -151,7 +151,7 @@ LobeFit refine_lobe(const MeasuredBins& bins, const Quadrature& quad, Smith smit
   std::vector<double> body = {fit.body.r, fit.body.g, fit.body.b};
   std::vector<std::array<double, 3>> fresnel(FresnelCurve::kSize);
   for (int j = 0; j < FresnelCurve::kSize; ++j)
-    for (int c = 0; c < 3; ++c) fresnel[std::size_t(j)][std::size_t(c)] = fit.fresnel.value[std::size_t(j)][c];
+    for (int c = 0; c < 3; ++c) fresnel[std::size_t(j)][std::size_t(c)] = clamp(fit.fresnel.value[std::size_t(j)][c], 0.0, 1.0);
   std::vector<double> g(bins.size()), coat(bins.size());
   for (std::size_t k = 0; k < bins.size(); ++k) coat[k] = start.coat.eval(bins.i[k], bins.o[k]);
   std::vector<NodeWeights> row_nodes;
@@ -189,8 +189,9 @@ LobeFit refine_lobe(const MeasuredBins& bins, const Quadrature& quad, Smith smit
     }
     // Bounds, not a clamp afterwards: left free, the solve trades negative nodes against each other.
     for (int c = 0; c < 3; ++c) problem.SetParameterLowerBound(body.data(), c, 0.0);
+    // A Fresnel factor is a reflectance: in [0, 1] (above 1 the fit would trade the NDF's scale for it).
     for (auto& f : fresnel)
-      for (int c = 0; c < 3; ++c) problem.SetParameterLowerBound(f.data(), c, 0.0);
+      for (int c = 0; c < 3; ++c) problem.SetParameterLowerBound(f.data(), c, 0.0), problem.SetParameterUpperBound(f.data(), c, 1.0);
     for (double& v : d) problem.SetParameterLowerBound(&v, 0, 0.0);
 
     ceres::Solver::Options solver;
@@ -206,7 +207,7 @@ LobeFit refine_lobe(const MeasuredBins& bins, const Quadrature& quad, Smith smit
     const double area = normalize_ndf(fit.ndf, quad);  // F D stays what the solve found
     d = fit.ndf.ndf;
     for (auto& f : fresnel)
-      for (double& v : f) v *= area;
+      for (double& v : f) v = std::min(v * area, 1.0);
   }
   fit.body = Rgb(body[0], body[1], body[2]);
   for (int j = 0; j < FresnelCurve::kSize; ++j)
