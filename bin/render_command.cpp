@@ -95,10 +95,10 @@ void add_render_command(CLI::App& app, int& status) {
   cmd->add_option("-o,--output", args->output, "Linear EXR to write")->required();
   cmd->add_option("--png", args->png, "Also write a display-referred sRGB PNG (OpenColorIO display transform)");
   cmd->add_option("--save-sky", args->save_sky, "Also write the built-in sky as a lat-long EXR (for other renderers)");
-  cmd->add_option("--spp", args->spp, "Samples per pixel (default: the scene's)");
+  cmd->add_option("--spp", args->spp, "Samples per pixel (default: the scene's)")->check(CLI::Range(1, 1 << 20));
   cmd->add_option("--seed", args->seed, "Random seed (default: the scene's)");
-  cmd->add_option("--width", args->width, "Image width (default: the scene's)");
-  cmd->add_option("--height", args->height, "Image height (default: the scene's)");
+  cmd->add_option("--width", args->width, "Image width (default: the scene's)")->check(CLI::Range(1, 16384));
+  cmd->add_option("--height", args->height, "Image height (default: the scene's)")->check(CLI::Range(1, 16384));
   cmd->add_option("--material", args->material, "Default scene only: the sphere's material file")->capture_default_str();
   cmd->add_option("--material-type", args->material_type, "Default scene only: measured, lut, ggx, beckmann or lsq (a measurement is baked first for the last four)")
       ->check(CLI::IsMember({"measured", "lut", "ggx", "beckmann", "lsq", "analytic", "lambert"}))

@@ -107,7 +107,8 @@ TEST(Cli, UsageErrors) {
   // Parser errors are usage errors too: exit 2, not the parser library's own codes (104-109).
   for (const char* args : {"fit --no-such-flag builtin:gold-ggx-0.15", "no-such-command", "", "--threads 0 fit builtin:gold-ggx-0.15",
                            "bake builtin:gold-ggx-0.15", "render --spp abc -o x.exr",
-                           "render --material-type foo -o x.exr"})
+                           "render --material-type foo -o x.exr", "render --width -5 -o x.exr", "render --spp -3 -o x.exr",
+                           "render --width 2147483647 -o x.exr"})
     EXPECT_EQ(facetfit(args).status, 2) << args;
   EXPECT_EQ(facetfit("--help").status, 0);
   const RunResult version = facetfit("--version");

@@ -21,10 +21,37 @@ using nlohmann::json;
 
 namespace {
 
+// Scene coordinates and sizes stay within this: beyond it, rays and their offsets stop being finite in
+// the ray tracer's float arithmetic.
+constexpr double kMaxCoordinate = 1e6;
+
 Vec3 vec3(const json& j, const std::string& what, const std::string& path) {
   if (!j.is_array() || j.size() != 3 || !j[0].is_number() || !j[1].is_number() || !j[2].is_number())
     fail(path, what + " must be an array of three numbers");
   return {j[0].get<double>(), j[1].get<double>(), j[2].get<double>()};
+}
+
+// A position: every coordinate within +-kMaxCoordinate.
+Vec3 position(const json& j, const std::string& what, const std::string& path) {
+  const Vec3 v = vec3(j, what, path);
+  for (int k = 0; k < 3; ++k)
+    if (!(std::abs(v[k]) <= kMaxCoordinate)) fail(path, what + " must have coordinates within +-1e6");
+  return v;
+}
+
+// A direction: finite, not zero; returned unit.
+Vec3 direction(const json& j, const std::string& what, const std::string& path) {
+  const Vec3 v = position(j, what, path);
+  if (!(glm::length(v) > 0.0)) fail(path, what + " must not be zero");
+  return glm::normalize(v);
+}
+
+// A colour or a radiometric value: three finite numbers >= 0.
+Vec3 nonnegative(const json& j, const std::string& what, const std::string& path) {
+  const Vec3 v = vec3(j, what, path);
+  for (int k = 0; k < 3; ++k)
+    if (!(v[k] >= 0.0 && v[k] <= 1e30)) fail(path, what + " must be three finite numbers >= 0");
+  return v;
 }
 
 template <class T>
@@ -48,10 +75,11 @@ MaterialDesc parse_material(const std::string& name, const json& j, const std::s
   if ((m.type == "measured" || m.type == "lut" || m.type == "lsq" || m.type == "analytic") && m.file.empty())
     fail(path, "material " + name + " needs a \"file\"");
   m.alpha = get<double>(j, "alpha", 0.0, path);
+  if (!(m.alpha >= 0.0 && m.alpha <= 10.0)) fail(path, "material " + name + ": alpha must be in [0, 10]");
   if ((m.type == "ggx" || m.type == "beckmann") && m.file.empty() && !(m.alpha > 0.0))
     fail(path, "material " + name + " needs \"alpha\" > 0 or a LUT \"file\"");
-  if (j.contains("f0")) m.f0 = vec3(j["f0"], "f0", path);
-  m.f82 = j.contains("f82") ? vec3(j["f82"], "f82", path) : m.f0;
+  if (j.contains("f0")) m.f0 = nonnegative(j["f0"], "material " + name + ": f0", path);
+  m.f82 = j.contains("f82") ? nonnegative(j["f82"], "material " + name + ": f82", path) : m.f0;
   m.fresnel = get<std::string>(j, "fresnel", "f82", path);
   if (m.fresnel != "curve" && m.fresnel != "f82") fail(path, "material " + name + ": fresnel must be curve or f82");
   m.slices = get<std::string>(j, "slices", "view", path);
@@ -59,31 +87,52 @@ MaterialDesc parse_material(const std::string& name, const json& j, const std::s
   const auto smith = parse_smith(get<std::string>(j, "smith", "correlated", path));
   if (!smith) fail(path, "material " + name + ": smith must be masking, correlated or separable");
   m.smith = *smith;
-  if (j.contains("albedo")) m.albedo = vec3(j["albedo"], "albedo", path);
+  if (j.contains("albedo")) m.albedo = nonnegative(j["albedo"], "material " + name + ": albedo", path);
   return m;
 }
 
 }  // namespace
 
 SceneDesc parse_scene(const std::string& path) {
+  std::error_code ec;
+  if (fs::exists(path, ec) && !fs::is_regular_file(path, ec)) fail(path, "not a regular file");
   std::ifstream in(path);
   if (!in) fail(path, "cannot open scene");
-  const json j = json::parse(in, nullptr, false);
-  if (j.is_discarded() || !j.is_object()) fail(path, "not a JSON object");
+  // Nesting is bounded as it is read: a scene is 4 levels deep, and a deeply nested document would only
+  // exhaust the stack of everything that later copies or destroys it.
+  constexpr int kMaxDepth = 32;
+  bool too_deep = false;
+  const json::parser_callback_t depth_limit = [&](int depth, json::parse_event_t, json&) {
+    if (depth > kMaxDepth) too_deep = true;
+    return depth <= kMaxDepth;
+  };
+  json j;
+  try {
+    j = json::parse(in, depth_limit, true);
+  } catch (const json::exception& e) {
+    fail(path, std::string("not a JSON object: ") + e.what());
+  }
+  if (too_deep) fail(path, "nested more than 32 levels deep");
+  if (!j.is_object()) fail(path, "not a JSON object");
   SceneDesc s;
   s.base_dir = fs::path(path).parent_path().string();
   if (s.base_dir.empty()) s.base_dir = ".";
   if (j.contains("camera")) {
     const json& c = j["camera"];
-    if (c.contains("position")) s.camera.position = vec3(c["position"], "camera.position", path);
-    if (c.contains("look_at")) s.camera.look_at = vec3(c["look_at"], "camera.look_at", path);
-    if (c.contains("up")) s.camera.up = vec3(c["up"], "camera.up", path);
+    if (c.contains("position")) s.camera.position = position(c["position"], "camera.position", path);
+    if (c.contains("look_at")) s.camera.look_at = position(c["look_at"], "camera.look_at", path);
+    if (c.contains("up")) s.camera.up = direction(c["up"], "camera.up", path);
     s.camera.fov_degrees = get<double>(c, "fov", s.camera.fov_degrees, path);
     s.camera.width = get<int>(c, "width", s.camera.width, path);
     s.camera.height = get<int>(c, "height", s.camera.height, path);
     if (s.camera.width < 1 || s.camera.height < 1 || s.camera.width > 16384 || s.camera.height > 16384)
       fail(path, "camera width and height must be between 1 and 16384");
     if (!(s.camera.fov_degrees > 0.0 && s.camera.fov_degrees < 180.0)) fail(path, "camera fov must be in (0, 180) degrees");
+    // A camera needs a view direction, and an up that is not along it.
+    const Vec3 view = s.camera.look_at - s.camera.position;
+    if (!(glm::length(view) > 1e-9)) fail(path, "camera.look_at must differ from camera.position");
+    if (!(glm::length(glm::cross(glm::normalize(view), glm::normalize(s.camera.up))) > 1e-6))
+      fail(path, "camera.up must not be parallel to the view direction");
   }
   if (j.contains("render")) {
     s.spp = get<int>(j["render"], "spp", s.spp, path);
@@ -93,12 +142,13 @@ SceneDesc parse_scene(const std::string& path) {
   if (j.contains("environment")) {
     const json& e = j["environment"];
     s.environment.scale = get<double>(e, "scale", 1.0, path);
+    if (!(s.environment.scale >= 0.0 && s.environment.scale <= 1e30)) fail(path, "environment.scale must be a finite number >= 0");
     if (e.contains("file")) {
       s.environment.kind = EnvironmentDesc::Kind::file;
       s.environment.file = get<std::string>(e, "file", "", path);
     } else if (e.contains("constant")) {
       s.environment.kind = EnvironmentDesc::Kind::constant;
-      s.environment.constant = vec3(e["constant"], "environment.constant", path);
+      s.environment.constant = nonnegative(e["constant"], "environment.constant", path);
     } else if (get<std::string>(e, "builtin", "", path) == "sky") {
       s.environment.kind = EnvironmentDesc::Kind::builtin_sky;
     } else {
@@ -116,12 +166,12 @@ SceneDesc parse_scene(const std::string& path) {
     const std::string type = get<std::string>(l, "type", "", path);
     if (type == "directional") {
       d.kind = LightDesc::Kind::directional;
-      d.vector = glm::normalize(vec3(l.value("direction", json()), "directional light direction", path));
-      d.value = vec3(l.value("irradiance", json()), "directional light irradiance", path);
+      d.vector = direction(l.value("direction", json()), "directional light direction", path);
+      d.value = nonnegative(l.value("irradiance", json()), "directional light irradiance", path);
     } else if (type == "point") {
       d.kind = LightDesc::Kind::point;
-      d.vector = vec3(l.value("position", json()), "point light position", path);
-      d.value = vec3(l.value("intensity", json()), "point light intensity", path);
+      d.vector = position(l.value("position", json()), "point light position", path);
+      d.value = nonnegative(l.value("intensity", json()), "point light intensity", path);
     } else {
       fail(path, "light type must be directional or point");
     }
@@ -133,14 +183,15 @@ SceneDesc parse_scene(const std::string& path) {
     const std::string type = get<std::string>(o, "type", "", path);
     if (type == "sphere") {
       d.kind = ObjectDesc::Kind::sphere;
-      d.center = vec3(o.value("center", json::array({0, 0, 0})), "sphere center", path);
+      d.center = position(o.value("center", json::array({0, 0, 0})), "sphere center", path);
       d.radius = get<double>(o, "radius", 1.0, path);
-      if (!(d.radius > 0.0)) fail(path, "sphere radius must be positive");
+      if (!(d.radius > 0.0 && d.radius <= kMaxCoordinate)) fail(path, "sphere radius must be in (0, 1e6]");
     } else if (type == "plane") {
       d.kind = ObjectDesc::Kind::plane;
-      d.point = vec3(o.value("point", json::array({0, 0, 0})), "plane point", path);
-      d.normal = glm::normalize(vec3(o.value("normal", json::array({0, 1, 0})), "plane normal", path));
+      d.point = position(o.value("point", json::array({0, 0, 0})), "plane point", path);
+      d.normal = direction(o.value("normal", json::array({0, 1, 0})), "plane normal", path);
       d.size = get<double>(o, "size", 10.0, path);
+      if (!(d.size > 0.0 && d.size <= kMaxCoordinate)) fail(path, "plane size must be in (0, 1e6]");
     } else if (type == "mesh") {
       d.kind = ObjectDesc::Kind::mesh;
       d.file = get<std::string>(o, "file", "", path);
