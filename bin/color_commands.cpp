@@ -123,7 +123,14 @@ Image read_image(const std::string& path) {
   image.rgb.resize(3 * n);
   if (a >= 0) image.alpha.resize(n);
   for (std::size_t p = 0; p < n; ++p) {
-    for (int c = 0; c < 3; ++c) image.rgb[3 * p + c] = all[p * nch + std::size_t(channel[c])];
+    for (int c = 0; c < 3; ++c) {
+      const float v = all[p * nch + std::size_t(channel[c])];
+      // A NaN or infinite pixel has no colour difference: refused, not averaged into a score.
+      if (!std::isfinite(v))
+        fail(path, std::string("non-finite ") + names[c] + " value at pixel (" + std::to_string(p % std::size_t(spec.width)) + ", " +
+                       std::to_string(p / std::size_t(spec.width)) + ")");
+      image.rgb[3 * p + c] = v;
+    }
     if (a >= 0) image.alpha[p] = all[p * nch + std::size_t(a)];
   }
   return image;

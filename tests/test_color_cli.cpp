@@ -222,6 +222,13 @@ TEST(DiffCli, BadInputs) {
   r = facetfit("diff " + a + " " + a + " --heatmap " + dir.file("no/such/folder/heat.png"));
   EXPECT_EQ(r.status, 1);
   EXPECT_EQ(r.out, "");
+
+  // NaN and infinite pixels have no colour difference: refused with the pixel named, not scored.
+  TestImage(8, 4, {"R", "G", "B"}).fill({0.2f, 0.1f, 0.05f}).fill({std::nanf(""), 0.1f, 0.05f}, 2, 3).write(dir.file("nan.exr"));
+  r = facetfit("diff " + dir.file("nan.exr") + " " + a);
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find(dir.file("nan.exr") + ": non-finite R value at pixel (2, 0)"), std::string::npos) << r.err;
+  EXPECT_EQ(r.out, "");
 }
 
 // A and B differ on the left half only.

@@ -1,8 +1,9 @@
 // LUT textures: bake -> write -> read gives back the same model; metadata round trip; bad files.
+#include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
 
-#include <OpenImageIO/imageio.h>
-
+#include <cmath>
+#include <limits>
 #include <random>
 
 #include "core/error.h"
@@ -143,6 +144,25 @@ TEST(Lut, BadFilesGetOneClearLine) {
   }
   EXPECT_NE(error_of([&] { read_lut(dir.file("contradicts.exr")); }).find("contradicts.exr: facetfit LUT whose smith_code"),
             std::string::npos);
+  // Metadata numbers that are not finite or out of range are refused, naming the attribute (a LUT with
+  // a NaN or negative alpha, f0 or tolerance used to render without complaint).
+  const auto tampered = [&](const char* name, float value) {
+    auto in = OIIO::ImageInput::open(dir.file("good.exr"));
+    OIIO::ImageSpec spec = in->spec();
+    std::vector<float> px(std::size_t(spec.width) * std::size_t(spec.height) * std::size_t(spec.nchannels));
+    EXPECT_TRUE(in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, px.data()));
+    spec.attribute(std::string("facetfit:") + name, value);
+    const std::string file = dir.file(std::string("tampered-") + name + ".exr");
+    auto out = OIIO::ImageOutput::create(file);
+    EXPECT_TRUE(out->open(file, spec) && out->write_image(OIIO::TypeDesc::FLOAT, px.data()) && out->close());
+    return error_of([&] { read_lut(file); });
+  };
+  for (const auto& [name, value] : {std::pair{"alpha_ggx", std::nanf("")}, {"alpha_beckmann", -0.2f}, {"tolerance", -1.0f},
+                                    {"coat_f0", 2.0f}, {"ggx_alpha", std::numeric_limits<float>::infinity()}, {"error", std::nanf("")}}) {
+    const std::string e = tampered(name, value);
+    EXPECT_NE(e.find(std::string("facetfit:") + name + " is "), std::string::npos) << name << ": " << e;
+    EXPECT_EQ(e.find('\n'), std::string::npos) << e;
+  }
 }
 
 }  // namespace

@@ -3,6 +3,7 @@
 #include <OpenImageIO/imageio.h>
 
 #include <cmath>
+#include <sstream>
 
 #include "core/error.h"
 #include "fit/roughness.h"
@@ -197,6 +198,46 @@ std::optional<ParametricBrdf> Lut::parametric(const std::string& family, Smith s
   return ParametricBrdf(Ndf::isotropic(type, p->alpha), smith, p->f0, p->f82, p->body, p->coat);
 }
 
+namespace {
+
+// Every number of the metadata finite and in its range, or one line naming the attribute: a LUT edited by
+// hand or damaged must not render NaN or negative light.
+void validate(const std::string& path, const LutMetadata& m) {
+  const auto in_range = [&](const std::string& name, double v, double lo, double hi) {
+    if (!(v >= lo && v <= hi)) {
+      std::ostringstream s;
+      s << "facetfit:" << name << " is " << v << ": must be in [" << lo << ", " << hi << "]";
+      fail(path, s.str());
+    }
+  };
+  const auto colour = [&](const std::string& name, const Rgb& c, double hi) {
+    for (int k = 0; k < 3; ++k) in_range(name, c[k], 0.0, hi);
+  };
+  in_range("alpha_ggx", m.alpha_ggx, 0.0, 10.0);
+  in_range("alpha_beckmann", m.alpha_beckmann, 0.0, 10.0);
+  colour("f0", m.f0, 1e3);  // an implausible measurement may give F > 1: baked with a warning, kept finite
+  colour("f82", m.f82, 1e3);
+  colour("body", m.body, 1e3);
+  in_range("coat_alpha", m.coat.alpha, 0.0, 10.0);
+  in_range("coat_f0", m.coat.f0, 0.0, 1.0);
+  for (const auto& [name, p] : {std::pair{"ggx", &m.ggx}, {"beckmann", &m.beckmann}, {"lsq", &m.lsq}}) {
+    const std::string n = name;
+    in_range(n + "_alpha", p->alpha, 0.0, 10.0);
+    colour(n + "_body", p->body, 1e3);
+    colour(n + "_f0", p->f0, 1e3);
+    colour(n + "_f82", p->f82, 1e3);
+    in_range(n + "_coat_alpha", p->coat.alpha, 0.0, 10.0);
+    in_range(n + "_coat_f0", p->coat.f0, 0.0, 1.0);
+  }
+  for (const auto& [name, v] : {std::pair{"tolerance", m.tolerance}, {"residual", m.residual}, {"error", m.error},
+                                {"error_ggx", m.error_ggx}, {"error_beckmann", m.error_beckmann}, {"error_lsq", m.error_lsq},
+                                {"error_extraction", m.error_extraction}, {"ndf_error_ggx", m.ndf_error_ggx},
+                                {"ndf_error_beckmann", m.ndf_error_beckmann}})
+    in_range(name, v, 0.0, 1e30);
+}
+
+}  // namespace
+
 Lut read_lut(const std::string& path) {
   auto image = open_image(path);
   const ImageSpec& spec = image->spec();
@@ -216,8 +257,11 @@ Lut read_lut(const std::string& path) {
   const auto smith = parse_smith(spec.get_string_attribute(key("smith")));
   const auto representation = parse_representation(spec.get_string_attribute(key("representation")));
   const auto f0 = get_color(spec, "f0"), f82 = get_color(spec, "f82");
-  if (!smith || !representation || !f0 || !f82 || m.resolution < 4 || m.resolution > 4096)
-    fail(path, "facetfit LUT with missing or invalid metadata");
+  if (!smith) fail(path, "facetfit:smith is missing or not masking, correlated or separable");
+  if (!representation) fail(path, "facetfit:representation is missing or not tabulated, ggx or beckmann");
+  if (!f0 || !f82) fail(path, std::string("facetfit:") + (!f0 ? "f0" : "f82") + " is missing or not a colour");
+  if (m.resolution < 4 || m.resolution > 4096)
+    fail(path, "facetfit:resolution is " + std::to_string(m.resolution) + ": must be between 4 and 4096");
   m.smith = *smith;
   m.representation = *representation;
   // The integer codes, where present (LUTs of facetfit 0.1.0 before they were added have none), must agree.
@@ -264,6 +308,7 @@ Lut read_lut(const std::string& path) {
     m.error_extraction = spec.get_float_attribute(key("error_extraction"));
   }
 
+  validate(path, m);
   const LutLayout layout = LutLayout::of(m.resolution, m.sampling);
   if (spec.width != layout.width || spec.height != layout.height)
     fail(path, "image is " + std::to_string(spec.width) + " x " + std::to_string(spec.height) + ", expected " +
