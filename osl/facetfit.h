@@ -46,46 +46,6 @@ int facetfit_code(string file, string attribute, string name0, string name1, str
 int facetfit_smith_code(string file) { return facetfit_code(file, "smith", "masking", "correlated", "separable"); }
 int facetfit_representation_code(string file) { return facetfit_code(file, "representation", "tabulated", "ggx", "beckmann"); }
 
-// Opens a LUT (format 1 or 2): its size and metadata, the body and coat of format 2. ok = 0 when the
-// file is missing, is not a facetfit LUT, or does not say its Smith model in a way this renderer can read.
-FacetfitLut facetfit_open(string file) {
-  FacetfitLut lut;
-  lut.file = file;
-  lut.ok = 0;
-  lut.body = color(0);
-  lut.coat_alpha = 0.0;
-  lut.coat_f0 = 0.0;
-  lut.weight_lobe = 1.0;
-  lut.weight_body = 0.0;
-  int res[2] = {0, 0};
-  int version = 0, resolution = 0, sampling = 0;
-  if (gettextureinfo(file, "resolution", res) && gettextureinfo(file, "facetfit:format_version", version) &&
-      gettextureinfo(file, "facetfit:resolution", resolution) && (version == 1 || version == 2)) {
-    gettextureinfo(file, "facetfit:sampling", sampling);
-    lut.width = res[0];
-    lut.height = res[1];
-    lut.resolution = resolution;
-    lut.sampling = sampling;
-    lut.smith = facetfit_smith_code(file);
-    lut.ok = lut.smith >= 0 && lut.smith <= 2;
-    if (version == 2) {
-      gettextureinfo(file, "facetfit:body", lut.body);
-      gettextureinfo(file, "facetfit:coat_alpha", lut.coat_alpha);
-      gettextureinfo(file, "facetfit:coat_f0", lut.coat_f0);
-      if (!(lut.coat_alpha > 0.0 && lut.coat_f0 > 0.0)) lut.coat_alpha = lut.coat_f0 = 0.0;
-    }
-    // The sampler's parts by albedo, as the library weighs them: lobe F(0), body, coat f0; the lobe and
-    // the coat at least 0.1.
-    color f0 = texture(file, 0.5 / lut.width, (FACETFIT_FRESNEL_ROW + 0.5) / lut.height, "interp", "linear", "wrap", "clamp",
-                       "width", 0.0);  // F(0): the Fresnel row's first texel
-    float lobe = max(0.2126 * f0[0] + 0.7152 * f0[1] + 0.0722 * f0[2], 0.1);
-    float body = max(0.2126 * lut.body[0] + 0.7152 * lut.body[1] + 0.0722 * lut.body[2], 0.0);
-    float coat = lut.coat_alpha > 0.0 ? max(lut.coat_f0, 0.1) : 0.0;
-    lut.weight_lobe = lobe / (lobe + body + coat);
-    lut.weight_body = body / (lobe + body + coat);
-  }
-  return lut;
-}
 
 // ---- accurate angles ----
 // OSL renderers may compile acos, atan2, sin and cos to fast approximations (Cycles' OSL: acos off by up
@@ -210,6 +170,48 @@ color facetfit_fresnel(FacetfitLut lut, float theta_d) {
   float x = clamp(theta_d / (0.5 * FACETFIT_PI) * 90.0, 0.0, 89.0);
   float s = (x + 0.5) / lut.width, t = (FACETFIT_FRESNEL_ROW + 0.5) / lut.height;
   return texture(lut.file, s, t, "interp", "linear", "wrap", "clamp", "width", 0.0);
+}
+
+// Rec.709 relative luminance, as core/vec.h's luminance().
+float facetfit_luminance(color c) { return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]; }
+
+// Opens a LUT (format 1 or 2): its size and metadata, the body and coat of format 2. ok = 0 when the
+// file is missing, is not a facetfit LUT, or does not say its Smith model in a way this renderer can read.
+FacetfitLut facetfit_open(string file) {
+  FacetfitLut lut;
+  lut.file = file;
+  lut.ok = 0;
+  lut.body = color(0);
+  lut.coat_alpha = 0.0;
+  lut.coat_f0 = 0.0;
+  lut.weight_lobe = 1.0;
+  lut.weight_body = 0.0;
+  int res[2] = {0, 0};
+  int version = 0, resolution = 0, sampling = 0;
+  if (gettextureinfo(file, "resolution", res) && gettextureinfo(file, "facetfit:format_version", version) &&
+      gettextureinfo(file, "facetfit:resolution", resolution) && (version == 1 || version == 2)) {
+    gettextureinfo(file, "facetfit:sampling", sampling);
+    lut.width = res[0];
+    lut.height = res[1];
+    lut.resolution = resolution;
+    lut.sampling = sampling;
+    lut.smith = facetfit_smith_code(file);
+    lut.ok = lut.smith >= 0 && lut.smith <= 2;
+    if (version == 2) {
+      gettextureinfo(file, "facetfit:body", lut.body);
+      gettextureinfo(file, "facetfit:coat_alpha", lut.coat_alpha);
+      gettextureinfo(file, "facetfit:coat_f0", lut.coat_f0);
+      if (!(lut.coat_alpha > 0.0 && lut.coat_f0 > 0.0)) lut.coat_alpha = lut.coat_f0 = 0.0;
+    }
+    // The sampler's parts by albedo, as the library weighs them: lobe F(0), body, coat f0; the lobe and
+    // the coat at least 0.1.
+    float lobe = max(facetfit_luminance(facetfit_fresnel(lut, 0.0)), 0.1);
+    float body = max(facetfit_luminance(lut.body), 0.0);
+    float coat = lut.coat_alpha > 0.0 ? max(lut.coat_f0, 0.1) : 0.0;
+    lut.weight_lobe = lobe / (lobe + body + coat);
+    lut.weight_body = body / (lobe + body + coat);
+  }
+  return lut;
 }
 
 // ---- the clear coat: GGX, grey Schlick Fresnel, height-correlated Smith (lib/model/coat.h) ----

@@ -39,7 +39,7 @@ struct MeasuredBins {
 
 // Every valid bin with both directions above the horizon, theta_d and phi_d taken every `stride_d` and
 // `stride_phi` bins (theta_h: every bin). Empty when the table has no valid bin.
-MeasuredBins measured_bins(const MerlTable& table, int stride_d = 2, int stride_phi = 6);
+MeasuredBins measured_bins(const MerlTable& table, int stride_d, int stride_phi);
 
 // The two bin sets of the fits: every solve runs on the sparse one (6.4k bins: the fitted distances
 // move by < 1% between 93k bins and this), every distance is measured on the denser, mostly disjoint
@@ -69,7 +69,6 @@ inline double metric_slope(double x) {
 
 // The metric's per-bin residual of one channel (the model is nonnegative; the measurement is kept as it is).
 inline double metric_residual(double model, double measured, double cos_mean) {
-  using std::cbrt;
   return metric_transform(std::max(model, 0.0) * cos_mean) - metric_transform(measured * cos_mean);
 }
 

@@ -17,8 +17,6 @@ std::string format(const char* fmt, double a, double b = 0.0, double c = 0.0) {
   return buf;
 }
 
-const char* kChannel[3] = {"red", "green", "blue"};
-
 // The largest channel value of `v` above `limit`: (channel, value), or channel -1.
 std::pair<int, double> above(const Rgb& v, double limit) {
   int c = -1;
@@ -56,22 +54,22 @@ std::vector<std::string> plausibility_warnings(const MerlTable& table, const Fit
     }
     if (negative > 0)
       out.push_back(format("%.1f%% of the measured values are negative in the ", 100.0 * double(negative) / double(valid)) +
-                    kChannel[c] + " channel (noise around zero, kept as measurements)");
+                    MerlTable::channel_name(c) + " channel (noise around zero, kept as measurements)");
   }
   // The Fresnel curve of the tabulated representation.
   for (int j = 0; j < FresnelCurve::kSize; ++j) {
     const auto [c, v] = above(fit.fresnel().value[std::size_t(j)], 1.0);
     if (c < 0) continue;
     out.push_back(format("Fresnel factor above 1: %.3f at theta_d %.0f degrees", v, FresnelCurve::theta_d(j) * 180.0 / kPi) +
-                  " (" + kChannel[c] + "; first such angle)");
+                  " (" + MerlTable::channel_name(c) + "; first such angle)");
     break;
   }
   if (fit.refined)
     for (const auto& [name, p] : {std::pair<const char*, const ParametricFit*>{"ggx", &fit.ggx}, {"beckmann", &fit.beckmann}, {"lsq", &fit.lsq}}) {
       const auto [c0, f0] = above(p->f0, 1.0);
       const auto [c82, f82] = above(p->f82, 1.0);
-      if (c0 >= 0) out.push_back(std::string(name) + format(" fit: f0 above 1 (%.3f, ", f0) + kChannel[c0] + ")");
-      if (c82 >= 0) out.push_back(std::string(name) + format(" fit: f82 above 1 (%.3f, ", f82) + kChannel[c82] + ")");
+      if (c0 >= 0) out.push_back(std::string(name) + format(" fit: f0 above 1 (%.3f, ", f0) + MerlTable::channel_name(c0) + ")");
+      if (c82 >= 0) out.push_back(std::string(name) + format(" fit: f82 above 1 (%.3f, ", f82) + MerlTable::channel_name(c82) + ")");
     }
   // Directional albedo of the measurement and of the tabulated representation.
   const TabulatedMicrofacet model(MicrofacetTables{fit.ndf(), fit.smith, fit.fresnel(), fit.body(), fit.lobe.coat}, {});
@@ -80,7 +78,7 @@ std::vector<std::string> plausibility_warnings(const MerlTable& table, const Fit
       const auto [c, v] = above(directional_albedo(*brdf, spherical_direction(degrees * kPi / 180.0, 0.0)), 1.0);
       if (c < 0) continue;
       out.push_back(std::string("directional albedo of the ") + what + format(" above 1: %.3f at theta %.0f degrees", v, degrees) +
-                    " (" + kChannel[c] + ")");
+                    " (" + MerlTable::channel_name(c) + ")");
       break;
     }
   }

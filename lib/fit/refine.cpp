@@ -103,22 +103,14 @@ class NormalizationCost final : public ceres::CostFunction {
   double weight_;
 };
 
-// weight (D_{j-1} - 2 D_j + D_{j+1}) / scale: a relative second difference of the NDF nodes.
-struct NdfSecondDifference {
-  double weight;  // already divided by the scale
-  template <class T>
-  bool operator()(const T* a, const T* b, const T* c, T* r) const {
-    r[0] = weight * (a[0] - 2.0 * b[0] + c[0]);
-    return true;
-  }
-};
-
-// weight (F_{j-1} - 2 F_j + F_{j+1}) per channel.
+// weight (x_{j-1} - 2 x_j + x_{j+1}) per component of N: the Fresnel curve's channels (N = 3), or an
+// NDF node (N = 1, the weight already divided by the node's scale: a relative second difference).
+template <int N>
 struct SecondDifference {
   double weight;
   template <class T>
   bool operator()(const T* a, const T* b, const T* c, T* r) const {
-    for (int ch = 0; ch < 3; ++ch) r[ch] = weight * (a[ch] - 2.0 * b[ch] + c[ch]);
+    for (int k = 0; k < N; ++k) r[k] = weight * (a[k] - 2.0 * b[k] + c[k]);
     return true;
   }
 };
@@ -179,12 +171,12 @@ LobeFit refine_lobe(const MeasuredBins& bins, const Quadrature& quad, Smith smit
     problem.AddResidualBlock(new NormalizationCost(quad.projected_area(), 10.0), nullptr, all_nodes);
     for (int j = 1; j + 1 < FresnelCurve::kSize; ++j)
       problem.AddResidualBlock(
-          new ceres::AutoDiffCostFunction<SecondDifference, 3, 3, 3, 3>(new SecondDifference{options.fresnel_smoothness}),
+          new ceres::AutoDiffCostFunction<SecondDifference<3>, 3, 3, 3, 3>(new SecondDifference<3>{options.fresnel_smoothness}),
           nullptr, fresnel[std::size_t(j - 1)].data(), fresnel[std::size_t(j)].data(), fresnel[std::size_t(j + 1)].data());
     for (std::size_t j = 1; j + 1 < d.size(); ++j) {
       const double scale = std::max(d[j], 1e-3 * d[0] + 1e-6);
-      problem.AddResidualBlock(new ceres::AutoDiffCostFunction<NdfSecondDifference, 1, 1, 1, 1>(
-                                   new NdfSecondDifference{options.ndf_smoothness / scale}),
+      problem.AddResidualBlock(new ceres::AutoDiffCostFunction<SecondDifference<1>, 1, 1, 1, 1>(
+                                   new SecondDifference<1>{options.ndf_smoothness / scale}),
                                nullptr, &d[j - 1], &d[j], &d[j + 1]);
     }
     // Bounds, not a clamp afterwards: left free, the solve trades negative nodes against each other.

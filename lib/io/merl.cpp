@@ -52,7 +52,6 @@ BinCoords bin_coords(const Vec3& i, const Vec3& o) {
           hd.theta_d / (0.5 * kPi) * MerlTable::kThetaD, phi_d / kPi * MerlTable::kPhiD};
 }
 
-const char* channel_name(int c) { return c == 0 ? "red" : (c == 1 ? "green" : "blue"); }
 
 }  // namespace
 
@@ -73,8 +72,18 @@ MerlTable MerlTable::centres_to_edges() const {
   // bin, and the power iteration carries that into alpha (+1.7% at alpha 0.4). In half/diff
   // coordinates cos(theta_i) cos(theta_o) = A^2 - B^2 cos^2(phi_d), A = cos(theta_h) cos(theta_d),
   // B = sin(theta_h) sin(theta_d) (docs/conventions.md).
-  const auto cosines = [](double theta_h, double theta_d, double phi_d) {
-    const double a = std::cos(theta_h) * std::cos(theta_d), b = std::sin(theta_h) * std::sin(theta_d), c = std::cos(phi_d);
+  // cos and sin of every axis position, at the edges ([0]) and at the centres ([1]), computed once.
+  struct Trig {
+    double cos[2], sin[2];
+  };
+  std::vector<Trig> th(kThetaH), td(kThetaD), tp(kPhiD);
+  for (int at = 0; at < 2; ++at) {
+    for (int i = 0; i < kThetaH; ++i) th[i].cos[at] = std::cos(theta_h(i + 0.5 * at)), th[i].sin[at] = std::sin(theta_h(i + 0.5 * at));
+    for (int j = 0; j < kThetaD; ++j) td[j].cos[at] = std::cos(theta_d(j + 0.5 * at)), td[j].sin[at] = std::sin(theta_d(j + 0.5 * at));
+    for (int k = 0; k < kPhiD; ++k) tp[k].cos[at] = std::cos(phi_d(k + 0.5 * at));
+  }
+  const auto cosines = [&](int i, int j, int k, int at) {
+    const double a = th[i].cos[at] * td[j].cos[at], b = th[i].sin[at] * td[j].sin[at], c = tp[k].cos[at];
     return a * a - b * b * c * c;
   };
   MerlTable out;
@@ -86,10 +95,9 @@ MerlTable MerlTable::centres_to_edges() const {
       for (int k = 0; k < kPhiD; ++k) {
         const int p[2] = {(k + kPhiD - 1) % kPhiD, k};
         const std::size_t n = index(i, j, k);
-        const double edge = cosines(theta_h(i), theta_d(j), phi_d(k));
+        const double edge = cosines(i, j, k, 0);
         double weight[8];
-        for (int corner = 0; corner < 8; ++corner)
-          weight[corner] = cosines(theta_h(h[corner & 1] + 0.5), theta_d(d[(corner >> 1) & 1] + 0.5), phi_d(p[corner >> 2] + 0.5));
+        for (int corner = 0; corner < 8; ++corner) weight[corner] = cosines(h[corner & 1], d[(corner >> 1) & 1], p[corner >> 2], 1);
         for (int c = 0; c < 3; ++c) {
           double sum = 0.0, plain = 0.0;
           int count = 0;

@@ -68,6 +68,7 @@ class MerlTable final : public Brdf {
   float* channel(int c) { return data_.data() + std::size_t(c) * kBins; }
   float value(int c, int i, int j, int k) const { return channel(c)[index(i, j, k)]; }
   static bool missing(float v) { return std::isnan(v); }
+  static const char* channel_name(int c) { return c == 0 ? "red" : (c == 1 ? "green" : "blue"); }
   void set(int i, int j, int k, const Rgb& v);
   void set_missing(int i, int j, int k);
 

@@ -192,7 +192,7 @@ void write_lut(const std::string& path, const Lut& lut) {
 }
 
 std::optional<ParametricBrdf> Lut::parametric(const std::string& family, Smith smith) const {
-  const LutMetadata::Parametric* p = family == "ggx" ? &meta.ggx : family == "beckmann" ? &meta.beckmann : family == "lsq" ? &meta.lsq : nullptr;
+  const LutMetadata::Parametric* p = meta.fit(family);
   if (!p) return std::nullopt;
   const NdfType type = family == "beckmann" ? NdfType::beckmann : NdfType::ggx;
   return ParametricBrdf(Ndf::isotropic(type, p->alpha), smith, p->f0, p->f82, p->body, p->coat);

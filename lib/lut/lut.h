@@ -41,6 +41,10 @@ struct LutMetadata {
     Coat coat;
   };
   Parametric ggx, beckmann, lsq;
+  // The fit named "ggx", "beckmann" or "lsq"; null for another name.
+  const Parametric* fit(const std::string& family) const {
+    return family == "ggx" ? &ggx : family == "beckmann" ? &beckmann : family == "lsq" ? &lsq : nullptr;
+  }
   // Distance of each representation from the measurement (fit/measurement.h), and of the paper's pure fit.
   double error = 0.0, error_ggx = 0.0, error_beckmann = 0.0, error_lsq = 0.0, error_extraction = 0.0;
   // Relative L1 distance (projected-area weighted) of each parametric NDF from the tabulated one.

@@ -304,7 +304,7 @@ std::shared_ptr<const ShadingModel> load_material(const SceneDesc& scene, const 
     // The LUT's fit of this family on the whole measurement: its alpha and body, with its own F82-tint
     // Fresnel or the tabulated curve.
     const Lut lut = read_lut(resolve(scene, m.file));
-    const LutMetadata::Parametric& p = m.type == "lsq" ? lut.meta.lsq : type == NdfType::ggx ? lut.meta.ggx : lut.meta.beckmann;
+    const LutMetadata::Parametric& p = *lut.meta.fit(m.type);  // m.type is ggx, beckmann or lsq here
     ndf = Ndf::isotropic(type, p.alpha);
     brdf = m.fresnel == "curve" ? std::make_shared<ParametricBrdf>(ndf, m.smith, lut.tables.fresnel, p.body, p.coat)
                                 : std::make_shared<ParametricBrdf>(*lut.parametric(m.type, m.smith));
