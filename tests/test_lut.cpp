@@ -96,6 +96,26 @@ TEST(Lut, ToleranceChoosesTheRepresentation) {
   EXPECT_EQ(make_lut(ggx.fit, ggx.fitter.quadrature(), "x", "", 0.02, true).meta.representation, Representation::ggx);
 }
 
+TEST(Lut, ADarkChannelOfNegativeNoiseBakesAndReadsBack) {
+  // Blue is noise around a slightly negative mean (RGL's dark channels): the paper's Fresnel ratio
+  // would be negative there; the curve is clamped at zero and the LUT reads back (a negative f0 is
+  // refused on reading).
+  MerlTable table = MerlTable::tabulate(MicrofacetBrdf(Ndf::isotropic(NdfType::ggx, 0.2), Smith::correlated, Fresnel::one()));
+  std::mt19937 rng(7);
+  std::normal_distribution<float> noise(-0.002f, 0.01f);
+  float* blue = table.channel(2);
+  for (std::size_t n = 0; n < MerlTable::kBins; ++n) blue[n] = noise(rng);
+  for (const FitOptions& options : {FitOptions::paper(), FitOptions{}}) {
+    const FitResult fit = Fitter(options).fit(table);
+    ASSERT_TRUE(fit.ok()) << fit.problem;
+    for (int j = 0; j < FresnelCurve::kSize; ++j) EXPECT_GE(fit.fresnel().value[std::size_t(j)].b, 0.0) << j;
+    TempDir dir;
+    write_lut(dir.file("dark.exr"), make_lut(fit, Fitter(options).quadrature(), "x", "", 0.02, false));
+    const Lut back = read_lut(dir.file("dark.exr"));
+    EXPECT_GE(back.meta.f0.b, 0.0);
+  }
+}
+
 TEST(Lut, EvalOnlyLeavesOutTheSamplingTables) {
   const Baked b = fit_of(MicrofacetBrdf(Ndf::isotropic(NdfType::ggx, 0.2), Smith::correlated, Fresnel::one()));
   TempDir dir;

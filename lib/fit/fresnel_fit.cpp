@@ -3,6 +3,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_reduce.h>
 
+#include <algorithm>
 #include <cmath>
 
 namespace facetfit {
@@ -112,7 +113,9 @@ FresnelCurve fit_fresnel(const MerlTable& table, const TabulatedNdf& ndf, Smith 
       curve.count[std::size_t(j)][c] = sums.count[j][c];
       if (sums.model[j][c] > 0.0 && sums.count[j][c] > 0) {
         usable.push_back(j);
-        curve.value[std::size_t(j)][c] = sums.measured[j][c] / sums.model[j][c];
+        // A reflectance is not negative: where noise around zero (RGL's negative entries) outweighs
+        // the signal, the ratio is clamped rather than baked as a negative Fresnel factor.
+        curve.value[std::size_t(j)][c] = std::max(0.0, sums.measured[j][c] / sums.model[j][c]);
       }
     }
     if (usable.empty()) {
