@@ -12,6 +12,7 @@ MeasuredBins measured_bins(const MerlTable& table, int stride_d, int stride_phi)
   for (int i = 0; i < MerlTable::kThetaH; ++i) {
     // The cell's measure, 4 cos(theta_d) sin(theta_d) sin(theta_h) dtheta_h dtheta_d dphi_d (the Jacobian of
     // the half/difference parameterization), at the cell's centre; theta_h = u^2 pi/2, so dtheta_h = u pi du.
+    // Each bin then weighs by cos(theta_i) cos(theta_o) too (below).
     const double u = (i + 0.5) / MerlTable::kThetaH;
     const double theta_h_mid = u * u * 0.5 * kPi;
     const double h_measure = std::sin(theta_h_mid) * u * kPi;
@@ -32,7 +33,7 @@ MeasuredBins measured_bins(const MerlTable& table, int stride_d, int stride_phi)
         bins.i.push_back(wi);
         bins.o.push_back(wo);
         bins.cos_mean.push_back(0.5 * (wi.z + wo.z));
-        bins.weight.push_back(measure);
+        bins.weight.push_back(measure * wi.z * wo.z);
         bins.value.push_back(v);
         bins.valid.push_back(valid);
         total += measure;

@@ -6,9 +6,11 @@
 // y the measurement, f the model, L CIE L*'s lightness function of pi x (over 116). f c is the reflected
 // radiance per unit irradiance, so a residual is a difference of lightness, what CIE Delta E measures of
 // a rendering: compressive on glossy peaks (10-1000), steep but bounded near black, where dark channels
-// and RGL's negative entries live. Each bin also weighs by the solid-angle measure of its cell in
-// (theta_h, theta_d, phi_d), so that the mean approximates an integral over direction pairs rather than
-// favouring the bins MERL packs near the specular peak.
+// and RGL's negative entries live. Each bin weighs by the projected solid angle of its cell,
+// cos(theta_i) cos(theta_o) d(omega_i) d(omega_o): the mean approximates an integral over direction pairs
+// rather than favouring the bins MERL packs near the specular peak, and over the pairs as a rendering
+// sees them (light arrives weighted by cos theta_i, a surface covers pixels in proportion to
+// cos theta_o), so grazing pairs, which plain solid angle favours, do not outweigh what is on screen.
 #pragma once
 
 #include <algorithm>

@@ -149,6 +149,24 @@ LobeFit refine_lobe(const MeasuredBins& bins, const Quadrature& quad, Smith smit
   std::vector<NodeWeights> row_nodes;
   row_nodes.reserve(bins.rows.size());
   for (const MeasuredBins::Row& row : bins.rows) row_nodes.push_back(node_weights(grid, MerlTable::theta_h(row.theta_h)));
+  // The Fresnel unknowns are the entries at the theta_d the bins sample (the knots); the entries between
+  // them are linear in between, those past the last knot equal it. The entries no bin sees carry no
+  // information of their own, and fewer unknowns make a faster solve.
+  std::vector<int> knots;
+  for (const MeasuredBins::Row& row : bins.rows) knots.push_back(row.theta_d);
+  std::sort(knots.begin(), knots.end());
+  knots.erase(std::unique(knots.begin(), knots.end()), knots.end());
+  // The two knots bracketing entry position x and their weights.
+  const auto bracket = [&knots](double x, int e[2], double w[2]) {
+    const auto above = std::upper_bound(knots.begin(), knots.end(), x);
+    if (above == knots.begin() || above == knots.end()) {
+      e[0] = e[1] = above == knots.begin() ? knots.front() : knots.back();
+      w[0] = 1.0, w[1] = 0.0;
+      return;
+    }
+    e[0] = *(above - 1), e[1] = *above;
+    w[1] = (x - e[0]) / double(e[1] - e[0]), w[0] = 1.0 - w[1];
+  };
 
   for (int pass = 0; pass < options.passes; ++pass) {
     // G2 / (4 cos_i cos_o) of the current NDF, held for this pass.
@@ -169,10 +187,10 @@ LobeFit refine_lobe(const MeasuredBins& bins, const Quadrature& quad, Smith smit
     std::vector<double*> all_nodes;
     for (double& v : d) all_nodes.push_back(&v);
     problem.AddResidualBlock(new NormalizationCost(quad.projected_area(), 10.0), nullptr, all_nodes);
-    for (int j = 1; j + 1 < FresnelCurve::kSize; ++j)
+    for (std::size_t k = 1; k + 1 < knots.size(); ++k)
       problem.AddResidualBlock(
           new ceres::AutoDiffCostFunction<SecondDifference<3>, 3, 3, 3, 3>(new SecondDifference<3>{options.fresnel_smoothness}),
-          nullptr, fresnel[std::size_t(j - 1)].data(), fresnel[std::size_t(j)].data(), fresnel[std::size_t(j + 1)].data());
+          nullptr, fresnel[std::size_t(knots[k - 1])].data(), fresnel[std::size_t(knots[k])].data(), fresnel[std::size_t(knots[k + 1])].data());
     for (std::size_t j = 1; j + 1 < d.size(); ++j) {
       const double scale = std::max(d[j], 1e-3 * d[0] + 1e-6);
       problem.AddResidualBlock(new ceres::AutoDiffCostFunction<SecondDifference<1>, 1, 1, 1, 1>(
@@ -182,8 +200,9 @@ LobeFit refine_lobe(const MeasuredBins& bins, const Quadrature& quad, Smith smit
     // Bounds, not a clamp afterwards: left free, the solve trades negative nodes against each other.
     for (int c = 0; c < 3; ++c) problem.SetParameterLowerBound(body.data(), c, 0.0);
     // A Fresnel factor is a reflectance: in [0, 1] (above 1 the fit would trade the NDF's scale for it).
-    for (auto& f : fresnel)
-      for (int c = 0; c < 3; ++c) problem.SetParameterLowerBound(f.data(), c, 0.0), problem.SetParameterUpperBound(f.data(), c, 1.0);
+    for (int j : knots)
+      for (int c = 0; c < 3; ++c)
+        problem.SetParameterLowerBound(fresnel[std::size_t(j)].data(), c, 0.0), problem.SetParameterUpperBound(fresnel[std::size_t(j)].data(), c, 1.0);
     for (double& v : d) problem.SetParameterLowerBound(&v, 0, 0.0);
 
     ceres::Solver::Options solver;
@@ -202,8 +221,13 @@ LobeFit refine_lobe(const MeasuredBins& bins, const Quadrature& quad, Smith smit
       for (double& v : f) v = std::min(v * area, 1.0);
   }
   fit.body = Rgb(body[0], body[1], body[2]);
-  for (int j = 0; j < FresnelCurve::kSize; ++j)
-    fit.fresnel.value[std::size_t(j)] = Rgb(fresnel[std::size_t(j)][0], fresnel[std::size_t(j)][1], fresnel[std::size_t(j)][2]);
+  for (int j = 0; j < FresnelCurve::kSize; ++j) {
+    int e[2];
+    double w[2];
+    bracket(j, e, w);
+    for (int c = 0; c < 3; ++c)
+      fit.fresnel.value[std::size_t(j)][c] = w[0] * fresnel[std::size_t(e[0])][std::size_t(c)] + w[1] * fresnel[std::size_t(e[1])][std::size_t(c)];
+  }
   return fit;
 }
 
