@@ -58,7 +58,7 @@ std::optional<FitOptions::Refine> parse_refine(const std::string& name) {
 }
 
 void Fitter::refine_on_measurement(const MerlTable& table, FitResult& result) const {
-  const MeasuredBins fit_bins = solve_bins(table), bins = error_bins(table);
+  const MeasuredBins fit_bins = solve_bins(table), parametric = parametric_bins(table), bins = error_bins(table);
   const Smith smith = options_.smith;
   const auto error_of = [&](const LobeFit& lobe) {
     return measurement_error(bins, TabulatedMicrofacet(MicrofacetTables{lobe.ndf, smith, lobe.fresnel, lobe.body, lobe.coat}, {}));
@@ -70,7 +70,7 @@ void Fitter::refine_on_measurement(const MerlTable& table, FitResult& result) co
     p.body = Rgb(0.05);
     return p;
   };
-  const auto fit = [&](const ParametricFit& p) { return fit_parametric(fit_bins, bins, smith, p); };
+  const auto fit = [&](const ParametricFit& p) { return fit_parametric(parametric, bins, smith, p); };
   // With a coat (a second, sharper GGX lobe) where it brings the fit 5% nearer.
   const auto fit_coated = [&](const ParametricFit& p) {
     const ParametricFit bare = fit(p);

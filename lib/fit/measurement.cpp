@@ -33,6 +33,12 @@ MeasuredBins measured_bins(const MerlTable& table, int stride_d, int stride_phi)
         bins.i.push_back(wi);
         bins.o.push_back(wo);
         bins.cos_mean.push_back(0.5 * (wi.z + wo.z));
+        bins.cos_h.push_back(std::cos(MerlTable::theta_h(i)));
+        bins.cos_d.push_back(std::cos(MerlTable::theta_d(j)));
+        Rgb lightness(0.0);
+        for (int c = 0; c < 3; ++c)
+          if (valid >> c & 1u) lightness[c] = metric_transform(v[c] * bins.cos_mean.back());
+        bins.lightness.push_back(lightness);
         bins.weight.push_back(measure * wi.z * wo.z);
         bins.value.push_back(v);
         bins.valid.push_back(valid);
@@ -54,7 +60,7 @@ double measurement_error(const MeasuredBins& bins, const Brdf& model) {
     const Rgb m = f ? *f : Rgb(0.0);
     for (int c = 0; c < 3; ++c) {
       if (!(bins.valid[b] >> c & 1u)) continue;
-      const double r = metric_residual(m[c], bins.value[b][c], bins.cos_mean[b]);
+      const double r = metric_residual(m[c], bins.cos_mean[b], bins.lightness[b][c]);
       sum += bins.weight[b] * r * r;
       norm += bins.weight[b];
     }

@@ -40,6 +40,12 @@ T schlick(const T& f0, double mu) {
   return f0 + (1.0 - f0) * m5;
 }
 
+// mu (1 - mu)^6: the shape of the F82-tint correction.
+inline double f82_basis(double mu) {
+  const double m = 1.0 - mu, m3 = m * m * m;
+  return mu * m3 * m3;
+}
+
 // The residuals of one row of bins (3 per bin). Parameters: body (3), log alpha (1), f0 (3), f82 (3),
 // coat (log alpha, f0).
 struct RowResiduals {
@@ -56,15 +62,14 @@ struct RowResiduals {
     const T coat_alpha = exp(coat_p[0]);
     const T coat_f0 = coat_p[1];
     constexpr double mu82 = 1.0 / 7.0;
-    const double basis82 = mu82 * std::pow(1.0 - mu82, 6.0);
+    const double basis82 = f82_basis(mu82);
     for (std::size_t k = row->begin; k < row->end; ++k) {
       const Vec3& wi = bins->i[k];
       const Vec3& wo = bins->o[k];
-      const Vec3 h = glm::normalize(wi + wo);
-      const double mu = std::min(1.0, glm::dot(wi, h));
-      const T lobe = ndf_of(type, alpha, h.z) *
+      const double mu = bins->cos_d[k], cos_h = bins->cos_h[k], basis = f82_basis(mu);
+      const T lobe = ndf_of(type, alpha, cos_h) *
                      g2(lambda_of(type, alpha, wi.z), lambda_of(type, alpha, wo.z)) / (4.0 * wi.z * wo.z);
-      const T coat = with_coat ? schlick(coat_f0, mu) * ndf_of(NdfType::ggx, coat_alpha, h.z) /
+      const T coat = with_coat ? schlick(coat_f0, mu) * ndf_of(NdfType::ggx, coat_alpha, cos_h) /
                                      (1.0 + lambda_of(NdfType::ggx, coat_alpha, wi.z) + lambda_of(NdfType::ggx, coat_alpha, wo.z)) /
                                      (4.0 * wi.z * wo.z)
                                : T(0.0);
@@ -72,12 +77,12 @@ struct RowResiduals {
       for (int ch = 0; ch < 3; ++ch) {
         T fresnel = schlick(f0[ch], mu);
         if (form == ParametricFit::FresnelForm::f82)
-          fresnel -= (schlick(f0[ch], mu82) - f82[ch]) / basis82 * (mu * std::pow(1.0 - mu, 6.0));
+          fresnel -= (schlick(f0[ch], mu82) - f82[ch]) / basis82 * basis;
         T m = body[ch] / kPi + fresnel * lobe + coat;
         if (m < 0.0) m = T(0.0);  // F82-tint can dip below zero for extreme f82: no negative reflectance
         T& out = r[3 * (k - row->begin) + std::size_t(ch)];
         if (bins->valid[k] >> ch & 1u)
-          out = s * (metric_transform(m * c) - metric_transform(bins->value[k][ch] * c));
+          out = s * (metric_transform(m * c) - bins->lightness[k][ch]);
         else
           out = T(0.0);
       }

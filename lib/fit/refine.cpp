@@ -58,7 +58,7 @@ class RowCost final : public ceres::CostFunction {
         const std::size_t r = 3 * b + std::size_t(ch);
         const bool valid = bins_.valid[k] >> ch & 1u;
         const double m = body[ch] * kInvPi + fresnel[ch] * d * g + coat_[k];
-        residuals[r] = valid ? s * metric_residual(m, bins_.value[k][ch], c) : 0.0;
+        residuals[r] = valid ? s * metric_residual(m, c, bins_.lightness[k][ch]) : 0.0;
         if (!jacobians) continue;
         // d/dm of the residual: the chain rule for every parameter below.
         const double dm = valid && m >= 0.0 ? s * c * metric_slope(m * c) : 0.0;
