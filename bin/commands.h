@@ -37,4 +37,10 @@ void add_report_command(CLI::App& app, int& status);
 // "facetfit: error: <message>" on stderr, one line.
 void report_error(const std::string& message);
 
+// Parses and runs one command line on an app holding the core commands (fit, convert, list-builtins) and
+// those `register_more` adds; returns the exit status.
+int run_app(int argc, char** argv, void (*register_more)(CLI::App& app, int& status));
+// Whether a subcommand is one of the core commands, which need no image I/O, colour or ray tracing.
+bool is_core_command(const std::string& name);
+
 }  // namespace facetfit::cli

@@ -1,101 +1,63 @@
 // facetfit: turn measured BRDFs into microfacet components.
-#include <tbb/global_control.h>
+//
+// The commands that only read measurements and fit (fit, convert, list-builtins) run in this executable, which
+// links the core library alone, and so does --version. Every other command (bake, info, render, diff,
+// deltae, report) and the help listing them all run in the plugin facetfit-commands.so, loaded on demand: it brings OpenImageIO, OpenColorIO
+// and Embree, whose loading costs more than a fit (docs/benchmarks.md, "Start-up").
+#include <dlfcn.h>
+#include <unistd.h>
 
-#include <cstdio>
-#include <memory>
+#include <cstring>
+#include <filesystem>
+#include <string>
+#include <vector>
 
 #include "commands.h"
-#include "core/error.h"
-#include "io/input.h"
 
-namespace facetfit::cli {
+namespace {
 
-void report_error(const std::string& message) { std::fprintf(stderr, "facetfit: error: %s\n", message.c_str()); }
-
-void add_fit_settings(CLI::App* cmd, FitSettings& s) {
-  cmd->add_option("--smith", s.smith,
-                  "Masking-shadowing model the fit is consistent with: masking (the paper), correlated "
-                  "(height-correlated, as pbrt-v4 and Cycles render), separable")
-      ->capture_default_str();
-  cmd->add_option("--resolution", s.resolution, "Intervals of the theta = u^2 pi/2 grid (90: MERL's own bins)")
-      ->capture_default_str();
-  cmd->add_option("--iteration-tolerance", s.iteration_tolerance, "Power-iteration stop: relative L1 change of the NDF")
-      ->capture_default_str();
-  cmd->add_option("--max-iterations", s.max_iterations, "Power-iteration limit")->capture_default_str();
-  cmd->add_option("--refine", s.refine,
-                  "full: refine body, NDF and Fresnel, and fit GGX and Beckmann, on the whole measurement; "
-                  "none: the paper's method alone (power iteration on back-scattering, Fresnel pass, moment alphas)")
-      ->capture_default_str();
-  cmd->add_option("--merl-bins", s.merl_bins,
-                  "Which point of its bin a MERL file's value stands for: start (the lower edge, what facetfit "
-                  "writes) or center")
-      ->capture_default_str();
-}
-
-// A flag's parsed value; nullopt after a usage error (status 2) naming the flag, its value and what it takes.
-template <class T>
-std::optional<T> flag_value(std::optional<T> parsed, const std::string& flag, const std::string& value, const char* accepted,
-                            int& status) {
-  if (!parsed) {
-    report_error(flag + " " + value + ": must be " + accepted);
-    status = 2;
+// The subcommand named on the command line (after the global --threads N), or "".
+std::string subcommand(int argc, char** argv) {
+  for (int k = 1; k < argc; ++k) {
+    const std::string arg = argv[k];
+    if (arg == "--threads") {
+      ++k;
+      continue;
+    }
+    if (arg.rfind("--threads=", 0) == 0) continue;
+    return arg;
   }
-  return parsed;
+  return "";
 }
 
-std::optional<FitOptions> fit_options(const FitSettings& s, int& status) {
-  const auto smith = flag_value(parse_smith(s.smith), "--smith", s.smith, "masking, correlated or separable", status);
-  const auto merl_bins = flag_value(parse_bin_point(s.merl_bins), "--merl-bins", s.merl_bins, "start or center", status);
-  const auto refine = flag_value(parse_refine(s.refine), "--refine", s.refine, "none or full", status);
-  if (!smith || !merl_bins || !refine) return std::nullopt;
-  FitOptions options;
-  options.smith = *smith;
-  options.resolution = s.resolution;
-  options.tolerance = s.iteration_tolerance;
-  options.max_iterations = s.max_iterations;
-  options.merl_bins = *merl_bins;
-  options.refine = *refine;
-  return options;
+// The plugin beside the executable (the build tree) or in ../lib/facetfit (an installed tree).
+std::vector<std::filesystem::path> plugin_candidates() {
+  std::error_code error;
+  const std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", error);
+  if (error) return {"facetfit-commands.so"};
+  const std::filesystem::path dir = exe.parent_path();
+  return {dir / "facetfit-commands.so", dir.parent_path() / "lib" / "facetfit" / "facetfit-commands.so"};
 }
 
-}  // namespace facetfit::cli
+}  // namespace
 
 int main(int argc, char** argv) {
   using namespace facetfit::cli;
-  CLI::App app{"facetfit: measured BRDFs to microfacet components (Dupuy et al. 2015, power iterations)", "facetfit"};
-  app.require_subcommand(1);
-  app.set_version_flag("--version", FACETFIT_VERSION);
-  // --threads N caps every parallel part of every command (TBB's global limit), set as soon as parsed.
-  std::unique_ptr<tbb::global_control> threads;
-  app.add_option_function<int>(
-         "--threads",
-         [&](int n) {
-           if (n > 0) threads = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, std::size_t(n));
-         },
-         "Threads to use (default: all cores)")
-      ->check(CLI::PositiveNumber)
-      ->trigger_on_parse();
-  int status = 0;
-  add_fit_command(app, status);
-  add_bake_command(app, status);
-  add_info_command(app, status);
-  add_render_command(app, status);
-  add_diff_command(app, status);
-  add_deltae_command(app, status);
-  add_report_command(app, status);
-  add_convert_command(app, status);
-  add_builtins_command(app, status);
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    // Help and --version exit 0; every usage error exits 2, as bin/commands.h promises.
-    return app.exit(e) == 0 ? 0 : 2;
-  } catch (const facetfit::Error& e) {
-    report_error(e.what());
-    return 1;
-  } catch (const std::exception& e) {
-    report_error(std::string("internal: ") + e.what());
-    return 1;
+  const std::string command = subcommand(argc, argv);
+  if (command == "--version" || is_core_command(command)) return run_app(argc, argv, nullptr);
+  std::string errors;
+  for (const std::filesystem::path& path : plugin_candidates()) {
+    if (!std::filesystem::exists(path)) continue;
+    void* plugin = ::dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
+    if (!plugin) {
+      errors = ::dlerror();
+      break;
+    }
+    using Main = int (*)(int, char**);
+    if (const auto run = reinterpret_cast<Main>(::dlsym(plugin, "facetfit_commands_main"))) return run(argc, argv);
+    errors = path.string() + ": no facetfit_commands_main";
+    break;
   }
-  return status;
+  report_error("cannot load the command plugin facetfit-commands.so" + (errors.empty() ? std::string(" (not found beside the executable or in ../lib/facetfit)") : ": " + errors));
+  return 1;
 }

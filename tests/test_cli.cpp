@@ -16,6 +16,7 @@ using test::TempDir;
 
 using test::facetfit;
 using test::RunResult;
+using test::run_command;
 
 int lines(const std::string& s) { return int(std::count(s.begin(), s.end(), '\n')); }
 
@@ -52,6 +53,28 @@ INSTANTIATE_TEST_SUITE_P(
     [](const testing::TestParamInfo<std::pair<std::string, std::string>>& param) {
       return param.param.first.substr(0, param.param.first.find('.'));
     });
+
+TEST(Cli, FittingLoadsNoImageLibrary) {
+  // fit, convert and list-builtins run in an executable linked with the core library alone; image I/O,
+  // colour management and ray tracing (some 250 shared libraries) load only with the command plugin.
+  const RunResult needed = run_command("readelf -d " + std::string(FACETFIT_CLI));
+  ASSERT_EQ(needed.status, 0) << needed.err;
+  EXPECT_NE(needed.out.find("NEEDED"), std::string::npos);
+  for (const char* heavy : {"OpenImageIO", "OpenColorIO", "embree"}) EXPECT_EQ(needed.out.find(heavy), std::string::npos) << heavy;
+}
+
+TEST(Cli, WithoutThePluginCoreCommandsRunAndOthersFailInOneLine) {
+  TempDir dir;
+  std::filesystem::copy_file(FACETFIT_CLI, dir.file("facetfit"));
+  std::filesystem::permissions(dir.file("facetfit"), std::filesystem::perms::owner_all);
+  const RunResult fit = run_command(dir.file("facetfit") + " fit builtin:gold-ggx-0.15 --refine none --json");
+  EXPECT_EQ(fit.status, 0) << fit.err;
+  EXPECT_NE(fit.out.find("\"alpha_ggx\""), std::string::npos);
+  const RunResult bake = run_command(dir.file("facetfit") + " bake builtin:gold-ggx-0.15 -o " + dir.file("luts"));
+  EXPECT_EQ(bake.status, 1);
+  EXPECT_EQ(lines(bake.err), 1) << bake.err;
+  EXPECT_NE(bake.err.find("facetfit: error: cannot load the command plugin facetfit-commands.so"), std::string::npos) << bake.err;
+}
 
 TEST(Cli, BatchGoesOnPastABadFile) {
   TempDir dir;

@@ -1,0 +1,49 @@
+#!/usr/bin/env python3
+"""Whole-process wall time and peak memory of facetfit commands (make bench; docs/benchmarks.md).
+
+usage: startup.py FACETFIT OUT.md [RUNS]
+
+Each command runs RUNS times under /usr/bin/time; the table gives the median wall time (by the clock,
+around the whole run) and the median of the peak resident set sizes. The MERL file is written by facetfit itself (builtin:red-plastic).
+"""
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+
+
+def measure(cmd, runs):
+    walls, rss = [], []
+    for _ in range(runs):
+        # Wall time by the clock around the whole run (/usr/bin/time's %e has 10 ms steps), peak memory
+        # from /usr/bin/time's %M.
+        start = time.perf_counter()
+        out = subprocess.run(["/usr/bin/time", "-f", "%M"] + cmd, stdout=subprocess.DEVNULL,
+                             stderr=subprocess.PIPE, text=True, check=True)
+        walls.append((time.perf_counter() - start) * 1e3)
+        rss.append(float(out.stderr.strip().splitlines()[-1]) / 1024.0)
+    return statistics.median(walls), statistics.median(rss)
+
+
+def main(facetfit, dst, runs=10):
+    with tempfile.TemporaryDirectory() as tmp:
+        merl = os.path.join(tmp, "red-plastic.binary")
+        subprocess.run([facetfit, "convert", "builtin:red-plastic", "-o", merl], check=True, stdout=subprocess.DEVNULL)
+        cases = [
+            ("`facetfit fit FILE --refine none` (the paper's method: the reference program's job)", [facetfit, "fit", merl, "--refine", "none"]),
+            ("`facetfit fit FILE` (default: refinement and parametric fits)", [facetfit, "fit", merl]),
+            ("`facetfit --version`", [facetfit, "--version"]),
+            ("`facetfit bake --help` (loads the command plugin: OpenImageIO, OpenColorIO, Embree)", [facetfit, "bake", "--help"]),
+        ]
+        lines = ["| command | wall (median) | peak memory (median) |", "|---|---|---|"]
+        for what, cmd in cases:
+            wall, rss = measure(cmd, runs)
+            lines.append(f"| {what} | {wall:.0f} ms | {rss:.0f} MiB |")
+    with open(dst, "w") as f:
+        f.write("\n".join(lines) + "\n")
+
+
+if __name__ == "__main__":
+    main(sys.argv[1], sys.argv[2], int(sys.argv[3]) if len(sys.argv) > 3 else 10)

@@ -1,0 +1,97 @@
+// The facetfit command line: the app every command registers on, and the settings they share.
+#include <tbb/global_control.h>
+
+#include <cstdio>
+#include <memory>
+
+#include "commands.h"
+#include "core/error.h"
+#include "io/input.h"
+
+namespace facetfit::cli {
+
+void report_error(const std::string& message) { std::fprintf(stderr, "facetfit: error: %s\n", message.c_str()); }
+
+void add_fit_settings(CLI::App* cmd, FitSettings& s) {
+  cmd->add_option("--smith", s.smith,
+                  "Masking-shadowing model the fit is consistent with: masking (the paper), correlated "
+                  "(height-correlated, as pbrt-v4 and Cycles render), separable")
+      ->capture_default_str();
+  cmd->add_option("--resolution", s.resolution, "Intervals of the theta = u^2 pi/2 grid (90: MERL's own bins)")
+      ->capture_default_str();
+  cmd->add_option("--iteration-tolerance", s.iteration_tolerance, "Power-iteration stop: relative L1 change of the NDF")
+      ->capture_default_str();
+  cmd->add_option("--max-iterations", s.max_iterations, "Power-iteration limit")->capture_default_str();
+  cmd->add_option("--refine", s.refine,
+                  "full: refine body, NDF and Fresnel, and fit GGX and Beckmann, on the whole measurement; "
+                  "none: the paper's method alone (power iteration on back-scattering, Fresnel pass, moment alphas)")
+      ->capture_default_str();
+  cmd->add_option("--merl-bins", s.merl_bins,
+                  "Which point of its bin a MERL file's value stands for: start (the lower edge, what facetfit "
+                  "writes) or center")
+      ->capture_default_str();
+}
+
+// A flag's parsed value; nullopt after a usage error (status 2) naming the flag, its value and what it takes.
+template <class T>
+std::optional<T> flag_value(std::optional<T> parsed, const std::string& flag, const std::string& value, const char* accepted,
+                            int& status) {
+  if (!parsed) {
+    report_error(flag + " " + value + ": must be " + accepted);
+    status = 2;
+  }
+  return parsed;
+}
+
+std::optional<FitOptions> fit_options(const FitSettings& s, int& status) {
+  const auto smith = flag_value(parse_smith(s.smith), "--smith", s.smith, "masking, correlated or separable", status);
+  const auto merl_bins = flag_value(parse_bin_point(s.merl_bins), "--merl-bins", s.merl_bins, "start or center", status);
+  const auto refine = flag_value(parse_refine(s.refine), "--refine", s.refine, "none or full", status);
+  if (!smith || !merl_bins || !refine) return std::nullopt;
+  FitOptions options;
+  options.smith = *smith;
+  options.resolution = s.resolution;
+  options.tolerance = s.iteration_tolerance;
+  options.max_iterations = s.max_iterations;
+  options.merl_bins = *merl_bins;
+  options.refine = *refine;
+  return options;
+}
+
+int run_app(int argc, char** argv, void (*register_more)(CLI::App& app, int& status)) {
+  CLI::App app{"facetfit: measured BRDFs to microfacet components (Dupuy et al. 2015, power iterations)", "facetfit"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", FACETFIT_VERSION);
+  // --threads N caps every parallel part of every command (TBB's global limit), set as soon as parsed.
+  std::unique_ptr<tbb::global_control> threads;
+  app.add_option_function<int>(
+         "--threads",
+         [&](int n) {
+           if (n > 0) threads = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, std::size_t(n));
+         },
+         "Threads to use (default: all cores)")
+      ->check(CLI::PositiveNumber)
+      ->trigger_on_parse();
+  int status = 0;
+  add_fit_command(app, status);
+  add_convert_command(app, status);
+  add_builtins_command(app, status);
+  if (register_more) register_more(app, status);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    // Help and --version exit 0; every usage error exits 2, as bin/commands.h promises.
+    return app.exit(e) == 0 ? 0 : 2;
+  } catch (const facetfit::Error& e) {
+    report_error(e.what());
+    return 1;
+  } catch (const std::exception& e) {
+    report_error(std::string("internal: ") + e.what());
+    return 1;
+  }
+  return status;
+}
+
+bool is_core_command(const std::string& name) { return name == "fit" || name == "convert" || name == "list-builtins"; }
+
+}  // namespace facetfit::cli
