@@ -6,10 +6,12 @@ BUILD      ?= build/release
 BPY_VENV   ?= build/bpy-venv
 MITSUBA_VENV ?= build/mitsuba-venv
 ASAN_BUILD ?= build/asan
+FUZZ_BUILD ?= build/fuzz
+FUZZ_SECONDS ?= 600
 JOBS       ?= $(shell nproc)
 CMAKE_GEN  := -G Ninja
 
-.PHONY: all deps build demo test asan osl-host mitsuba-host osl-docs bench accuracy clean
+.PHONY: all deps build demo test asan fuzz-build fuzz osl-host mitsuba-host osl-docs bench accuracy clean
 
 all: build
 
@@ -33,6 +35,16 @@ asan: deps
 	  -DFACETFIT_BUILD_TOOLS=OFF -DFACETFIT_WERROR=ON >/dev/null
 	@cmake --build $(ASAN_BUILD) -j $(JOBS) --target facetfit_unit_tests facetfit_stress_tests
 
+# libFuzzer harnesses of every reader (fuzz/), built by clang with ASan + UBSan.
+fuzz-build: deps
+	@cmake -S . -B $(FUZZ_BUILD) $(CMAKE_GEN) -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++ \
+	  -DFACETFIT_SANITIZE=ON -DFACETFIT_FUZZ=ON -DFACETFIT_BUILD_TOOLS=OFF -DFACETFIT_OSL_TESTS=OFF -DFACETFIT_MITSUBA_TESTS=OFF >/dev/null
+	@cmake --build $(FUZZ_BUILD) -j $(JOBS) --target fuzz_merl fuzz_rgl fuzz_scene fuzz_obj
+
+# Runs each fuzz target for FUZZ_SECONDS (default 600); fails on any finding (docs/reliability.md).
+fuzz: fuzz-build
+	fuzz/run.sh $(FUZZ_BUILD) $(FUZZ_SECONDS)
+
 # Blender's bpy wheel (Cycles with OSL) in a venv: the host of the OSL tests (label osl).
 osl-host:
 	@scripts/setup-bpy.sh $(BPY_VENV) >/dev/null
@@ -41,8 +53,9 @@ osl-host:
 mitsuba-host:
 	@scripts/setup-mitsuba.sh $(MITSUBA_VENV) >/dev/null
 
-test: build asan osl-host mitsuba-host
+test: build asan fuzz-build osl-host mitsuba-host
 	cd $(BUILD) && ctest --output-on-failure -j $(JOBS)
+	fuzz/run.sh $(FUZZ_BUILD) 20
 	cd $(ASAN_BUILD) && ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1 \
 	  ctest --output-on-failure -j $(JOBS) -L 'unit|stress'
 

@@ -1,0 +1,32 @@
+#!/usr/bin/env bash
+# run.sh BUILD_DIR SECONDS [TARGET...]: runs each fuzz target for SECONDS under ASan + UBSan, from its
+# seeds (fuzz/seeds/TARGET, plus generated binary seeds), with a private corpus in BUILD_DIR/corpus;
+# exits nonzero on the first finding (the crashing input is kept in BUILD_DIR/findings). Prints the
+# executions per second and coverage each reached.
+set -euo pipefail
+build=$1; seconds=$2; shift 2
+here="$(cd "$(dirname "$0")" && pwd)"
+targets=("${@:-merl rgl scene obj}")
+targets=(${targets[@]})
+mkdir -p "$build/findings"
+python3 "$here/make_seeds.py" "$build/seeds"
+export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1:allocator_may_return_null=1
+export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
+status=0
+for t in "${targets[@]}"; do
+  corpus="$build/corpus/$t"; mkdir -p "$corpus"
+  seeds=()
+  for d in "$build/seeds/$t" "$here/seeds/$t"; do [[ -d "$d" ]] && seeds+=("$d"); done
+  log="$build/fuzz_$t.log"
+  max_len=65536; [[ $t == rgl ]] && max_len=1048576  # a real RGL material is 0.66 MB
+  if "$build/fuzz/fuzz_$t" "$corpus" "${seeds[@]}" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 \
+       -max_len="$max_len" -artifact_prefix="$build/findings/$t-" -print_final_stats=1 >"$log" 2>&1; then
+    runs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' || echo "?")
+    cov=$(grep -o 'cov: [0-9]*' "$log" | tail -1 | grep -o '[0-9]*' || echo "?")
+    echo "fuzz_$t: ${seconds} s, $runs executions ($((${runs:-0} / seconds))/s), coverage $cov edges, no finding"
+  else
+    echo "fuzz_$t: FINDING (log $log, input in $build/findings/):"; grep -m5 -E "ERROR|SUMMARY|runtime error|deadly signal|timeout" "$log" || tail -20 "$log"
+    status=1
+  fi
+done
+exit $status
