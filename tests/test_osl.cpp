@@ -19,7 +19,7 @@
 #include <regex>
 
 #include "color/image_diff.h"
-#include "fit/grid.h"
+#include "model/theta_grid.h"
 #include "io/image_file.h"
 #include "lut/lut.h"
 #include "test_util.h"

@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "fit/quadrature.h"
-#include "fit/tabulated_ndf.h"
+#include "model/tabulated_ndf.h"
 #include "model/smith.h"
 
 namespace facetfit {

@@ -8,12 +8,7 @@
 
 namespace facetfit {
 
-Rgb FresnelCurve::eval(double theta_d) const {
-  const double x = clamp(theta_d / (0.5 * kPi) * kSize, 0.0, double(kSize - 1));
-  const int j = std::min(int(x), kSize - 2);
-  const double t = x - j;
-  return value[std::size_t(j)] * (1.0 - t) + value[std::size_t(j) + 1] * t;
-}
+static_assert(FresnelCurve::kSize == MerlTable::kThetaD, "one Fresnel entry per MERL theta_d bin");
 
 namespace {
 

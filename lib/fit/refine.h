@@ -18,7 +18,7 @@
 #include "fit/fresnel_fit.h"
 #include "fit/measurement.h"
 #include "fit/quadrature.h"
-#include "fit/tabulated_ndf.h"
+#include "model/tabulated_ndf.h"
 #include "model/coat.h"
 #include "model/smith.h"
 

@@ -7,7 +7,7 @@
 #include <functional>
 
 #include "fit/quadrature.h"
-#include "fit/tabulated_ndf.h"
+#include "model/tabulated_ndf.h"
 #include "model/ndf.h"
 
 namespace facetfit {

@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "core/error.h"
-#include "fit/quadrature.h"
+#include "core/quadrature_rules.h"
 
 namespace facetfit {
 

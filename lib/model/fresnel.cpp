@@ -3,6 +3,8 @@
 #include <cmath>
 #include <complex>
 
+#include "model/fresnel_curve.h"
+
 namespace facetfit {
 
 Rgb fresnel_schlick(const Rgb& f0, double cos_d) {
@@ -63,6 +65,13 @@ Rgb Fresnel::eval(double cos_d) const {
     case Kind::dielectric: return Rgb(fresnel_dielectric(eta.x, cos_d));
   }
   return Rgb(1.0);
+}
+
+Rgb FresnelCurve::eval(double theta_d) const {
+  const double x = clamp(theta_d / (0.5 * kPi) * kSize, 0.0, double(kSize - 1));
+  const int j = std::min(int(x), kSize - 2);
+  const double t = x - j;
+  return value[std::size_t(j)] * (1.0 - t) + value[std::size_t(j) + 1] * t;
 }
 
 }  // namespace facetfit

@@ -4,7 +4,7 @@
 #pragma once
 
 #include "core/brdf.h"
-#include "fit/fresnel_fit.h"
+#include "model/fresnel_curve.h"
 #include "model/coat.h"
 #include "model/ndf.h"
 #include "model/smith.h"

@@ -5,7 +5,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "fit/quadrature.h"
+#include "core/quadrature_rules.h"
 
 namespace facetfit {
 

@@ -13,8 +13,8 @@
 #include <vector>
 
 #include "core/brdf.h"
-#include "fit/fresnel_fit.h"
-#include "fit/tabulated_ndf.h"
+#include "model/fresnel_curve.h"
+#include "model/tabulated_ndf.h"
 #include "model/coat.h"
 #include "model/smith.h"
 

@@ -3,7 +3,7 @@
 
 #include <vector>
 
-#include "fit/grid.h"
+#include "model/theta_grid.h"
 #include "model/ndf.h"
 
 namespace facetfit {
