@@ -36,7 +36,12 @@ void AtomicFile::commit() {
   // fsync before rename so that a crash cannot leave a renamed but empty file.
   const int fd = ::open(temp_.c_str(), O_RDONLY);
   if (fd < 0) fail(path_, std::string("cannot write: ") + std::strerror(errno));
-  ::fsync(fd);
+  // fsync reports what the writes could not (delayed allocation on a full disk, I/O errors).
+  if (::fsync(fd) != 0) {
+    const int error = errno;
+    ::close(fd);
+    fail(path_, std::string("cannot write: ") + std::strerror(error));
+  }
   ::close(fd);
   if (std::rename(temp_.c_str(), path_.c_str()) != 0)
     fail(path_, std::string("cannot write: ") + std::strerror(errno));

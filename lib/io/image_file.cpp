@@ -1,5 +1,7 @@
 #include "io/image_file.h"
 
+#include <vector>
+
 #include "core/error.h"
 #include "io/atomic_file.h"
 
@@ -21,6 +23,16 @@ void write_image_atomic(const std::string& path, const OIIO::ImageSpec& spec, co
   if (!image->open(out.temp_path(), spec) || !image->write_image(spec.format, pixels) || !image->close())
     fail(path, "cannot write: " + image->geterror());
   image.reset();
+  // Some writers (PNG) report no error when the disk fills and leave a truncated file: read it back
+  // whole before it takes the target's name.
+  auto check = OIIO::ImageInput::open(out.temp_path());
+  std::vector<unsigned char> back(check ? check->spec().image_bytes() : 0);
+  if (!check || !check->read_image(0, 0, 0, check->spec().nchannels, check->spec().format, back.data())) {
+    const std::string why = check ? check->geterror() : OIIO::geterror();
+    fail(path, "cannot write: the written file does not read back whole (disk full?)" +
+                   (why.empty() ? std::string() : ": " + why.substr(0, why.find('\n'))));
+  }
+  check->close();
   out.commit();
 }
 
