@@ -1,9 +1,11 @@
 // facetfit info LUT.exr : the metadata and the tables of a LUT, to read or to plot.
 #include <cstdio>
+#include <filesystem>
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
 #include "core/error.h"
+#include "io/input.h"
 #include "lut/record.h"
 #include "lut/lut.h"
 
@@ -98,6 +100,10 @@ void add_info_command(CLI::App& app, int& status) {
   cmd->add_flag("--json", *json, "As one JSON object");
   cmd->callback([path, json, &status] {
     try {
+      // A measurement named where a LUT is expected: say what to run instead of OpenImageIO's complaint.
+      const std::string ext = std::filesystem::path(*path).extension().string();
+      if (is_builtin(*path) || ext == ".binary" || ext == ".bsdf")
+        throw Error(*path + ": a measurement, not a LUT: `facetfit fit` it, or `facetfit bake` it and run info on the LUT");
       const Lut lut = read_lut(*path);
       if (*json) std::printf("%s\n", info_json(lut).dump().c_str());
       else print_info(lut);

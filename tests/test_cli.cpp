@@ -76,6 +76,15 @@ TEST(Cli, WithoutThePluginCoreCommandsRunAndOthersFailInOneLine) {
   EXPECT_NE(bake.err.find("facetfit: error: cannot load the command plugin facetfit-commands.so"), std::string::npos) << bake.err;
 }
 
+TEST(Cli, InfoOnAMeasurementSaysWhatToRun) {
+  for (const std::string input : {"builtin:gold-ggx-0.15", "x.bsdf", "x.binary"}) {
+    const RunResult r = facetfit("info " + input);
+    EXPECT_EQ(r.status, 1);
+    EXPECT_EQ(lines(r.err), 1) << r.err;
+    EXPECT_NE(r.err.find(input + ": a measurement, not a LUT"), std::string::npos) << r.err;
+  }
+}
+
 TEST(Cli, BatchGoesOnPastABadFile) {
   TempDir dir;
   test::write_bytes(dir.file("bad.binary"), "garbage");
