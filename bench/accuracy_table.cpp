@@ -150,7 +150,7 @@ double retro_rgb(const RglBsdf& b, double theta) {
 // constant for theta_d = theta_h <= 30 degrees). No back-scattering involved.
 double normal_incidence_ndf(const RglBsdf& b, double theta_h) {
   const Vec3 n(0.0, 0.0, 1.0), o = spherical_direction(2.0 * theta_h, 0.0);
-  return luminance(*b.eval(n, o)) * b.measured_sigma(2.0 * theta_h);
+  return luminance(*b.eval(o, n)) * b.measured_sigma(2.0 * theta_h);
 }
 
 void rgl_section(std::ostringstream& md, const std::string& folder) {

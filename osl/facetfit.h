@@ -228,7 +228,7 @@ float facetfit_coat_lambda(float alpha, vector w) {
   return 0.5 * (sqrt(1.0 + alpha * alpha * (w[0] * w[0] + w[1] * w[1]) / (w[2] * w[2])) - 1.0);
 }
 
-float facetfit_coat_eval(FacetfitLut lut, vector i, vector o) {
+float facetfit_coat_eval(FacetfitLut lut, vector o, vector i) {
   if (lut.coat_alpha <= 0.0 || i[2] <= 0.0 || o[2] <= 0.0) return 0.0;
   vector h = normalize(i + o);
   float m = 1.0 - clamp(dot(i, h), 0.0, 1.0), m5 = m * m * m * m * m;
@@ -237,14 +237,14 @@ float facetfit_coat_eval(FacetfitLut lut, vector i, vector o) {
   return fresnel * facetfit_coat_D(lut.coat_alpha, h) * g2 / (4.0 * i[2] * o[2]);
 }
 
-// f(i, o) in 1/sr: body + lobe + coat.
-color facetfit_eval(FacetfitLut lut, vector i, vector o) {
+// f(o, i) in 1/sr: body + lobe + coat (o toward the viewer, i toward the light, as every function here).
+color facetfit_eval(FacetfitLut lut, vector o, vector i) {
   if (i[2] <= 0.0 || o[2] <= 0.0) return color(0);
   vector h = normalize(i + o);
   float g2 = facetfit_G2(lut, facetfit_G1(lut, i), facetfit_G1(lut, o));
   float theta_d = facetfit_angle(length(cross(i, h)), dot(i, h));
   return lut.body / FACETFIT_PI + facetfit_fresnel(lut, theta_d) * (facetfit_D(lut, h) * g2 / (4.0 * i[2] * o[2])) +
-         color(facetfit_coat_eval(lut, i, o));
+         color(facetfit_coat_eval(lut, o, i));
 }
 
 // ---- sampling the visible normals (docs/sampling.md) ----

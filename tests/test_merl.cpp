@@ -68,10 +68,10 @@ TEST(Merl, NearestLookupTruncatesLikeTheReferenceReader) {
   const double th = std::pow((12 + 0.9) / 90.0, 2) * 0.5 * kPi, td = (34 + 0.9) / 90.0 * 0.5 * kPi,
                pd = (56 + 0.9) / 180.0 * kPi;
   const auto [i, o] = from_half_diff(th, td, pd);
-  const Rgb v = *table.eval(i, o);
+  const Rgb v = *table.eval(o, i);
   EXPECT_EQ(v, Rgb(12, 34, 56));
   // phi_d and phi_d + pi are the same bin (reciprocity).
-  EXPECT_EQ(*table.eval(o, i), Rgb(12, 34, 56));
+  EXPECT_EQ(*table.eval(i, o), Rgb(12, 34, 56));
 }
 
 TEST(Merl, LinearLookupInterpolatesAndSkipsMissingBins) {
@@ -82,16 +82,16 @@ TEST(Merl, LinearLookupInterpolatesAndSkipsMissingBins) {
   // Halfway along theta_d between bins 40 and 41: the mean of the two.
   const double th = std::pow(30.0 / 90.0, 2) * 0.5 * kPi, pd = 50.0 / 180.0 * kPi;
   auto [i, o] = from_half_diff(th, 40.5 / 90.0 * 0.5 * kPi, pd);
-  EXPECT_NEAR(table.eval(i, o)->r, 30 + 81.0 + 25, 1e-3);
+  EXPECT_NEAR(table.eval(o, i)->r, 30 + 81.0 + 25, 1e-3);
   // With bin 41 missing, only bin 40 remains.
   table.set_missing(30, 41, 50);
-  EXPECT_NEAR(table.eval(i, o)->r, 30 + 80.0 + 25, 1e-3);
+  EXPECT_NEAR(table.eval(o, i)->r, 30 + 80.0 + 25, 1e-3);
   // All neighbours missing: no value, never zero. (Clear a block around the point: after the round
   // trip through directions its coordinates are only near the bin centres.)
   for (int a = 29; a <= 31; ++a)
     for (int b = 40; b <= 41; ++b)
       for (int c = 49; c <= 51; ++c) table.set_missing(a, b, c);
-  EXPECT_FALSE(table.eval(i, o).has_value());
+  EXPECT_FALSE(table.eval(o, i).has_value());
 }
 
 // MERL files mark missing bins with negative numbers; in memory a missing bin is NaN.

@@ -57,7 +57,7 @@ TEST(MitsubaParity, ViewSlicesEqualMitsubasMeasuredEval) {
     int negative = 0, beyond = 0, values = 0;
     for (std::size_t n = 0; n < pairs.size(); ++n) {
       const auto& [o, i] = pairs[n];
-      const Rgb f = *bsdf.eval(i, o) * i.z;  // Mitsuba's eval carries cos(theta) of the non-viewer side
+      const Rgb f = *bsdf.eval(o, i) * i.z;  // Mitsuba's eval carries cos(theta) of the non-viewer side
       for (int c = 0; c < 3; ++c) {
         const double m = reference[n][std::size_t(c)].get<double>();
         negative += m < 0.0;

@@ -309,18 +309,18 @@ TEST_P(OslModel, EvalEqualsLibrary) {
   const TabulatedMicrofacet model = read_lut(lut()).model();
   const Cases cases = direction_pairs(11);
   const Image img = probe_checked(0, cases, [&](int k) {
-    const Rgb f = model.eval(cases.unit_i(k), cases.unit_o(k)).value_or(Rgb(0.0));
+    const Rgb f = model.eval(cases.unit_o(k), cases.unit_i(k)).value_or(Rgb(0.0));
     return f.r > 1e-3 || f.g > 1e-3 || f.b > 1e-3;
   });
   ASSERT_EQ(img.width, kGrid);
   double worst = 0.0;
   int checked = 0;
   for (int k = 0; k < kGrid * kGrid; ++k) {
-    const Rgb f = model.eval(cases.unit_i(k), cases.unit_o(k)).value_or(Rgb(0.0));
+    const Rgb f = model.eval(cases.unit_o(k), cases.unit_i(k)).value_or(Rgb(0.0));
     const float* px = img.at(k % kGrid, k / kGrid);
     for (int c = 0; c < 3; ++c) {
       const double moved = 2.0 * input_sensitivity(cases.unit_i(k), cases.unit_o(k), [&](const Vec3& i, const Vec3& o) {
-        return model.eval(i, o).value_or(Rgb(0.0))[c];
+        return model.eval(o, i).value_or(Rgb(0.0))[c];
       });
       EXPECT_TRUE(close(px[c], f[c], 1e-6 + moved)) << "case " << k << " channel " << c << ": OSL " << px[c] << ", C++ " << f[c]
                                             << "; o " << str(cases.o[std::size_t(k)]) << ", i " << str(cases.second[std::size_t(k)]);

@@ -112,7 +112,7 @@ TEST(Refine, LutCarriesBodyCoatAndParametricFits) {
   // The LUT's model is the fit: body + lobe + coat, evaluated.
   const TabulatedMicrofacet model = lut.model();
   const Vec3 i = glm::normalize(Vec3(0.3, 0.1, 0.9)), o = glm::normalize(Vec3(-0.2, 0.0, 0.8));
-  const Rgb f = *model.eval(i, o), expected = *truth.eval(i, o);
+  const Rgb f = *model.eval(o, i), expected = *truth.eval(o, i);
   for (int c = 0; c < 3; ++c) EXPECT_NEAR(f[c], expected[c], 0.02 * expected[c]) << "channel " << c;
 }
 

@@ -60,7 +60,7 @@ TEST(Render, WhiteFurnaceNeverExceedsOneAndMatchesTheAlbedo) {
     for (int a = 0; a < n; ++a)
       for (int b = 0; b < n; ++b) {
         const double c = (a + 0.5) / n, s = std::sqrt(1 - c * c), phi = (b + 0.5) / n * 2 * kPi;
-        sum += brdf.eval(Vec3(s * std::cos(phi), s * std::sin(phi), c), o)->g * c / (n * n) * 2 * kPi;
+        sum += brdf.eval(o, Vec3(s * std::cos(phi), s * std::sin(phi), c))->g * c / (n * n) * 2 * kPi;
       }
     return sum;
   };

@@ -226,19 +226,35 @@ TEST_F(RglSynthetic, EvalMatchesClosedForm) {
     const RglBsdf::Slices modes[3] = {RglBsdf::Slices::symmetric, RglBsdf::Slices::light, RglBsdf::Slices::view};
     for (int m = 0; m < 3; ++m) {
       b.set_slices(modes[m]);
-      const Rgb got = *b.eval(i, o);
+      const Rgb got = *b.eval(o, i);
       for (int c = 0; c < 3; ++c)
         ASSERT_NEAR(got[c], want[m][c], 1e-6 * (1.0 + want[m][c])) << "mode " << m << " channel " << c;
     }
   }
 }
 
+TEST_F(RglSynthetic, ViewSlicesArePickedByTheFirstArgument) {
+  // eval(o, i): o toward the viewer comes first (docs/conventions.md). The synthetic table is not
+  // reciprocal, so a swapped order anywhere shows: view-sliced eval(o, i) is light-sliced eval(i, o),
+  // and differs from view-sliced eval(i, o).
+  RglBsdf view = RglBsdf::read(write("synthetic.bsdf", serialize(synthetic_fields()))), light = view;
+  view.set_slices(RglBsdf::Slices::view);
+  light.set_slices(RglBsdf::Slices::light);
+  const Vec3 o = spherical_direction(0.2, 0.4), i = spherical_direction(1.1, 2.5);
+  const Rgb picked_by_o = synthetic_table(o, i) / i.z;
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_NEAR((*view.eval(o, i))[c], picked_by_o[c], 1e-6 * (1.0 + picked_by_o[c]));
+    EXPECT_NEAR((*light.eval(i, o))[c], picked_by_o[c], 1e-6 * (1.0 + picked_by_o[c]));
+  }
+  EXPECT_GT(std::abs(luminance(*view.eval(o, i)) - luminance(*view.eval(i, o))), 0.01 * luminance(*view.eval(o, i)));
+}
+
 TEST_F(RglSynthetic, BelowHorizonIsZeroAndNdfIsNormalized) {
   const RglBsdf b = RglBsdf::read(write("synthetic.bsdf", serialize(synthetic_fields())));
   const Vec3 up(0, 0, 1), down = spherical_direction(0.6 * kPi, 0.3), flat(1, 0, 0);
-  EXPECT_EQ(*b.eval(up, down), Rgb(0.0));
   EXPECT_EQ(*b.eval(down, up), Rgb(0.0));
-  EXPECT_EQ(*b.eval(flat, up), Rgb(0.0));
+  EXPECT_EQ(*b.eval(up, down), Rgb(0.0));
+  EXPECT_EQ(*b.eval(up, flat), Rgb(0.0));
   EXPECT_NEAR(b.measured_ndf(0.0), kInvPi, 1e-6);
   EXPECT_NEAR(b.measured_ndf(1.0), kInvPi, 1e-6);
   EXPECT_EQ(b.measured_ndf(-0.1), 0.0);
@@ -249,12 +265,12 @@ TEST_F(RglSynthetic, BelowHorizonIsZeroAndNdfIsNormalized) {
 TEST_F(RglSynthetic, CopiesShareTablesAndMovesWork) {
   RglBsdf a = RglBsdf::read(write("synthetic.bsdf", serialize(synthetic_fields())));
   const Vec3 i = spherical_direction(0.3, 0.1), o = spherical_direction(0.7, 2.0);
-  const Rgb ref = *a.eval(i, o);
+  const Rgb ref = *a.eval(o, i);
   RglBsdf copy = a;
   copy.set_slices(RglBsdf::Slices::light);  // per-object setting, tables shared
-  EXPECT_EQ(*a.eval(i, o), ref);
+  EXPECT_EQ(*a.eval(o, i), ref);
   RglBsdf moved = std::move(a);
-  EXPECT_EQ(*moved.eval(i, o), ref);
+  EXPECT_EQ(*moved.eval(o, i), ref);
 }
 
 // A GGX material (alpha 0.5) whose ndf, sigma and vndf are tabulated as the acquisition does, at
@@ -443,7 +459,7 @@ Rgb albedo(const RglBsdf& b, const Vec3& i) {
   for (int k = 0; k < kTheta; ++k) {
     const double u = (k + 0.5) / kTheta, th = 0.5 * kPi * u * u;
     const double w = std::cos(th) * std::sin(th) * (kPi * u / kTheta) * (2.0 * kPi / kPhi);
-    for (int m = 0; m < kPhi; ++m) sum += *b.eval(i, spherical_direction(th, (m + 0.5) / kPhi * 2.0 * kPi)) * w;
+    for (int m = 0; m < kPhi; ++m) sum += *b.eval(spherical_direction(th, (m + 0.5) / kPhi * 2.0 * kPi), i) * w;
   }
   return sum;
 }
@@ -464,7 +480,7 @@ TEST(RglReal, LoadAndEvalFiniteIncludingGrazing) {
         for (const double to : degrees)
           for (const double phi : {0.0, 0.5, 1.5, 2.5, kPi}) {
             const Vec3 i = spherical_direction(ti * kPi / 180.0, 0.2), o = spherical_direction(to * kPi / 180.0, 0.2 + phi);
-            const auto v = b.eval(i, o);
+            const auto v = b.eval(o, i);
             ASSERT_TRUE(v.has_value());
             for (int c = 0; c < 3; ++c) {
               ASSERT_TRUE(std::isfinite((*v)[c]))
@@ -473,7 +489,7 @@ TEST(RglReal, LoadAndEvalFiniteIncludingGrazing) {
             }
           }
     }
-    EXPECT_EQ(*b.eval(Vec3(0, 0, 1), spherical_direction(1.6, 0.0)), Rgb(0.0));
+    EXPECT_EQ(*b.eval(spherical_direction(1.6, 0.0), Vec3(0, 0, 1)), Rgb(0.0));
   }
   EXPECT_GT(negative, 0);
 }
@@ -491,14 +507,14 @@ TEST(RglReal, Reciprocity) {
         for (int p = 0; p < 24; ++p) {
           const Vec3 i = spherical_direction(ti * kPi / 180.0, 0.0), o = spherical_direction(to * kPi / 180.0, p * kPi / 24.0);
           b.set_slices(RglBsdf::Slices::light);
-          const double fl = luminance(*b.eval(i, o));
+          const double fl = luminance(*b.eval(o, i));
           b.set_slices(RglBsdf::Slices::view);
-          const double fv = luminance(*b.eval(i, o));
+          const double fv = luminance(*b.eval(o, i));
           const double w = i.z * o.z * std::sin(ti * kPi / 180.0) * std::sin(to * kPi / 180.0);
           diff += w * std::abs(fl - fv);
           mean += w * 0.5 * (fl + fv);
           b.set_slices(RglBsdf::Slices::symmetric);
-          const double a = luminance(*b.eval(i, o)), r = luminance(*b.eval(o, i));
+          const double a = luminance(*b.eval(o, i)), r = luminance(*b.eval(i, o));
           worst_sym = std::max(worst_sym, std::abs(a - r) / std::max(1e-300, a + r));
         }
     const double asym = diff / mean;
@@ -577,7 +593,7 @@ TEST(RglReal, PhysicalMagnitudes) {
   // White paper: near-Lambertian, albedo ~0.8, so f ~ 0.27/sr.
   const RglBsdf paper = RglBsdf::read((rgl_dir() / "paper_white_rgb.bsdf").string());
   EXPECT_NEAR(luminance(albedo(paper, Vec3(0, 0, 1))), 0.83, 0.08);
-  EXPECT_NEAR(luminance(*paper.eval(Vec3(0, 0, 1), spherical_direction(0.5, 1.0))), 0.27, 0.04);
+  EXPECT_NEAR(luminance(*paper.eval(spherical_direction(0.5, 1.0), Vec3(0, 0, 1))), 0.27, 0.04);
 }
 
 TEST(RglReal, ConcurrentEvalMatchesSerial) {
@@ -588,11 +604,11 @@ TEST(RglReal, ConcurrentEvalMatchesSerial) {
   std::uniform_real_distribution<double> th(0.0, 0.5 * kPi), ph(-kPi, kPi);
   for (int n = 0; n < 4000; ++n) pairs.emplace_back(spherical_direction(th(rng), ph(rng)), spherical_direction(th(rng), ph(rng)));
   std::vector<Rgb> serial, parallel(pairs.size());
-  for (const auto& [i, o] : pairs) serial.push_back(*b.eval(i, o));
+  for (const auto& [i, o] : pairs) serial.push_back(*b.eval(o, i));
   std::vector<std::thread> threads;
   for (std::size_t t = 0; t < 4; ++t)
     threads.emplace_back([&, t] {
-      for (std::size_t n = t; n < pairs.size(); n += 4) parallel[n] = *b.eval(pairs[n].first, pairs[n].second);
+      for (std::size_t n = t; n < pairs.size(); n += 4) parallel[n] = *b.eval(pairs[n].second, pairs[n].first);
     });
   for (auto& t : threads) t.join();
   EXPECT_EQ(serial, parallel);

@@ -37,7 +37,7 @@ TEST(Tabulated, EvalMatchesTheAnalyticModel) {
     for (int n = 0; n < 500; ++n) {
       const Vec3 i = spherical_direction(std::acos(u(rng)) * 0.95, 2 * kPi * u(rng));
       const Vec3 o = spherical_direction(std::acos(u(rng)) * 0.95, 2 * kPi * u(rng));
-      const Rgb a = *truth.eval(i, o), b = *model.eval(i, o);
+      const Rgb a = *truth.eval(o, i), b = *model.eval(o, i);
       if (luminance(a) < 1e-3) continue;
       EXPECT_NEAR(b.g / a.g, 1.0, 0.01) << "alpha " << alpha << " i " << i.z << " o " << o.z;
     }
@@ -49,7 +49,7 @@ TEST(Tabulated, Reciprocal) {
   std::mt19937 rng(4);
   for (int n = 0; n < 200; ++n) {
     const Vec3 i = test::random_direction(rng), o = test::random_direction(rng);
-    const Rgb a = *model.eval(i, o), b = *model.eval(o, i);
+    const Rgb a = *model.eval(o, i), b = *model.eval(i, o);
     EXPECT_NEAR(a.r, b.r, 1e-12 * std::max(1.0, a.r));
   }
 }
@@ -279,7 +279,7 @@ TEST(Tabulated, WhiteFurnace) {
         for (int a = 0; a < m; ++a)
           for (int b = 0; b < m; ++b) {
             const double c = (a + 0.5) / m, s = std::sqrt(1 - c * c), phi = (b + 0.5) / m * 2 * kPi;
-            integral += model.eval(Vec3(s * std::cos(phi), s * std::sin(phi), c), o)->g * c / (m * m) * 2 * kPi;
+            integral += model.eval(o, Vec3(s * std::cos(phi), s * std::sin(phi), c))->g * c / (m * m) * 2 * kPi;
           }
         EXPECT_NEAR(albedo, integral, 5e-3) << "alpha " << alpha << " theta_o " << theta_o;
       }

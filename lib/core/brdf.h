@@ -7,16 +7,16 @@
 
 namespace facetfit {
 
-// A BRDF f(i, o) in 1/sr. Conventions (docs/conventions.md): both directions are unit vectors in the
-// local frame with the surface normal along +z, pointing away from the surface; i toward the light,
-// o toward the viewer. Implementations are reciprocal where the physics is, and thread-safe for eval.
+// A BRDF f(o, i) in 1/sr. Conventions (docs/conventions.md): both directions are unit vectors in the
+// local frame with the surface normal along +z, pointing away from the surface; o toward the viewer,
+// i toward the light, in that order in every eval, pdf and sample (as pbrt's f(wo, wi)). Implementations are reciprocal where the physics is, and thread-safe for eval.
 class Brdf {
  public:
   virtual ~Brdf() = default;
 
   // Reflectance, or nullopt where the source has no measurement for this pair (a measured table's
   // missing bin). Analytic models always answer; below the horizon they answer zero.
-  virtual std::optional<Rgb> eval(const Vec3& i, const Vec3& o) const = 0;
+  virtual std::optional<Rgb> eval(const Vec3& o, const Vec3& i) const = 0;
 };
 
 }  // namespace facetfit

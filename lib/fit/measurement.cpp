@@ -56,7 +56,7 @@ MeasuredBins measured_bins(const MerlTable& table, int stride_d, int stride_phi)
 double measurement_error(const MeasuredBins& bins, const Brdf& model) {
   double sum = 0.0, norm = 0.0;
   for (std::size_t b = 0; b < bins.size(); ++b) {
-    const auto f = model.eval(bins.i[b], bins.o[b]);
+    const auto f = model.eval(bins.o[b], bins.i[b]);
     const Rgb m = f ? *f : Rgb(0.0);
     for (int c = 0; c < 3; ++c) {
       if (!(bins.valid[b] >> c & 1u)) continue;

@@ -1,7 +1,7 @@
 // Parametric fits on the whole measurement: body + one GGX or Beckmann lobe, in the metric of
 // fit/measurement.h, from the moment estimates of the tabulated fit.
 //
-//   f(i, o) = body / pi + F(theta_d) D_alpha(h) G2_alpha(i, o) / (4 cos theta_i cos theta_o)
+//   f(o, i) = body / pi + F(theta_d) D_alpha(h) G2_alpha(o, i) / (4 cos theta_i cos theta_o)
 //
 // Two Fresnel forms: `f82` (Hoffman's F82-tint from RGB f0 and f82, what renderers' closures take:
 // the ggx and beckmann representations) and `schlick` (RGB f0 only: the classical baseline `lsq`, a

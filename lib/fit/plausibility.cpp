@@ -35,7 +35,7 @@ Rgb directional_albedo(const Brdf& brdf, const Vec3& o, int n) {
       // Cosine-weighted: r = sqrt(u1) on the unit disk, so each cell holds cos(theta) d(omega) = pi / n^2.
       const double r = std::sqrt((a + 0.5) / n), phi = 2.0 * kPi * (b + 0.5) / n;
       const Vec3 i(r * std::cos(phi), r * std::sin(phi), std::sqrt(std::max(0.0, 1.0 - r * r)));
-      if (const auto f = brdf.eval(i, o)) sum += *f;
+      if (const auto f = brdf.eval(o, i)) sum += *f;
     }
   return sum * (kPi / double(n * n));
 }

@@ -13,7 +13,7 @@ namespace facetfit {
 
 struct FitResult;
 
-// Directional albedo rho(o) = integral of f(i, o) cos(theta_i) d(omega_i), per channel, by a stratified
+// Directional albedo rho(o) = integral of f(o, i) cos(theta_i) d(omega_i), per channel, by a stratified
 // cosine-weighted grid of `n` x `n` directions. Missing values count as zero.
 Rgb directional_albedo(const Brdf& brdf, const Vec3& o, int n = 16);
 

@@ -145,7 +145,7 @@ LobeFit refine_lobe(const MeasuredBins& bins, const Quadrature& quad, Smith smit
   for (int j = 0; j < FresnelCurve::kSize; ++j)
     for (int c = 0; c < 3; ++c) fresnel[std::size_t(j)][std::size_t(c)] = clamp(fit.fresnel.value[std::size_t(j)][c], 0.0, 1.0);
   std::vector<double> g(bins.size()), coat(bins.size());
-  for (std::size_t k = 0; k < bins.size(); ++k) coat[k] = start.coat.eval(bins.i[k], bins.o[k]);
+  for (std::size_t k = 0; k < bins.size(); ++k) coat[k] = start.coat.eval(bins.o[k], bins.i[k]);
   std::vector<NodeWeights> row_nodes;
   row_nodes.reserve(bins.rows.size());
   for (const MeasuredBins::Row& row : bins.rows) row_nodes.push_back(node_weights(grid, MerlTable::theta_h(row.theta_h)));

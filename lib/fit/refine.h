@@ -4,7 +4,7 @@
 // (subsurface, diffuse reflection) and noise, so starting from the extraction, every parameter is
 // refined against every bin the fit samples (fit/measurement.h), in that file's metric:
 //
-//   f(i, o) = body / pi + F(theta_d) D(theta_h) G2(i, o) / (4 cos theta_i cos theta_o)
+//   f(o, i) = body / pi + F(theta_d) D(theta_h) G2(o, i) / (4 cos theta_i cos theta_o)
 //
 // with the NDF nodes D, the RGB Fresnel curve F and the RGB body albedo as unknowns, bounded below by
 // zero. G2 depends on every D node through sigma, densely, so it is held fixed within a pass (each bin

@@ -207,7 +207,7 @@ MerlTable MerlTable::tabulate(const Brdf& brdf, BinPoint at) {
       for (int k = 0; k < kPhiD; ++k) {
         const auto [wi, wo] = from_half_diff(theta_h(i + offset), theta_d(j + offset), phi_d(k + offset));
         if (wi.z <= 0.0 || wo.z <= 0.0) continue;  // stays missing: no measurement below the horizon
-        const auto f = brdf.eval(wi, wo);
+        const auto f = brdf.eval(wo, wi);
         if (!f || !std::isfinite(f->r) || !std::isfinite(f->g) || !std::isfinite(f->b)) continue;
         table.set(i, j, k, *f);  // negative measurements stay (RGL noise around zero)
       }
@@ -237,7 +237,7 @@ void MerlTable::write(const std::string& path) const {
   out.commit();
 }
 
-std::optional<Rgb> MerlTable::eval(const Vec3& i, const Vec3& o) const {
+std::optional<Rgb> MerlTable::eval(const Vec3& o, const Vec3& i) const {
   if (i.z <= 0.0 || o.z <= 0.0) return Rgb(0.0);
   const BinCoords x = bin_coords(i, o);
   return lookup_ == Lookup::nearest ? eval_nearest(x.h, x.d, x.p) : eval_linear(x.h, x.d, x.p);

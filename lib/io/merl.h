@@ -53,7 +53,7 @@ class MerlTable final : public Brdf {
   // Writes MERL layout through a temporary file; missing bins are written as -1.
   void write(const std::string& path) const;
 
-  std::optional<Rgb> eval(const Vec3& i, const Vec3& o) const override;
+  std::optional<Rgb> eval(const Vec3& o, const Vec3& i) const override;
   Lookup lookup() const { return lookup_; }
   void set_lookup(Lookup lookup) { lookup_ = lookup; }
 

@@ -602,7 +602,7 @@ Rgb RglBsdf::table_value(const Vec3& p, const Vec3& q) const {
   return v * (bilinear(t.ndf, u_h0, u_h1) / (4.0 * bilinear(t.sigma, theta_to_u(theta_p), u_p1)));
 }
 
-std::optional<Rgb> RglBsdf::eval(const Vec3& i_in, const Vec3& o_in) const {
+std::optional<Rgb> RglBsdf::eval(const Vec3& o_in, const Vec3& i_in) const {
   if (!(i_in.z > 0.0) || !(o_in.z > 0.0)) return Rgb(0.0);
   const Vec3 i = glm::normalize(i_in), o = glm::normalize(o_in);
   switch (slices_) {

@@ -49,9 +49,9 @@ class RglBsdf final : public Brdf {
     view,       // o, as Mitsuba renders it (its wi is the camera side): T(o,i) / cos i
   };
 
-  // f(i, o) in 1/sr, RGB; zero when either direction is not strictly above the horizon. The table
+  // f(o, i) in 1/sr, RGB; zero when either direction is not strictly above the horizon. The table
   // covers the whole hemisphere, so there is always an answer.
-  std::optional<Rgb> eval(const Vec3& i, const Vec3& o) const override;
+  std::optional<Rgb> eval(const Vec3& o, const Vec3& i) const override;
   Slices slices() const { return slices_; }
   void set_slices(Slices slices) { slices_ = slices; }
 

@@ -2,7 +2,7 @@
 
 namespace facetfit {
 
-std::optional<Rgb> MicrofacetBrdf::eval(const Vec3& i, const Vec3& o) const {
+std::optional<Rgb> MicrofacetBrdf::eval(const Vec3& o, const Vec3& i) const {
   if (i.z <= 0.0 || o.z <= 0.0) return Rgb(0.0);
   const Vec3 h = glm::normalize(i + o);
   const double g2 = smith_g2(smith_, ndf_.lambda(i), ndf_.lambda(o));
@@ -10,15 +10,15 @@ std::optional<Rgb> MicrofacetBrdf::eval(const Vec3& i, const Vec3& o) const {
   return fresnel_.eval(glm::dot(i, h)) * scalar;
 }
 
-std::optional<Rgb> LambertBrdf::eval(const Vec3& i, const Vec3& o) const {
+std::optional<Rgb> LambertBrdf::eval(const Vec3& o, const Vec3& i) const {
   if (i.z <= 0.0 || o.z <= 0.0) return Rgb(0.0);
   return albedo_ * kInvPi;
 }
 
-std::optional<Rgb> SumBrdf::eval(const Vec3& i, const Vec3& o) const {
+std::optional<Rgb> SumBrdf::eval(const Vec3& o, const Vec3& i) const {
   Rgb sum(0.0);
   for (const auto& lobe : lobes_) {
-    const auto f = lobe->eval(i, o);
+    const auto f = lobe->eval(o, i);
     if (!f) return std::nullopt;
     sum += *f;
   }

@@ -11,11 +11,11 @@
 
 namespace facetfit {
 
-// f(i, o) = F(i.h) D(h) G2(i, o) / (4 cos(theta_i) cos(theta_o)).
+// f(o, i) = F(i.h) D(h) G2(o, i) / (4 cos(theta_i) cos(theta_o)).
 class MicrofacetBrdf final : public Brdf {
  public:
   MicrofacetBrdf(Ndf ndf, Smith smith, Fresnel fresnel) : ndf_(ndf), smith_(smith), fresnel_(fresnel) {}
-  std::optional<Rgb> eval(const Vec3& i, const Vec3& o) const override;
+  std::optional<Rgb> eval(const Vec3& o, const Vec3& i) const override;
 
   const Ndf& ndf() const { return ndf_; }
   Smith smith() const { return smith_; }
@@ -30,7 +30,7 @@ class MicrofacetBrdf final : public Brdf {
 class LambertBrdf final : public Brdf {
  public:
   explicit LambertBrdf(const Rgb& albedo) : albedo_(albedo) {}
-  std::optional<Rgb> eval(const Vec3& i, const Vec3& o) const override;
+  std::optional<Rgb> eval(const Vec3& o, const Vec3& i) const override;
 
  private:
   Rgb albedo_;
@@ -40,7 +40,7 @@ class LambertBrdf final : public Brdf {
 class SumBrdf final : public Brdf {
  public:
   explicit SumBrdf(std::vector<std::shared_ptr<const Brdf>> lobes) : lobes_(std::move(lobes)) {}
-  std::optional<Rgb> eval(const Vec3& i, const Vec3& o) const override;
+  std::optional<Rgb> eval(const Vec3& o, const Vec3& i) const override;
 
  private:
   std::vector<std::shared_ptr<const Brdf>> lobes_;

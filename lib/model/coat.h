@@ -20,8 +20,8 @@ struct Coat {
   double f0 = 0.0;     // normal-incidence reflectance (grey)
 
   bool present() const { return alpha > 0.0 && f0 > 0.0; }
-  // f(i, o) of the coat alone, the same in R, G and B.
-  double eval(const Vec3& i, const Vec3& o) const {
+  // f(o, i) of the coat alone, the same in R, G and B.
+  double eval(const Vec3& o, const Vec3& i) const {
     if (!present() || i.z <= 0.0 || o.z <= 0.0) return 0.0;
     const Vec3 h = glm::normalize(i + o);
     const Ndf ndf = Ndf::isotropic(NdfType::ggx, alpha);

@@ -19,7 +19,7 @@ class ParametricBrdf final : public Brdf {
   ParametricBrdf(const Ndf& ndf, Smith smith, const Rgb& f0, const Rgb& f82, const Rgb& body = Rgb(0.0), const Coat& coat = {})
       : ndf_(ndf), smith_(smith), f0_(f0), f82_(f82), body_(body), coat_(coat) {}
 
-  std::optional<Rgb> eval(const Vec3& i, const Vec3& o) const override;
+  std::optional<Rgb> eval(const Vec3& o, const Vec3& i) const override;
   const Ndf& ndf() const { return ndf_; }
 
  private:

@@ -72,11 +72,11 @@ double TabulatedMicrofacet::g1(const Vec3& w) const { return tables_.ndf.g1(w.z)
 
 Rgb TabulatedMicrofacet::fresnel(double cos_d) const { return tables_.fresnel.eval(std::acos(clamp(cos_d, 0.0, 1.0))); }
 
-std::optional<Rgb> TabulatedMicrofacet::eval(const Vec3& i, const Vec3& o) const {
+std::optional<Rgb> TabulatedMicrofacet::eval(const Vec3& o, const Vec3& i) const {
   if (i.z <= 0.0 || o.z <= 0.0) return Rgb(0.0);
   const Vec3 h = glm::normalize(i + o);
   const double g2 = smith_g2_from_g1(tables_.smith, g1(i), g1(o));
-  return tables_.body * kInvPi + fresnel(glm::dot(i, h)) * (D(h) * g2 / (4.0 * i.z * o.z)) + Rgb(tables_.coat.eval(i, o));
+  return tables_.body * kInvPi + fresnel(glm::dot(i, h)) * (D(h) * g2 / (4.0 * i.z * o.z)) + Rgb(tables_.coat.eval(o, i));
 }
 
 namespace {

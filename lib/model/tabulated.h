@@ -1,6 +1,6 @@
 // The tabulated microfacet BRDF: the fitted tables evaluated, importance-sampled and given a pdf.
 //
-//   f(i, o) = body / pi + F(theta_d) D(h) G2(i, o) / (4 cos(theta_i) cos(theta_o)) + coat(i, o)
+//   f(o, i) = body / pi + F(theta_d) D(h) G2(o, i) / (4 cos(theta_o) cos(theta_i)) + coat(o, i)
 //
 // with D and sigma (hence G1 = cos / sigma) splines on the theta grid, F the RGB Fresnel curve and G2
 // the Smith model the fit was made with. sample() picks one of the three parts with probabilities set
@@ -49,11 +49,11 @@ class TabulatedMicrofacet final : public Brdf {
   // Uses given sampling tables (from a LUT); empty tables make sample() and pdf() unavailable.
   TabulatedMicrofacet(MicrofacetTables tables, VisibleNormalTables sampling);
 
-  std::optional<Rgb> eval(const Vec3& i, const Vec3& o) const override;
+  std::optional<Rgb> eval(const Vec3& o, const Vec3& i) const override;
 
   struct Sample {
     Vec3 i;
-    Rgb weight;  // f(i, o) cos(theta_i) / pdf
+    Rgb weight;  // f(o, i) cos(theta_i) / pdf
     double pdf;  // per steradian of i
   };
   // Samples a light direction i for the view direction o from two uniform numbers in [0, 1) (u1 also

@@ -222,7 +222,7 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
       const Vec3 il = frame.to_local(ls.d);
       if (il.z > 0.0 && ls.pdf > 0.0 && !occluded(origin, ls.d, std::numeric_limits<float>::infinity())) {
         const double w = power_heuristic(ls.pdf, model.pdf(o, il));
-        sum += model.f(il, o) * ls.radiance * (il.z * w / ls.pdf);
+        sum += model.f(o, il) * ls.radiance * (il.z * w / ls.pdf);
       }
       // BRDF sampling, weighted against the environment's.
       if (const auto bs = model.sample(o, u[2], u[3], u[4])) {
@@ -247,7 +247,7 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
         dist *= 1.0 - 1e-6;
       }
       const Vec3 il = frame.to_local(d);
-      if (il.z > 0.0 && o.z > 0.0 && !occluded(origin, d, dist)) sum += model.f(il, o) * e * il.z;
+      if (il.z > 0.0 && o.z > 0.0 && !occluded(origin, d, dist)) sum += model.f(o, il) * e * il.z;
     }
     radiance = sum;
   };

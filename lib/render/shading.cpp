@@ -9,9 +9,9 @@ namespace facetfit {
 ShadingModel::ShadingModel(std::shared_ptr<const Brdf> brdf, std::shared_ptr<const TabulatedMicrofacet> proposal)
     : brdf_(std::move(brdf)), proposal_(std::move(proposal)), lobe_weight_(proposal_ && proposal_->can_sample() ? 0.85 : 0.0) {}
 
-Rgb ShadingModel::f(const Vec3& i, const Vec3& o) const {
+Rgb ShadingModel::f(const Vec3& o, const Vec3& i) const {
   // Negative values (a measurement's noise around zero) are rendered as they are, as Mitsuba does.
-  const auto v = brdf_->eval(i, o);
+  const auto v = brdf_->eval(o, i);
   return v ? *v : Rgb(0.0);
 }
 
@@ -45,7 +45,7 @@ std::optional<ShadingModel::Sample> ShadingModel::sample(const Vec3& o, double u
   }
   const double p = pdf(o, i);
   if (!(p > 0.0)) return std::nullopt;
-  return Sample{i, f(i, o) * (i.z / p), p};
+  return Sample{i, f(o, i) * (i.z / p), p};
 }
 
 }  // namespace facetfit

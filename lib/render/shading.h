@@ -20,8 +20,8 @@ class ShadingModel {
   // `proposal` may be null: cosine sampling alone (a Lambertian surface).
   ShadingModel(std::shared_ptr<const Brdf> brdf, std::shared_ptr<const TabulatedMicrofacet> proposal);
 
-  // f(i, o) in the local frame (missing measurements count as zero).
-  Rgb f(const Vec3& i, const Vec3& o) const;
+  // f(o, i) in the local frame (missing measurements count as zero).
+  Rgb f(const Vec3& o, const Vec3& i) const;
 
   struct Sample {
     Vec3 i;

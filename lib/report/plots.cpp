@@ -57,7 +57,7 @@ std::vector<PlotSeries> incidence_plane(double theta_i_degrees, const std::vecto
     for (int d = -89; d <= 89; ++d) {
       // theta_o > 0: the mirror side (phi = 0); < 0: the side of i (phi = pi).
       const Vec3 o = spherical_direction(std::abs(d) * kPi / 180.0, d >= 0 ? 0.0 : kPi);
-      const auto f = brdfs[k].second->eval(i, o);
+      const auto f = brdfs[k].second->eval(o, i);
       s.points.emplace_back(d, f ? std::cbrt(std::max(0.0, luminance(*f) * o.z)) : std::nan(""));
     }
     out.push_back(std::move(s));
