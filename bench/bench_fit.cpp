@@ -99,7 +99,7 @@ void BM_FresnelPass(benchmark::State& state) {
   const auto threads = limit_threads(state);
   const Fitter fitter(FitOptions::paper());
   const FitResult fit = fitter.fit(gold());
-  for (auto _ : state) benchmark::DoNotOptimize(fit_fresnel(gold(), fit.ndf(), Smith::correlated, nullptr));
+  for (auto _ : state) benchmark::DoNotOptimize(fit_fresnel(gold(), fit.ndf(), Smith::correlated));
   state.SetBytesProcessed(int64_t(state.iterations()) * int64_t(3 * MerlTable::kBins * sizeof(float)));
 }
 BENCHMARK(BM_FresnelPass)->ArgName("threads")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);

@@ -41,7 +41,7 @@ namespace {
 
 Quadrature checked_quadrature(const FitOptions& options) {
   if (options.resolution < 4 || options.resolution > 4096)
-    fail("--resolution " + std::to_string(options.resolution), "must be between 4 and 4096");
+    fail("resolution " + std::to_string(options.resolution), "must be between 4 and 4096");
   return Quadrature(options.resolution);
 }
 
@@ -121,8 +121,12 @@ FitResult Fitter::fit(const MerlTable& table) const {
     result.problem = result.extraction.problem;
     return result;
   }
-  result.lobe.fresnel = fit_fresnel(table, result.ndf(), options_.smith, &result.problem);
-  if (!result.ok()) return result;
+  const auto fresnel = fit_fresnel(table, result.ndf(), options_.smith);
+  if (!fresnel) {
+    result.problem = "no measurement where the microfacet model is nonzero (all missing?)";
+    return result;
+  }
+  result.lobe.fresnel = *fresnel;
 
   const bool refine = options_.refine == FitOptions::Refine::full;
   result.refined = refine;

@@ -31,7 +31,7 @@ struct Sums {
 
 }  // namespace
 
-FresnelCurve fit_fresnel(const MerlTable& table, const TabulatedNdf& ndf, Smith smith, std::string* problem) {
+std::optional<FresnelCurve> fit_fresnel(const MerlTable& table, const TabulatedNdf& ndf, Smith smith) {
   // Everything that depends on one axis only is computed once.
   std::array<double, kH> d_h{}, cos_h{}, sin_h{};
   for (int i = 0; i < kH; ++i) {
@@ -113,10 +113,7 @@ FresnelCurve fit_fresnel(const MerlTable& table, const TabulatedNdf& ndf, Smith 
         curve.value[std::size_t(j)][c] = std::max(0.0, sums.measured[j][c] / sums.model[j][c]);
       }
     }
-    if (usable.empty()) {
-      if (problem) *problem = "no measurement where the microfacet model is nonzero (all missing?)";
-      return curve;
-    }
+    if (usable.empty()) return std::nullopt;
     std::size_t u = 0;
     for (int j = 0; j < kD; ++j) {
       while (u + 1 < usable.size() && usable[u + 1] <= j) ++u;

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <array>
+#include <optional>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -17,7 +18,8 @@ namespace facetfit {
 // One pass over every valid bin of the table. Each theta_d entry is the mean of the ratios
 // measurement / model weighted by the model: sum(measurement) / sum(model). The unweighted mean is
 // dominated by the bins where the F = 1 model is nearly zero, i.e. by noise and by what is not
-// microfacet reflection. Sets `problem` when no bin holds a usable measurement.
-FresnelCurve fit_fresnel(const MerlTable& table, const TabulatedNdf& ndf, Smith smith, std::string* problem);
+// microfacet reflection. nullopt when no bin holds a usable measurement in some channel (a fit
+// without meaning, not an error: Fitter::fit reports it in FitResult::problem).
+std::optional<FresnelCurve> fit_fresnel(const MerlTable& table, const TabulatedNdf& ndf, Smith smith);
 
 }  // namespace facetfit
