@@ -11,7 +11,7 @@
 #include "core/error.h"
 #include "fit/extract.h"
 #include "fit/fit.h"
-#include "fit/ground_truth.h"
+#include "support/ground_truth.h"
 #include "fit/roughness.h"
 #include "io/atomic_file.h"
 #include "io/rgl.h"

@@ -2,7 +2,7 @@
 // Smith model extracted by the matching --smith. The same figures make docs/accuracy.md.
 #include <gtest/gtest.h>
 
-#include "fit/ground_truth.h"
+#include "support/ground_truth.h"
 #include "io/input.h"
 #include "model/analytic.h"
 #include "test_util.h"

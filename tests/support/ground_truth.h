@@ -1,5 +1,6 @@
 // Accuracy against ground truth: an analytic material written into a MERL table, fitted, and compared
-// with the parameters it was made from. The accuracy tests and docs/accuracy.md share this code.
+// with the parameters it was made from: a test oracle, not part of the library. The accuracy tests and
+// docs/accuracy.md (bench/accuracy_table.cpp) share it through the facetfit_testing library.
 #pragma once
 
 #include <string>

@@ -1,4 +1,4 @@
-#include "fit/ground_truth.h"
+#include "support/ground_truth.h"
 
 #include <cmath>
 
