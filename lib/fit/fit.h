@@ -24,7 +24,7 @@ struct FitOptions {
   Smith smith = Smith::correlated;
   double tolerance = 1e-10;
   int max_iterations = 1000;
-  // full: refinement and parametric fits on the whole measurement (fit/refine.h), ~1 s of CPU a
+  // full: refinement and parametric fits on the whole measurement (fit/refine.h), ~0.6 s of CPU a
   // material; none: the paper's method alone, a few milliseconds.
   enum class Refine { none, full };
   Refine refine = Refine::full;
