@@ -115,6 +115,13 @@ TEST(Render, BadScenesGetOneClearLine) {
        "albedo must be three finite numbers >= 0"},
       {R"({"environment": {"constant": [1, 1, 1], "scale": -2}, )" + sphere + "}]}", "environment.scale must be"},
       {R"({"objects": )" + std::string(100000, '[') + std::string(100000, ']') + "}", "nested more than 32 levels"},
+      // Integers out of range, which nlohmann/json stores as floats: converting them was undefined
+      // behaviour (fuzz_scene's finding).
+      {R"({"render": {"seed": 100000000000000000000000000000000000000}, )" + sphere + "}]}", "\"seed\" must be an integer between 0 and"},
+      {R"({"render": {"seed": -1}, )" + sphere + "}]}", "\"seed\" must be an integer between 0 and"},
+      {R"({"render": {"spp": 2.5}, )" + sphere + "}]}", "\"spp\" must be an integer"},
+      {R"({"camera": {"width": 1e20}, )" + sphere + "}]}", "\"width\" must be an integer between 1 and 16384"},
+      {R"({"camera": {"height": 0}, )" + sphere + "}]}", "\"height\" must be an integer between 1 and 16384"},
   };
   for (const auto& [text, message] : bad) {
     test::write_bytes(dir.file("bad.json"), text);
@@ -123,6 +130,9 @@ TEST(Render, BadScenesGetOneClearLine) {
     EXPECT_EQ(e.find('\n'), std::string::npos) << e.substr(0, 200);  // one line
   }
   EXPECT_NE(test::error_of([&] { parse_scene("/dev/zero"); }).find("/dev/zero: not a regular file"), std::string::npos);
+  // An integral float is an integer.
+  test::write_bytes(dir.file("ok.json"), R"({"camera": {"width": 64.0}, "render": {"seed": 7, "spp": 8}, )" + sphere + "}]}");
+  EXPECT_EQ(parse_scene(dir.file("ok.json")).camera.width, 64);
   // A material built in code with an unknown type fails instead of rendering as some other type.
   MaterialDesc odd;
   odd.type = "velvet";

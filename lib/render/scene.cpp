@@ -1,6 +1,8 @@
 #include "render/scene.h"
 
 #include <algorithm>
+#include <cmath>
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -64,6 +66,24 @@ T get(const json& j, const char* key, T fallback, const std::string& path) {
   }
 }
 
+// An integer in [lo, hi]: a JSON integer, or a float with an integral value. nlohmann/json stores an
+// integer too large for 64 bits as a float, and converting such a float (or a negative one to an
+// unsigned type) is undefined behaviour (found by fuzz_scene): the range is checked first.
+template <class T>
+T get_integer(const json& j, const char* key, T fallback, long double lo, long double hi, const std::string& path) {
+  if (!j.contains(key)) return fallback;
+  const json& v = j.at(key);
+  long double x = 0.0L;
+  if (v.is_number_unsigned()) x = static_cast<long double>(v.get<std::uint64_t>());
+  else if (v.is_number_integer()) x = static_cast<long double>(v.get<std::int64_t>());
+  else if (v.is_number_float() && std::isfinite(v.get<double>()) && v.get<double>() == std::floor(v.get<double>())) x = v.get<double>();
+  else fail(path, std::string("\"") + key + "\" must be an integer");
+  if (!(x >= lo && x <= hi))
+    fail(path, std::string("\"") + key + "\" must be an integer between " + std::to_string(static_cast<long long>(lo)) + " and " +
+                   std::to_string(static_cast<unsigned long long>(hi)));
+  return static_cast<T>(x);
+}
+
 MaterialDesc parse_material(const std::string& name, const json& j, const std::string& path) {
   if (!j.is_object()) fail(path, "material " + name + " must be an object");
   MaterialDesc m;
@@ -123,10 +143,8 @@ SceneDesc parse_scene(const std::string& path) {
     if (c.contains("look_at")) s.camera.look_at = position(c["look_at"], "camera.look_at", path);
     if (c.contains("up")) s.camera.up = direction(c["up"], "camera.up", path);
     s.camera.fov_degrees = get<double>(c, "fov", s.camera.fov_degrees, path);
-    s.camera.width = get<int>(c, "width", s.camera.width, path);
-    s.camera.height = get<int>(c, "height", s.camera.height, path);
-    if (s.camera.width < 1 || s.camera.height < 1 || s.camera.width > 16384 || s.camera.height > 16384)
-      fail(path, "camera width and height must be between 1 and 16384");
+    s.camera.width = get_integer<int>(c, "width", s.camera.width, 1, 16384, path);
+    s.camera.height = get_integer<int>(c, "height", s.camera.height, 1, 16384, path);
     if (!(s.camera.fov_degrees > 0.0 && s.camera.fov_degrees < 180.0)) fail(path, "camera fov must be in (0, 180) degrees");
     // A camera needs a view direction, and an up that is not along it.
     const Vec3 view = s.camera.look_at - s.camera.position;
@@ -135,9 +153,8 @@ SceneDesc parse_scene(const std::string& path) {
       fail(path, "camera.up must not be parallel to the view direction");
   }
   if (j.contains("render")) {
-    s.spp = get<int>(j["render"], "spp", s.spp, path);
-    s.seed = get<std::uint64_t>(j["render"], "seed", s.seed, path);
-    if (s.spp < 1 || s.spp > 1 << 20) fail(path, "render.spp must be between 1 and 1048576");
+    s.spp = get_integer<int>(j["render"], "spp", s.spp, 1, 1 << 20, path);
+    s.seed = get_integer<std::uint64_t>(j["render"], "seed", s.seed, 0, 18446744073709551615.0L, path);
   }
   if (j.contains("environment")) {
     const json& e = j["environment"];
