@@ -114,6 +114,8 @@ TEST(Render, BadScenesGetOneClearLine) {
       {R"({"materials": {"m": {"type": "lambert", "albedo": [-1, 0, 0]}}, "objects": [{"type": "sphere", "material": "m"}]})",
        "albedo must be three finite numbers >= 0"},
       {R"({"environment": {"constant": [1, 1, 1], "scale": -2}, )" + sphere + "}]}", "environment.scale must be"},
+      {R"({"materials": {"m": {"type": "lambert", "proposal": "x.exr"}}, "objects": [{"type": "sphere", "material": "m"}]})",
+       "\"proposal\" is for measured materials"},
       {R"({"objects": )" + std::string(100000, '[') + std::string(100000, ']') + "}", "nested more than 32 levels"},
       // Integers out of range, which nlohmann/json stores as floats: converting them was undefined
       // behaviour (fuzz_scene's finding).
@@ -160,17 +162,18 @@ TEST(Render, ObjMeshes) {
 }  // namespace facetfit
 
 #include "color/image_diff.h"
+#include "io/input.h"
+#include "lut/lut.h"
 
 namespace facetfit {
 namespace {
 
-TEST(Render, MeasuredGgxTableMatchesTheAnalyticGgx) {
-  // The analytic gold GGX, tabulated into a MERL table and rendered from it (trilinear lookup), against
-  // the analytic model itself, same scene and seeds: mean Delta E 2000 over the sphere < 0.5.
-  MaterialDesc measured, analytic;
-  measured.type = "measured";
+// `measured` (builtin:gold-ggx-0.15 as a measurement) and the analytic model rendered in the same
+// small scene with the same seeds, compared over the sphere.
+ImageDiff measured_against_analytic_gold(const MaterialDesc& measured) {
+  MaterialDesc analytic;
   analytic.type = "analytic";
-  measured.file = analytic.file = "builtin:gold-ggx-0.15";
+  analytic.file = "builtin:gold-ggx-0.15";
   SceneDesc a = default_scene(measured), b = default_scene(analytic);
   for (SceneDesc* s : {&a, &b}) {
     s->camera.width = s->camera.height = 64;
@@ -179,10 +182,38 @@ TEST(Render, MeasuredGgxTableMatchesTheAnalyticGgx) {
   const RenderedImage ia = render(a), ib = render(b);
   std::vector<bool> mask(std::size_t(ia.width) * ia.height);
   for (std::size_t p = 0; p < mask.size(); ++p) mask[p] = ia.rgba[4 * p + 3] >= 1.0f;
-  const ImageDiff d = image_delta_e(ia.rgb(), false, ib.rgb(), false, mask, DisplayTransform());
+  return image_delta_e(ia.rgb(), false, ib.rgb(), false, mask, DisplayTransform());
+}
+
+TEST(Render, MeasuredGgxTableMatchesTheAnalyticGgx) {
+  // The analytic gold GGX, tabulated into a MERL table and rendered from it (trilinear lookup), against
+  // the analytic model itself: mean Delta E 2000 over the sphere < 0.5.
+  MaterialDesc measured;
+  measured.type = "measured";
+  measured.file = "builtin:gold-ggx-0.15";
+  const ImageDiff d = measured_against_analytic_gold(measured);
   EXPECT_GT(d.pixels, 1000u);
   EXPECT_LT(d.mean, 0.5);
   std::printf("measured vs analytic GGX: mean Delta E 2000 %.4f, max %.4f over %zu pixels\n", d.mean, d.max, d.pixels);
+}
+
+TEST(Render, MeasuredMaterialSampledByAGivenLutRendersTheSameImage) {
+  // A measured material sampled by a bake's LUT (the report hands its bake over rather than fitting
+  // again) still renders the measurement: the same bar against the analytic model.
+  test::TempDir dir;
+  const Fitter fitter{FitOptions::paper()};
+  write_lut(dir.file("gold.exr"),
+            make_lut(fitter.fit(load_table("builtin:gold-ggx-0.15")), fitter.quadrature(), "builtin:gold-ggx-0.15", "x", 0.02, true));
+  MaterialDesc measured;
+  measured.type = "measured";
+  measured.file = "builtin:gold-ggx-0.15";
+  measured.proposal = dir.file("gold.exr");
+  const ImageDiff d = measured_against_analytic_gold(measured);
+  EXPECT_GT(d.pixels, 1000u);
+  EXPECT_LT(d.mean, 0.5);
+  // A missing proposal is an error naming it, not a silent refit.
+  measured.proposal = dir.file("none.exr");
+  EXPECT_NE(test::error_of([&] { render(default_scene(measured)); }).find("none.exr"), std::string::npos);
 }
 
 }  // namespace

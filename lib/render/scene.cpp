@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <nlohmann/json.hpp>
 
 #include "core/error.h"
@@ -103,6 +104,8 @@ MaterialDesc parse_material(const std::string& name, const json& j, const std::s
   m.fresnel = get<std::string>(j, "fresnel", "f82", path);
   if (m.fresnel != "curve" && m.fresnel != "f82") fail(path, "material " + name + ": fresnel must be curve or f82");
   m.slices = get<std::string>(j, "slices", "view", path);
+  m.proposal = get<std::string>(j, "proposal", "", path);
+  if (!m.proposal.empty() && m.type != "measured") fail(path, "material " + name + ": \"proposal\" is for measured materials");
   if (!parse_slices(m.slices)) fail(path, "material " + name + ": slices must be view, symmetric or light");
   const auto smith = parse_smith(get<std::string>(j, "smith", "correlated", path));
   if (!smith) fail(path, "material " + name + ": smith must be masking, correlated or separable");
@@ -118,6 +121,13 @@ SceneDesc parse_scene(const std::string& path) {
   if (fs::exists(path, ec) && !fs::is_regular_file(path, ec)) fail(path, "not a regular file");
   std::ifstream in(path);
   if (!in) fail(path, "cannot open scene");
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (in.bad()) fail(path, "cannot read scene");
+  std::string base_dir = fs::path(path).parent_path().string();
+  return parse_scene_text(text, path, base_dir.empty() ? "." : base_dir);
+}
+
+SceneDesc parse_scene_text(const std::string& text, const std::string& path, const std::string& base_dir) {
   // Nesting is bounded as it is read: a scene is 4 levels deep, and a deeply nested document would only
   // exhaust the stack of everything that later copies or destroys it.
   constexpr int kMaxDepth = 32;
@@ -128,15 +138,14 @@ SceneDesc parse_scene(const std::string& path) {
   };
   json j;
   try {
-    j = json::parse(in, depth_limit, true);
+    j = json::parse(text, depth_limit, true);
   } catch (const json::exception& e) {
     fail(path, std::string("not a JSON object: ") + e.what());
   }
   if (too_deep) fail(path, "nested more than 32 levels deep");
   if (!j.is_object()) fail(path, "not a JSON object");
   SceneDesc s;
-  s.base_dir = fs::path(path).parent_path().string();
-  if (s.base_dir.empty()) s.base_dir = ".";
+  s.base_dir = base_dir;
   if (j.contains("camera")) {
     const json& c = j["camera"];
     if (c.contains("position")) s.camera.position = position(c["position"], "camera.position", path);
@@ -272,6 +281,17 @@ std::string resolve(const SceneDesc& scene, const std::string& file) {
   return resolve_source(scene.base_dir, file);
 }
 
+namespace {
+
+// A LUT's tabulated model, able to sample: an --eval-only LUT gets its sampling tables built here.
+std::shared_ptr<const TabulatedMicrofacet> sampled_lut_model(const std::string& path) {
+  Lut lut = read_lut(path);
+  if (lut.sampling.empty()) return std::make_shared<TabulatedMicrofacet>(std::move(lut.tables));
+  return std::make_shared<TabulatedMicrofacet>(std::move(lut.tables), std::move(lut.sampling));
+}
+
+}  // namespace
+
 std::shared_ptr<const ShadingModel> load_material(const SceneDesc& scene, const MaterialDesc& m) {
   if (m.type == "lambert") return std::make_shared<ShadingModel>(std::make_shared<LambertBrdf>(m.albedo), nullptr);
   if (m.type == "analytic") {  // a built-in's analytic model itself: the ground truth
@@ -284,29 +304,32 @@ std::shared_ptr<const ShadingModel> load_material(const SceneDesc& scene, const 
     return std::make_shared<ShadingModel>(builtin->brdf, proposal);
   }
   if (m.type == "measured") {
-    // The measurement is what is rendered; its fit only proposes directions.
+    // The measurement is what is rendered; a fit only proposes directions: the given LUT's (a bake
+    // already made it), or else the paper's fit alone (a proposal needs the lobe's shape, not the
+    // refinement's accuracy).
     const std::string source = resolve(scene, m.file);
-    auto table = std::make_shared<MerlTable>(load_table(source));
-    // The paper's fit alone: a proposal needs the lobe's shape, not the refinement's accuracy.
-    const Fitter fitter{FitOptions::paper()};
-    const FitResult fit = fitter.fit(*table);
+    const bool rgl = std::filesystem::path(source).extension() == ".bsdf";
+    std::shared_ptr<const MerlTable> table;
+    if (!rgl || m.proposal.empty()) table = std::make_shared<MerlTable>(load_table(source));
     std::shared_ptr<const TabulatedMicrofacet> proposal;
-    if (fit.ok()) proposal = std::make_shared<TabulatedMicrofacet>(MicrofacetTables{fit.ndf(), fit.smith, fit.fresnel(), {}, {}});
+    if (!m.proposal.empty()) {
+      proposal = sampled_lut_model(resolve(scene, m.proposal));
+    } else {
+      const FitResult fit = Fitter{FitOptions::paper()}.fit(*table);
+      if (fit.ok()) proposal = std::make_shared<TabulatedMicrofacet>(MicrofacetTables{fit.ndf(), fit.smith, fit.fresnel(), {}, {}});
+    }
     // RGL files render through their own evaluation (the renderer's o is the viewer's side), not the
     // MERL-layout table: with view slices this is Mitsuba's `measured` (tests/test_mitsuba.cpp).
-    if (std::filesystem::path(source).extension() == ".bsdf") {
-      auto rgl = std::make_shared<RglBsdf>(RglBsdf::read(source));
-      rgl->set_slices(*parse_slices(m.slices));
-      return std::make_shared<ShadingModel>(rgl, proposal);
+    if (rgl) {
+      auto brdf = std::make_shared<RglBsdf>(RglBsdf::read(source));
+      brdf->set_slices(*parse_slices(m.slices));
+      return std::make_shared<ShadingModel>(brdf, proposal);
     }
     return std::make_shared<ShadingModel>(table, proposal);
   }
   if (m.type == "lut") {
-    auto model = std::make_shared<TabulatedMicrofacet>(read_lut(resolve(scene, m.file)).model());
-    std::shared_ptr<const TabulatedMicrofacet> proposal = model;
-    if (!model->can_sample())  // an --eval-only LUT: sample its NDF with freshly built tables
-      proposal = std::make_shared<TabulatedMicrofacet>(model->tables());
-    return std::make_shared<ShadingModel>(model, proposal);
+    std::shared_ptr<const TabulatedMicrofacet> model = sampled_lut_model(resolve(scene, m.file));
+    return std::make_shared<ShadingModel>(model, model);
   }
   // ggx | beckmann | lsq (the LUT's classical baseline: Lambert + GGX + Schlick); nothing else renders as them
   if (m.type != "ggx" && m.type != "beckmann" && m.type != "lsq")

@@ -43,6 +43,9 @@ struct MaterialDesc {
   // measured RGL files: which direction picks the file's slices (io/rgl.h): "view" (Mitsuba's
   // evaluation, the reference), "symmetric" (both one-sided estimates, reciprocal) or "light".
   std::string slices = "view";
+  // measured: optional LUT of the same material (a bake's output) whose fit proposes directions; without
+  // one the paper's fit is made on load.
+  std::string proposal;
   Smith smith = Smith::correlated;
   Rgb albedo{0.8};
 };
@@ -70,6 +73,9 @@ struct SceneDesc {
 
 // Throws Error("<path>: <problem>") for unreadable or inconsistent scenes.
 SceneDesc parse_scene(const std::string& path);
+// The same from the scene's text: `name` stands for the file in messages, relative files resolve against
+// `base_dir`.
+SceneDesc parse_scene_text(const std::string& text, const std::string& name, const std::string& base_dir);
 // The embedded default: a sphere of `subject` under the built-in sky. Needs no asset.
 SceneDesc default_scene(const MaterialDesc& subject);
 

@@ -271,6 +271,7 @@ json run_report(const ReportOptions& o) {
           MaterialDesc m;
           m.type = type;
           m.file = file;
+          if (type == "measured") m.proposal = lut;  // the bake's fit, not a second one
           return render(report_scene(m, o));
         };
         const RenderedImage measured = render_as("measured", source);
