@@ -5,13 +5,14 @@
 BUILD      ?= build/release
 BPY_VENV   ?= build/bpy-venv
 MITSUBA_VENV ?= build/mitsuba-venv
+PY_VENV    ?= build/py-venv
 ASAN_BUILD ?= build/asan
 FUZZ_BUILD ?= build/fuzz
 FUZZ_SECONDS ?= 600
 JOBS       ?= $(shell nproc)
 CMAKE_GEN  := -G Ninja
 
-.PHONY: all deps build demo test asan fuzz-build fuzz osl-host mitsuba-host osl-docs bench accuracy clean
+.PHONY: all deps build demo test asan fuzz-build fuzz osl-host mitsuba-host python osl-docs bench accuracy clean
 
 all: build
 
@@ -20,7 +21,8 @@ deps:
 
 build: deps
 	@cmake -S . -B $(BUILD) $(CMAKE_GEN) -DCMAKE_BUILD_TYPE=Release -DFACETFIT_WERROR=ON \
-	  -DFACETFIT_BPY_PYTHON=$(CURDIR)/$(BPY_VENV)/bin/python -DFACETFIT_MITSUBA_PYTHON=$(CURDIR)/$(MITSUBA_VENV)/bin/python >/dev/null
+	  -DFACETFIT_BPY_PYTHON=$(CURDIR)/$(BPY_VENV)/bin/python -DFACETFIT_MITSUBA_PYTHON=$(CURDIR)/$(MITSUBA_VENV)/bin/python \
+	  -DFACETFIT_PY_PYTHON=$(CURDIR)/$(PY_VENV)/bin/python >/dev/null
 	@cmake --build $(BUILD) -j $(JOBS)
 
 demo: build
@@ -53,7 +55,11 @@ osl-host:
 mitsuba-host:
 	@scripts/setup-mitsuba.sh $(MITSUBA_VENV) >/dev/null
 
-test: build asan fuzz-build osl-host mitsuba-host
+# The Python module, built and installed by `pip install .` into a venv of the build (label python).
+python: deps
+	@scripts/setup-python.sh $(PY_VENV) >/dev/null
+
+test: build asan fuzz-build osl-host mitsuba-host python
 	cd $(BUILD) && ctest --output-on-failure -j $(JOBS)
 	fuzz/run.sh $(FUZZ_BUILD) 20
 	cd $(ASAN_BUILD) && ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1 \

@@ -19,11 +19,19 @@ namespace facetfit {
 
 namespace fs = std::filesystem;
 
-std::string bake_cache_key(const std::string& source_sha256, const BakeOptions& o) {
+std::string source_sha256(const std::string& source) {
+  if (is_builtin(source)) {
+    // A built-in is defined by its name and the code that makes it: the version is in the cache key.
+    return sha256_hex(source.data(), source.size());
+  }
+  return sha256_file(source);
+}
+
+std::string bake_cache_key(const std::string& sha256, const BakeOptions& o) {
   nlohmann::json k;
   k["facetfit_version"] = FACETFIT_VERSION;
   k["lut_format_version"] = kLutFormatVersion;
-  k["source_sha256"] = source_sha256;
+  k["source_sha256"] = sha256;
   k["resolution"] = o.fit.resolution;
   k["smith"] = to_string(o.fit.smith);
   k["iteration_tolerance"] = o.fit.tolerance;
@@ -37,14 +45,6 @@ std::string bake_cache_key(const std::string& source_sha256, const BakeOptions& 
 }
 
 namespace {
-
-std::string source_hash(const std::string& source) {
-  if (is_builtin(source)) {
-    // A built-in is defined by its name and the code that makes it: the version is in the cache key.
-    return sha256_hex(source.data(), source.size());
-  }
-  return sha256_file(source);
-}
 
 // The cached sidecar, if it is complete and was made from the same content with the same settings.
 std::optional<nlohmann::json> cached_record(const fs::path& json_path, const fs::path& lut_path, const std::string& key) {
@@ -73,7 +73,7 @@ BakeOutcome bake_material(const std::string& source, const std::string& name, co
     tbb::task_group hashing;
     hashing.run([&] {
       try {
-        sha = source_hash(source);
+        sha = source_sha256(source);
       } catch (const Error& e) {
         hash_error = e.what();
       }

@@ -26,8 +26,11 @@ struct BakeOutcome {
   double seconds = 0.0;
 };
 
-// The key under which a bake of `source_sha256` with these settings is cached.
-std::string bake_cache_key(const std::string& source_sha256, const BakeOptions& options);
+// The identity of a source in LUT metadata: SHA-256 of a file's bytes, of a built-in's name.
+std::string source_sha256(const std::string& source);
+
+// The key under which a bake of the source with this `sha256` with these settings is cached.
+std::string bake_cache_key(const std::string& sha256, const BakeOptions& options);
 
 // Bakes one source into out_dir (which must exist). Never throws for a bad input: the outcome says why.
 BakeOutcome bake_material(const std::string& source, const std::string& name, const std::string& out_dir,

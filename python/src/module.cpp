@@ -1,0 +1,391 @@
+// The Python module `facetfit._facetfit` (pybind11): measurements, fits, LUTs, every material as a model
+// to evaluate, sample and give a pdf on numpy arrays of directions, rendering and Delta E. The package
+// python/facetfit re-exports it (docs/python.md).
+//
+// Conventions are the library's (docs/conventions.md): directions are unit vectors in the local frame,
+// normal +z, pointing away from the surface, o toward the viewer first, i toward the light second.
+// Errors the library reports as facetfit::Error arrive as facetfit.Error, one line naming the input.
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "arrays.h"
+#include "color/image_diff.h"
+#include "core/error.h"
+#include "fit/fit.h"
+#include "io/input.h"
+#include "lut/bake.h"
+#include "lut/lut.h"
+#include "lut/record.h"
+#include "model/ndf.h"
+#include "model/parametric.h"
+#include "model/tabulated.h"
+#include "render/renderer.h"
+#include "render/scene.h"
+
+namespace facetfit::python {
+namespace {
+
+py::object to_python(const nlohmann::json& j) { return py::module_::import("json").attr("loads")(j.dump()); }
+std::string to_json_text(const py::object& o) { return py::module_::import("json").attr("dumps")(o).cast<std::string>(); }
+
+// A measured material as the fit reads it: the MERL-layout table of any input.
+struct Measurement {
+  std::string source;
+  std::shared_ptr<const MerlTable> table;
+};
+
+struct Model {
+  std::shared_ptr<const ShadingModel> shading;
+};
+
+Model tabulated_model(const MicrofacetTables& tables) {
+  auto m = std::make_shared<TabulatedMicrofacet>(tables);
+  return Model{std::make_shared<ShadingModel>(m, m)};
+}
+
+struct Fit {
+  std::string source;
+  FitResult result;
+  std::shared_ptr<const Fitter> fitter;  // its quadrature bakes the LUT
+};
+
+FitOptions fit_options(const std::string& refine, int resolution, const std::string& smith, const std::string& merl_bins) {
+  FitOptions o;
+  const auto r = parse_refine(refine);
+  if (!r) throw py::value_error("refine: must be full or none, not '" + refine + "'");
+  const auto s = parse_smith(smith);
+  if (!s) throw py::value_error("smith: must be masking, correlated or separable, not '" + smith + "'");
+  const auto b = parse_bin_point(merl_bins);
+  if (!b) throw py::value_error("merl_bins: must be start or center, not '" + merl_bins + "'");
+  if (resolution < 8 || resolution > 1024) throw py::value_error("resolution: must be in [8, 1024]");
+  o.refine = *r;
+  o.resolution = resolution;
+  o.smith = *s;
+  o.merl_bins = *b;
+  return o;
+}
+
+Measurement load(const std::string& source, const std::string& merl_bins) {
+  const auto b = parse_bin_point(merl_bins);
+  if (!b) throw py::value_error("merl_bins: must be start or center, not '" + merl_bins + "'");
+  py::gil_scoped_release release;
+  return Measurement{source, std::make_shared<MerlTable>(load_table(source, *b))};
+}
+
+Fit fit(const Measurement& m, const FitOptions& options) {
+  py::gil_scoped_release release;
+  auto fitter = std::make_shared<const Fitter>(options);
+  return Fit{m.source, fitter->fit(*m.table), fitter};
+}
+
+// f(o, i): shape (..., 3) from two stacks of directions.
+py::array_t<double> eval_rgb(const py::handle& o, const py::handle& i, const std::function<Rgb(const Vec3&, const Vec3&)>& f) {
+  const Vectors vo(o, "o"), vi(i, "i");
+  const auto shape = broadcast(vo, vi, "eval");
+  py::array_t<double> out(with_axis(shape, 3));
+  double* p = out.mutable_data();
+  parallel(count_of(shape), [&](std::size_t k) {
+    const Rgb v = f(vo.at(vo.count == 1 ? 0 : k), vi.at(vi.count == 1 ? 0 : k));
+    p[3 * k] = v.r;
+    p[3 * k + 1] = v.g;
+    p[3 * k + 2] = v.b;
+  });
+  return out;
+}
+
+py::dict sample(const Model& m, const py::handle& o, const py::handle& u) {
+  const Vectors vo(o, "o"), vu(u, "u");
+  const auto shape = broadcast(vo, vu, "sample");
+  const std::size_t n = count_of(shape);
+  py::array_t<double> dir(with_axis(shape, 3)), weight(with_axis(shape, 3)), pdf(shape);
+  double *pd = dir.mutable_data(), *pw = weight.mutable_data(), *pp = pdf.mutable_data();
+  parallel(n, [&](std::size_t k) {
+    const Vec3 uk = vu.at(vu.count == 1 ? 0 : k);
+    const auto s = m.shading->sample(vo.at(vo.count == 1 ? 0 : k), uk.x, uk.y, uk.z);
+    const Vec3 i = s ? s->i : Vec3(0.0);
+    const Rgb w = s ? s->weight : Rgb(0.0);
+    for (int c = 0; c < 3; ++c) {
+      pd[3 * k + c] = i[c];
+      pw[3 * k + c] = w[c];
+    }
+    pp[k] = s ? s->pdf : 0.0;
+  });
+  py::dict d;
+  d["i"] = dir;
+  d["weight"] = weight;
+  d["pdf"] = pdf;
+  return d;
+}
+
+py::array_t<double> pdf(const Model& m, const py::handle& o, const py::handle& i) {
+  const Vectors vo(o, "o"), vi(i, "i");
+  const auto shape = broadcast(vo, vi, "pdf");
+  py::array_t<double> out(shape);
+  double* p = out.mutable_data();
+  parallel(count_of(shape), [&](std::size_t k) { p[k] = m.shading->pdf(vo.at(vo.count == 1 ? 0 : k), vi.at(vi.count == 1 ? 0 : k)); });
+  return out;
+}
+
+// A material as a scene describes it (docs/scene-format.md), e.g. {"type": "ggx", "alpha": 0.2}.
+Model material(const py::dict& description, const std::string& base_dir) {
+  const std::string text = R"({"materials": {"m": )" + to_json_text(description) + R"(}, "objects": [{"type": "sphere", "material": "m"}]})";
+  py::gil_scoped_release release;
+  const SceneDesc scene = parse_scene_text(text, "material", base_dir);
+  return Model{load_material(scene, scene.materials.at("m"))};
+}
+
+py::array_t<float> render_scene(const py::object& scene, int spp, std::uint64_t seed) {
+  SceneDesc desc;
+  if (py::isinstance<py::dict>(scene)) {
+    const std::string text = to_json_text(scene);
+    desc = parse_scene_text(text, "scene", py::module_::import("os").attr("getcwd")().cast<std::string>());
+  } else {
+    desc = parse_scene(py::str(py::module_::import("os").attr("fspath")(scene)).cast<std::string>());
+  }
+  RenderSettings settings;
+  settings.spp = spp;
+  settings.seed = seed;
+  RenderedImage image;
+  {
+    py::gil_scoped_release release;
+    image = render(desc, settings);
+  }
+  py::array_t<float> out({py::ssize_t(image.height), py::ssize_t(image.width), py::ssize_t(4)});
+  std::copy(image.rgba.begin(), image.rgba.end(), out.mutable_data());
+  return out;
+}
+
+py::tuple delta_e(const py::handle& a, const py::handle& b, const py::object& mask, bool a_display_referred, bool b_display_referred) {
+  using FloatArray = py::array_t<float, py::array::c_style | py::array::forcecast>;
+  const FloatArray fa = FloatArray::ensure(a), fb = FloatArray::ensure(b);
+  if (!fa || !fb || fa.ndim() != 3 || fb.ndim() != 3 || fa.shape(2) < 3 || fb.shape(2) < 3 || fa.shape(0) != fb.shape(0) ||
+      fa.shape(1) != fb.shape(1))
+    throw py::value_error("delta_e: images must be (height, width, 3 or 4) arrays of the same size");
+  const py::ssize_t h = fa.shape(0), w = fa.shape(1);
+  const std::size_t pixels = std::size_t(h) * std::size_t(w);
+  const auto rgb = [pixels](const FloatArray& x) {
+    std::vector<float> v(pixels * 3);
+    const py::ssize_t channels = x.shape(2);
+    for (std::size_t p = 0; p < pixels; ++p)
+      for (int c = 0; c < 3; ++c) v[3 * p + c] = x.data()[p * std::size_t(channels) + c];
+    return v;
+  };
+  std::vector<bool> keep(pixels, true);
+  if (!mask.is_none()) {
+    using BoolArray = py::array_t<bool, py::array::c_style | py::array::forcecast>;
+    const BoolArray m = BoolArray::ensure(mask);
+    if (!m || m.ndim() != 2 || m.shape(0) != h || m.shape(1) != w) throw py::value_error("delta_e: mask must be a (height, width) array");
+    for (std::size_t p = 0; p < pixels; ++p) keep[p] = m.data()[p];
+  }
+  std::vector<float> va = rgb(fa), vb = rgb(fb);
+  ImageDiff d;
+  {
+    py::gil_scoped_release release;
+    d = image_delta_e(std::move(va), a_display_referred, std::move(vb), b_display_referred, keep, DisplayTransform());
+  }
+  py::array_t<float> map({h, w});
+  std::copy(d.delta_e.begin(), d.delta_e.end(), map.mutable_data());
+  return py::make_tuple(map, d.mean, d.max);
+}
+
+py::array_t<double> fresnel_array(const FresnelCurve& f) {
+  py::array_t<double> a({py::ssize_t(FresnelCurve::kSize), py::ssize_t(3)});
+  for (int j = 0; j < FresnelCurve::kSize; ++j)
+    for (int c = 0; c < 3; ++c) a.mutable_at(j, c) = f.value[std::size_t(j)][c];
+  return a;
+}
+
+py::array_t<double> theta_array(const ThetaGrid& grid) {
+  std::vector<double> t(std::size_t(grid.size()));
+  for (int j = 0; j < grid.size(); ++j) t[std::size_t(j)] = grid.theta(j);
+  return vector_array(t);
+}
+
+py::array_t<double> fresnel_theta_d() {
+  std::vector<double> t(FresnelCurve::kSize);
+  for (int j = 0; j < FresnelCurve::kSize; ++j) t[std::size_t(j)] = FresnelCurve::theta_d(j);
+  return vector_array(t);
+}
+
+// Evaluates `per_theta` at every element of an array of polar angles.
+py::array_t<double> over_theta(const py::handle& theta, const std::function<double(double)>& per_theta) {
+  const Array t = Array::ensure(theta);
+  if (!t) throw py::value_error("theta: must be an array of angles in radians");
+  py::array_t<double> out(std::vector<py::ssize_t>(t.shape(), t.shape() + t.ndim()));
+  for (py::ssize_t k = 0; k < t.size(); ++k) out.mutable_data()[k] = per_theta(t.data()[k]);
+  return out;
+}
+
+}  // namespace
+}  // namespace facetfit::python
+
+using namespace facetfit;
+using namespace facetfit::python;
+
+PYBIND11_MODULE(_facetfit, m) {
+  m.doc() = "facetfit: microfacet fits of measured BRDFs (Dupuy et al. 2015), LUTs, rendering, Delta E 2000";
+  m.attr("__version__") = FACETFIT_VERSION;
+  py::register_exception<Error>(m, "Error", PyExc_RuntimeError);
+
+  py::class_<Measurement>(m, "Measurement", "A measured material in MERL layout (MERL, RGL or builtin: source).")
+      .def_readonly("source", &Measurement::source)
+      .def_property_readonly("name", [](const Measurement& x) { return source_name(x.source); })
+      .def(
+          "eval",
+          [](const Measurement& x, const py::handle& o, const py::handle& i) {
+            return eval_rgb(o, i, [&x](const Vec3& vo, const Vec3& vi) {
+              const auto v = x.table->eval(vo, vi);
+              return v ? *v : Rgb(std::nan(""));
+            });
+          },
+          py::arg("o"), py::arg("i"), "f(o, i) in 1/sr, shape (..., 3); NaN where the measurement has no value.")
+      .def("__repr__", [](const Measurement& x) { return "<facetfit.Measurement " + x.source + ">"; });
+
+  m.def("load", &load, py::arg("source"), py::arg("merl_bins") = "start",
+        "Loads a measurement: a MERL .binary, an RGL .bsdf or builtin:NAME. Raises facetfit.Error naming the file.");
+  m.def("builtins", [] {
+    std::vector<std::string> names;
+    for (const std::string& s : expand_inputs({kBuiltinPrefix})) names.push_back(source_name(s));
+    return names;
+  });
+
+  py::class_<Model>(m, "Model",
+                    "Any material (measured, tabulated, parametric): eval, pdf and sample on numpy arrays of directions, "
+                    "o toward the viewer and i toward the light, local frame with the normal along +z.")
+      .def(
+          "eval", [](const Model& x, const py::handle& o, const py::handle& i) { return eval_rgb(o, i, [&x](const Vec3& a, const Vec3& b) { return x.shading->f(a, b); }); },
+          py::arg("o"), py::arg("i"), "f(o, i) in 1/sr, shape (..., 3).")
+      .def("pdf", &pdf, py::arg("o"), py::arg("i"), "Density of sample() per steradian of i, shape (...).")
+      .def("sample", &sample, py::arg("o"), py::arg("u"),
+           "Draws i for each o from three uniform numbers u (..., 3): a dict of i (..., 3), weight = f cos / pdf (..., 3) "
+           "and pdf (...); failed draws have pdf 0.");
+
+  m.def("material", &material, py::arg("description"), py::arg("base_dir") = ".",
+        "The model of a material described as in a scene (docs/scene-format.md), e.g. {'type': 'ggx', 'alpha': 0.2}.");
+
+  py::class_<Fit>(m, "Fit", "The fit of one measured material (docs/extraction.md).")
+      .def_readonly("source", &Fit::source)
+      .def_property_readonly("ok", [](const Fit& f) { return f.result.ok(); })
+      .def_property_readonly("problem", [](const Fit& f) { return f.result.problem; })
+      .def_property_readonly("warnings", [](const Fit& f) { return f.result.warnings; })
+      .def_property_readonly("theta", [](const Fit& f) { return theta_array(f.result.ndf().grid); }, "polar angles of the NDF's nodes")
+      .def_property_readonly("ndf", [](const Fit& f) { return vector_array(f.result.ndf().ndf); }, "D at the nodes, 1/sr")
+      .def_property_readonly("sigma", [](const Fit& f) { return vector_array(f.result.ndf().sigma); }, "projected area at the nodes")
+      .def_property_readonly("ndf_extraction", [](const Fit& f) { return vector_array(f.result.extraction.ndf.ndf); },
+                             "the paper's NDF (the power iteration alone)")
+      .def("D", [](const Fit& f, const py::handle& t) { return over_theta(t, [&f](double x) { return f.result.ndf().D(x); }); }, py::arg("theta"))
+      .def("slope_pdf", [](const Fit& f, const py::handle& t) { return over_theta(t, [&f](double x) { return f.result.ndf().slope_pdf(x); }); },
+           py::arg("theta"))
+      .def_property_readonly("fresnel", [](const Fit& f) { return fresnel_array(f.result.fresnel()); }, "RGB Fresnel at fresnel_theta_d, (90, 3)")
+      .def_property_readonly_static("fresnel_theta_d", [](const py::object&) { return fresnel_theta_d(); })
+      .def_property_readonly("body", [](const Fit& f) { return rgb_array(f.result.body()); }, "Lambertian albedo")
+      .def_property_readonly("alpha_ggx", [](const Fit& f) { return f.result.alpha_ggx; })
+      .def_property_readonly("alpha_beckmann", [](const Fit& f) { return f.result.alpha_beckmann; })
+      .def_property_readonly("error", [](const Fit& f) { return f.result.error; })
+      .def_property_readonly("error_extraction", [](const Fit& f) { return f.result.error_extraction; })
+      .def_property_readonly("eigenvalue", [](const Fit& f) { return f.result.extraction.eigenvalue; })
+      .def_property_readonly("iterations", [](const Fit& f) { return f.result.extraction.iterations; })
+      .def_property_readonly("record", [](const Fit& f) { return to_python(fit_record(f.source, f.result, 0.0)); },
+                             "everything as `facetfit fit --json` prints it (parametric fits, coat, errors)")
+      .def("model", [](const Fit& f) {
+        if (!f.result.ok()) throw Error(f.source + ": " + f.result.problem);
+        return tabulated_model(MicrofacetTables{f.result.ndf(), f.result.smith, f.result.fresnel(), f.result.body(), f.result.lobe.coat});
+      }, "The tabulated model: body + tabulated lobe + coat.")
+      .def(
+          "write_lut",
+          [](const Fit& f, const std::string& path, double tolerance, bool sampling) {
+            if (!f.result.ok()) throw Error(f.source + ": " + f.result.problem);
+            py::gil_scoped_release release;
+            write_lut(path, make_lut(f.result, f.fitter->quadrature(), f.source, source_sha256(f.source), tolerance, sampling));
+          },
+          py::arg("path"), py::arg("tolerance") = 0.02, py::arg("sampling") = true, "Bakes the LUT texture (docs/lut-format.md).")
+      .def("__repr__", [](const Fit& f) {
+        return "<facetfit.Fit " + f.source + (f.result.ok() ? " alpha_ggx=" + std::to_string(f.result.alpha_ggx) : " failed") + ">";
+      });
+
+  m.def(
+      "fit",
+      [](const py::object& what, const std::string& refine, int resolution, const std::string& smith, const std::string& merl_bins) {
+        const FitOptions o = fit_options(refine, resolution, smith, merl_bins);
+        if (py::isinstance<Measurement>(what)) return fit(what.cast<const Measurement&>(), o);
+        return fit(load(py::str(py::module_::import("os").attr("fspath")(what)).cast<std::string>(), merl_bins), o);
+      },
+      py::arg("measurement"), py::arg("refine") = "full", py::arg("resolution") = 90, py::arg("smith") = "correlated",
+      py::arg("merl_bins") = "start", "Fits a Measurement or a source path (refine='none': the paper's method alone).");
+
+  py::class_<Lut>(m, "Lut", "A baked LUT texture.")
+      .def_property_readonly("theta", [](const Lut& l) { return theta_array(l.tables.ndf.grid); })
+      .def_property_readonly("ndf", [](const Lut& l) { return vector_array(l.tables.ndf.ndf); })
+      .def_property_readonly("sigma", [](const Lut& l) { return vector_array(l.tables.ndf.sigma); })
+      .def_property_readonly("fresnel", [](const Lut& l) { return fresnel_array(l.tables.fresnel); })
+      .def_property_readonly("body", [](const Lut& l) { return rgb_array(l.tables.body); })
+      .def_property_readonly("source", [](const Lut& l) { return l.meta.source; })
+      .def_property_readonly("representation", [](const Lut& l) { return std::string(to_string(l.meta.representation)); })
+      .def_property_readonly("alpha_ggx", [](const Lut& l) { return l.meta.alpha_ggx; })
+      .def_property_readonly("alpha_beckmann", [](const Lut& l) { return l.meta.alpha_beckmann; })
+      .def_property_readonly("warnings", [](const Lut& l) { return l.meta.warnings; })
+      .def("model", [](const Lut& l) { return tabulated_model(l.tables); }, "The tabulated model.")
+      .def(
+          "parametric",
+          [](const Lut& l, const std::string& family) {
+            const auto p = l.parametric(family, l.tables.smith);
+            if (!p) throw py::value_error("family: must be ggx, beckmann or lsq, not '" + family + "'");
+            const LutMetadata::Parametric& fit = *l.meta.fit(family);
+            MicrofacetTables proposal;
+            proposal.ndf = tabulate_ndf(Ndf::isotropic(family == "beckmann" ? NdfType::beckmann : NdfType::ggx, fit.alpha));
+            proposal.smith = l.tables.smith;
+            std::fill(proposal.fresnel.value.begin(), proposal.fresnel.value.end(), fit.f0);
+            proposal.body = fit.body;
+            proposal.coat = fit.coat;
+            return Model{std::make_shared<ShadingModel>(std::make_shared<ParametricBrdf>(*p), std::make_shared<TabulatedMicrofacet>(proposal))};
+          },
+          py::arg("family"), "One of the parametric fits the LUT carries: 'ggx', 'beckmann' or 'lsq'.");
+  m.def(
+      "read_lut", [](const std::string& path) {
+        py::gil_scoped_release release;
+        return read_lut(path);
+      },
+      py::arg("path"), "Reads a LUT; raises facetfit.Error for anything that is not a complete facetfit LUT.");
+
+  m.def(
+      "bake",
+      [](const std::string& source, const std::string& out_dir, std::string name, bool force, double tolerance, bool sampling,
+         const std::string& refine, int resolution, const std::string& smith, const std::string& merl_bins) {
+        BakeOptions o;
+        o.fit = fit_options(refine, resolution, smith, merl_bins);
+        o.force = force;
+        o.tolerance = tolerance;
+        o.with_sampling = sampling;
+        if (name.empty()) name = source_name(source);
+        BakeOutcome r;
+        {
+          py::gil_scoped_release release;
+          r = bake_material(source, name, out_dir, o, Fitter(o.fit));
+        }
+        if (r.status == BakeOutcome::Status::failed) throw Error(r.error);
+        py::dict d = to_python(r.record);
+        d["status"] = r.status == BakeOutcome::Status::baked ? "baked" : "cached";
+        return d;
+      },
+      py::arg("source"), py::arg("out_dir"), py::arg("name") = "", py::arg("force") = false, py::arg("tolerance") = 0.02,
+      py::arg("sampling") = true, py::arg("refine") = "full", py::arg("resolution") = 90, py::arg("smith") = "correlated",
+      py::arg("merl_bins") = "start",
+      "Bakes OUT_DIR/NAME.exr and its JSON sidecar as `facetfit bake` does (cached by content); returns the sidecar.");
+
+  m.def("render", &render_scene, py::arg("scene"), py::arg("spp") = 0, py::arg("seed") = 0,
+        "Renders a scene (a path, or a dict as in docs/scene-format.md; relative files against the current folder): "
+        "(height, width, 4) float32, linear Rec.709 RGB and coverage.");
+  m.def("delta_e", &delta_e, py::arg("a"), py::arg("b"), py::arg("mask") = py::none(), py::arg("a_display_referred") = false,
+        py::arg("b_display_referred") = false,
+        "CIE Delta E 2000 per pixel through the display chain (docs/colour.md): (map, mean, max) over the mask.");
+}
