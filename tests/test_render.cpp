@@ -226,6 +226,27 @@ TEST(Render, MeasuredMaterialSampledByAGivenLutRendersTheSameImage) {
 namespace facetfit {
 namespace {
 
+TEST(PiecewiseConstant2D, DrawsCellsInProportionToTheirWeightsAndReportsTheirDensity) {
+  // 3 x 2 cells, one empty, one empty row: counts within 1% of the weights' shares, density = share x 6.
+  const std::vector<double> w = {1.0, 0.0, 3.0, 0.0, 0.0, 0.0};
+  const PiecewiseConstant2D d(w, 3, 2);
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::vector<int> count(6, 0);
+  const int n = 200000;
+  for (int k = 0; k < n; ++k) {
+    const auto s = d.sample(u(rng), u(rng));
+    ASSERT_EQ(int(s.u * 3), s.x);
+    ASSERT_EQ(int(s.v * 2), s.y);
+    ++count[std::size_t(s.y * 3 + s.x)];
+  }
+  EXPECT_NEAR(count[0] / double(n), 0.25, 0.01);
+  EXPECT_NEAR(count[2] / double(n), 0.75, 0.01);
+  EXPECT_EQ(count[1] + count[3] + count[4] + count[5], 0);
+  EXPECT_DOUBLE_EQ(d.pdf(0, 0), 0.25 * 6);
+  EXPECT_DOUBLE_EQ(d.pdf(2, 0), 0.75 * 6);
+}
+
 TEST(Environment, ImportanceSamplingAgreesWithItsPdf) {
   const Environment sky = Environment::sky(128);
   std::mt19937 rng(11);

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/piecewise_constant.h"
 #include "core/quadrature_rules.h"
 
 namespace facetfit {
@@ -191,10 +192,8 @@ std::optional<Vec3> TabulatedMicrofacet::lobe_direction(const Vec3& o, double u1
   u1 = clamp(u1, 0.0, 1.0 - 1e-16);
   // The interval of theta_h: the last node whose CDF is <= u1 (zero-mass intervals are never chosen).
   const double* cdf = sampling_.cdf.data() + std::size_t(slice) * (r + 1);
-  int j = int(std::upper_bound(cdf, cdf + r + 1, u1) - cdf) - 1;
-  j = std::clamp(j, 0, r - 1);
-  const double m = cdf[j + 1] - cdf[j];
-  const double frac = m > 0.0 ? clamp((u1 - cdf[j]) / m, 0.0, 1.0) : 0.5;
+  double frac;
+  const int j = sample_cdf(cdf, r, u1, &frac);
   const double cos_h = cos_nodes_[std::size_t(j)] - frac * (cos_nodes_[std::size_t(j)] - cos_nodes_[std::size_t(j) + 1]);
   const double sin_h = std::sqrt(std::max(0.0, 1.0 - cos_h * cos_h));
   const double sin_o = std::sqrt(std::max(0.0, 1.0 - o.z * o.z));

@@ -81,31 +81,16 @@ Environment Environment::sky(int width) {
 
 void Environment::build_distribution() {
   const int w = width_, h = height_;
-  col_cdf_.assign(std::size_t(h) * (w + 1), 0.0);
-  row_cdf_.assign(std::size_t(h) + 1, 0.0);
-  density_.assign(std::size_t(w) * h, 0.0);
   std::vector<double> weight(std::size_t(w) * h);
-  double total = 0.0;
   for (int y = 0; y < h; ++y) {
     const double s = std::sin((y + 0.5) / h * kPi);
-    double* cdf = col_cdf_.data() + std::size_t(y) * (w + 1);
     for (int x = 0; x < w; ++x) {
       const float* p = rgb_.data() + (std::size_t(y) * w + x) * 3;
       // A floor keeps every direction samplable, so light sampling alone is unbiased too.
-      const double lum = luminance(Rgb(p[0], p[1], p[2])) + 1e-4;
-      weight[std::size_t(y) * w + x] = lum * s;
-      cdf[x + 1] = cdf[x] + lum * s;
+      weight[std::size_t(y) * w + x] = (luminance(Rgb(p[0], p[1], p[2])) + 1e-4) * s;
     }
-    row_cdf_[std::size_t(y) + 1] = row_cdf_[std::size_t(y)] + cdf[w];
-    total += cdf[w];
   }
-  for (int y = 0; y < h; ++y) {
-    double* cdf = col_cdf_.data() + std::size_t(y) * (w + 1);
-    const double row = cdf[w];
-    for (int x = 0; x <= w; ++x) cdf[x] = row > 0.0 ? cdf[x] / row : double(x) / w;
-  }
-  for (double& v : row_cdf_) v /= total;
-  for (std::size_t k = 0; k < weight.size(); ++k) density_[k] = weight[k] / total * double(w) * double(h);
+  distribution_ = PiecewiseConstant2D(weight, w, h);
 }
 
 int Environment::pixel_of(const Vec3& d, int* x, int* y) const {
@@ -121,7 +106,7 @@ Environment::Sample Environment::at_pixel(const Vec3& d, int pixel) const {
   const float* p = rgb_.data() + std::size_t(pixel) * 3;
   const double s = std::sqrt(std::max(0.0, 1.0 - d.y * d.y));
   // Density over [0,1]^2 to solid angle: d(omega) = 2 pi^2 sin(theta) du dv.
-  const double pdf = s > 0.0 ? density_[std::size_t(pixel)] / (2.0 * kPi * kPi * s) : 0.0;
+  const double pdf = s > 0.0 ? distribution_.pdf(pixel % width_, pixel / width_) / (2.0 * kPi * kPi * s) : 0.0;
   return {d, Rgb(p[0], p[1], p[2]), pdf};
 }
 
@@ -136,18 +121,8 @@ Environment::Sample Environment::sample(double u1, double u2) const {
     const double z = 1.0 - 2.0 * u1, r = std::sqrt(std::max(0.0, 1.0 - z * z)), phi = 2.0 * kPi * u2;
     return {Vec3(r * std::cos(phi), z, r * std::sin(phi)), constant_, 1.0 / (4.0 * kPi)};
   }
-  const auto pick = [](const double* cdf, int n, double u, double* t) {
-    int k = int(std::upper_bound(cdf, cdf + n + 1, u) - cdf) - 1;
-    k = std::clamp(k, 0, n - 1);
-    const double m = cdf[k + 1] - cdf[k];
-    *t = m > 0.0 ? clamp((u - cdf[k]) / m, 0.0, 1.0) : 0.5;
-    return k;
-  };
-  double tv, tu;
-  const int y = pick(row_cdf_.data(), height_, u1, &tv);
-  const int x = pick(col_cdf_.data() + std::size_t(y) * (width_ + 1), width_, u2, &tu);
-  const double u = (x + tu) / width_, v = (y + tv) / height_;
-  return at_pixel(direction_of(u, v), y * width_ + x);  // the pixel drawn: no second lookup
+  const PiecewiseConstant2D::Sample p = distribution_.sample(u1, u2);
+  return at_pixel(direction_of(p.u, p.v), p.y * width_ + p.x);  // the pixel drawn: no second lookup
 }
 
 double Environment::pdf(const Vec3& d) const { return lookup(d).pdf; }

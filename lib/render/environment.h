@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "core/piecewise_constant.h"
 #include "core/vec.h"
 
 namespace facetfit {
@@ -46,9 +47,7 @@ class Environment {
   int width_ = 0, height_ = 0;  // 0: constant
   Rgb constant_{0.0};
   std::vector<float> rgb_;
-  std::vector<double> row_cdf_;   // height + 1
-  std::vector<double> col_cdf_;   // height x (width + 1)
-  std::vector<double> density_;   // per pixel, over [0,1]^2
+  PiecewiseConstant2D distribution_;  // over [0,1]^2 of the pixels: luminance x sin(theta)
 };
 
 // Direction of the built-in sky's sun (toward the sun).

@@ -1,0 +1,64 @@
+// Piecewise-constant distributions, sampled by inverting their running sums: the one sampler behind the
+// environment map's pixels (2D) and the tabulated model's visible normals (one 1D distribution per view
+// slice). The RGL warp (io/rgl.cpp) is not one of them: the format defines a bilinear density, which
+// Mitsuba 3 inverts as such, and the parity with it needs that density.
+#pragma once
+
+#include <algorithm>
+#include <cstddef>
+#include <vector>
+
+namespace facetfit {
+
+// The interval k of a normalised running sum cdf[0..n] (cdf[0] = 0, cdf[n] = 1, nondecreasing) in which
+// u in [0, 1) falls, and u's fraction t within it. Intervals without mass are never chosen.
+inline int sample_cdf(const double* cdf, int n, double u, double* t) {
+  int k = int(std::upper_bound(cdf, cdf + n + 1, u) - cdf) - 1;
+  k = std::clamp(k, 0, n - 1);
+  const double m = cdf[k + 1] - cdf[k];
+  *t = m > 0.0 ? std::clamp((u - cdf[k]) / m, 0.0, 1.0) : 0.5;
+  return k;
+}
+
+// A density over [0, 1]^2 constant on an nx x ny grid of cells, proportional to given weights: rows are
+// drawn from the marginal, then the cell from the row's conditional. A row without weight is uniform.
+class PiecewiseConstant2D {
+ public:
+  PiecewiseConstant2D() = default;
+  // weights: ny rows of nx cells, each >= 0, not all zero.
+  PiecewiseConstant2D(const std::vector<double>& weights, int nx, int ny)
+      : nx_(nx), ny_(ny), conditional_(std::size_t(ny) * (nx + 1)), marginal_(std::size_t(ny) + 1), density_(weights.size()) {
+    double total = 0.0;
+    for (int y = 0; y < ny; ++y) {
+      double* cdf = conditional_.data() + std::size_t(y) * (nx + 1);
+      for (int x = 0; x < nx; ++x) cdf[x + 1] = cdf[x] + weights[std::size_t(y) * nx + x];
+      marginal_[std::size_t(y) + 1] = marginal_[std::size_t(y)] + cdf[nx];
+      total += cdf[nx];
+      const double row = cdf[nx];
+      for (int x = 0; x <= nx; ++x) cdf[x] = row > 0.0 ? cdf[x] / row : double(x) / nx;
+    }
+    for (double& v : marginal_) v /= total;
+    for (std::size_t k = 0; k < weights.size(); ++k) density_[k] = weights[k] / total * double(nx) * double(ny);
+  }
+
+  struct Sample {
+    double u, v;  // the point of [0, 1]^2
+    int x, y;     // its cell
+  };
+  Sample sample(double u1, double u2) const {
+    double tv, tu;
+    const int y = sample_cdf(marginal_.data(), ny_, u1, &tv);
+    const int x = sample_cdf(conditional_.data() + std::size_t(y) * (nx_ + 1), nx_, u2, &tu);
+    return {(x + tu) / nx_, (y + tv) / ny_, x, y};
+  }
+  // Density over [0, 1]^2 in cell (x, y).
+  double pdf(int x, int y) const { return density_[std::size_t(y) * nx_ + x]; }
+
+ private:
+  int nx_ = 0, ny_ = 0;
+  std::vector<double> conditional_;  // ny rows of nx + 1 running sums
+  std::vector<double> marginal_;     // ny + 1
+  std::vector<double> density_;      // per cell
+};
+
+}  // namespace facetfit
