@@ -12,6 +12,13 @@ namespace facetfit::cli {
 
 void report_error(const std::string& message) { std::fprintf(stderr, "facetfit: error: %s\n", message.c_str()); }
 
+void report_settings(const Context& ctx, const std::string& command, const FitOptions& o) {
+  if (!ctx.verbose()) return;
+  std::fprintf(stderr, "facetfit: %s: refine %s, resolution %d, smith %s, merl-bins %s, threads %zu\n", command.c_str(),
+               to_string(o.refine), o.resolution, to_string(o.smith), to_string(o.merl_bins),
+               tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
+}
+
 void add_fit_settings(CLI::App* cmd, FitSettings& s) {
   cmd->add_option("--smith", s.smith,
                   "Masking-shadowing model the fit is consistent with: masking (the paper), correlated "
@@ -59,7 +66,7 @@ std::optional<FitOptions> fit_options(const FitSettings& s, int& status) {
   return options;
 }
 
-int run_app(int argc, char** argv, void (*register_more)(CLI::App& app, int& status)) {
+int run_app(int argc, char** argv, void (*register_more)(CLI::App& app, Context& ctx)) {
   CLI::App app{"facetfit: measured BRDFs to microfacet components (Dupuy et al. 2015, power iterations)", "facetfit"};
   app.require_subcommand(1);
   app.set_version_flag("--version", FACETFIT_VERSION);
@@ -73,16 +80,21 @@ int run_app(int argc, char** argv, void (*register_more)(CLI::App& app, int& sta
          "Threads to use (default: all cores)")
       ->check(CLI::PositiveNumber)
       ->trigger_on_parse();
-  int status = 0;
-  add_fit_command(app, status);
-  add_convert_command(app, status);
-  add_builtins_command(app, status);
-  if (register_more) register_more(app, status);
+  Context ctx;
+  app.add_flag_callback("-q,--quiet", [&ctx] { ctx.verbosity = Verbosity::quiet; }, "Print only results, warnings and errors");
+  app.add_flag_callback("-v,--verbose", [&ctx] { ctx.verbosity = Verbosity::verbose; }, "Also print settings and per-item timings");
+  add_fit_command(app, ctx);
+  add_convert_command(app, ctx);
+  add_builtins_command(app, ctx);
+  if (register_more) register_more(app, ctx);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    // Help and --version exit 0; every usage error exits 2, as bin/commands.h promises.
-    return app.exit(e) == 0 ? 0 : 2;
+    // Help and --version exit 0; every usage error exits 2, as bin/commands.h promises, with one line in
+    // the command's error style.
+    if (e.get_exit_code() == static_cast<int>(CLI::ExitCodes::Success)) return app.exit(e);
+    report_error(std::string(e.what()) + " (see facetfit --help)");
+    return 2;
   } catch (const facetfit::Error& e) {
     report_error(e.what());
     return 1;
@@ -90,7 +102,7 @@ int run_app(int argc, char** argv, void (*register_more)(CLI::App& app, int& sta
     report_error(std::string("internal: ") + e.what());
     return 1;
   }
-  return status;
+  return ctx.status;
 }
 
 bool is_core_command(const std::string& name) { return name == "fit" || name == "convert" || name == "list-builtins"; }

@@ -52,7 +52,8 @@ std::string canonical(const std::string& source) {
   return ec ? source : p.string();
 }
 
-void run_bake(const BakeArgs& args, int& status) {
+void run_bake(const BakeArgs& args, Context& ctx) {
+  int& status = ctx.status;
   const auto fit = fit_options(args.settings, status);
   if (!fit) return;
   std::vector<std::string> inputs = expand_inputs(args.inputs);
@@ -66,7 +67,7 @@ void run_bake(const BakeArgs& args, int& status) {
       for (const auto& in : inputs)
         for (const auto& w : wanted)
           if (canonical(in) == canonical(w)) kept.push_back(in);
-      std::fprintf(stderr, "facetfit: the scene references %zu of %zu inputs\n", kept.size(), inputs.size());
+      if (!ctx.quiet()) std::fprintf(stderr, "facetfit: the scene references %zu of %zu inputs\n", kept.size(), inputs.size());
       inputs = kept;
     }
   }
@@ -90,6 +91,7 @@ void run_bake(const BakeArgs& args, int& status) {
   options.with_sampling = !args.eval_only;
   options.force = args.force;
   const Fitter fitter(options.fit);
+  report_settings(ctx, "bake", options.fit);
 
   // Output names must be unique: a second input with the same stem is an error, not an overwrite.
   std::vector<BakeOutcome> outcomes(inputs.size());
@@ -106,7 +108,7 @@ void run_bake(const BakeArgs& args, int& status) {
       outcomes[k].error = inputs[k] + ": output name " + name + " is already taken by " + it->second;
     }
   }
-  Progress progress(inputs.size());
+  Progress progress(inputs.size(), ctx.verbosity);
   for (const auto& o : outcomes)
     if (!o.error.empty()) report_outcome(progress, o);
   const int jobs = args.jobs > 0 ? args.jobs : int(std::thread::hardware_concurrency());
@@ -153,7 +155,7 @@ void run_bake(const BakeArgs& args, int& status) {
     status = 1;
     return;
   }
-  std::printf("baked %d, cached %d, failed %d: %s\n", baked, cached, failed, (fs::path(args.out_dir) / "index.json").c_str());
+  if (!ctx.quiet()) std::printf("baked %d, cached %d, failed %d: %s\n", baked, cached, failed, (fs::path(args.out_dir) / "index.json").c_str());
   if (failed > 0) {
     std::fprintf(stderr, "facetfit: %d of %zu inputs failed:\n", failed, inputs.size());
     for (const auto& o : outcomes)
@@ -164,7 +166,7 @@ void run_bake(const BakeArgs& args, int& status) {
 
 }  // namespace
 
-void add_bake_command(CLI::App& app, int& status) {
+void add_bake_command(CLI::App& app, Context& ctx) {
   auto args = std::make_shared<BakeArgs>();
   CLI::App* cmd = app.add_subcommand("bake", "Bake LUT textures (DIR/NAME.exr) and sidecars (DIR/NAME.json, DIR/index.json)");
   cmd->add_option("inputs", args->inputs, "Material files, folders, globs, builtin:NAME (builtin: for all)");
@@ -177,7 +179,7 @@ void add_bake_command(CLI::App& app, int& status) {
       ->capture_default_str();
   cmd->add_flag("--eval-only", args->eval_only, "Leave out the sampling tables");
   add_fit_settings(cmd, args->settings);
-  cmd->callback([args, &status] { run_bake(*args, status); });
+  cmd->callback([args, &ctx] { run_bake(*args, ctx); });
 }
 
 }  // namespace facetfit::cli

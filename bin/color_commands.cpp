@@ -53,7 +53,8 @@ std::array<double, 6> parse_pair(const std::string& line, int number) {
   return v;
 }
 
-void run_deltae(int& status) {
+void run_deltae(Context& ctx) {
+  int& status = ctx.status;
   std::string line;
   int number = 0, failures = 0;
   while (std::getline(std::cin, line)) {
@@ -167,7 +168,8 @@ struct DiffArgs {
   bool json = false;
 };
 
-void run_diff(const DiffArgs& args, int& status) {
+void run_diff(const DiffArgs& args, Context& ctx) {
+  int& status = ctx.status;
   if (!args.heatmap.empty() && !is_png(args.heatmap)) {
     report_error("--heatmap " + args.heatmap + ": must end in .png");
     status = 2;
@@ -200,14 +202,14 @@ void run_diff(const DiffArgs& args, int& status) {
 
 }  // namespace
 
-void add_deltae_command(CLI::App& app, int& status) {
+void add_deltae_command(CLI::App& app, Context& ctx) {
   CLI::App* cmd = app.add_subcommand("deltae",
                                      "CIEDE2000 of colour pairs: reads lines 'L1 a1 b1 L2 a2 b2' on stdin, prints "
                                      "one Delta E 2000 per line (6 decimals)");
-  cmd->callback([&status] { run_deltae(status); });
+  cmd->callback([&ctx] { run_deltae(ctx); });
 }
 
-void add_diff_command(CLI::App& app, int& status) {
+void add_diff_command(CLI::App& app, Context& ctx) {
   auto args = std::make_shared<DiffArgs>();
   CLI::App* cmd = app.add_subcommand(
       "diff", "Mean and max CIEDE2000 between two scene-linear images, through the sRGB display transform");
@@ -218,7 +220,7 @@ void add_diff_command(CLI::App& app, int& status) {
   cmd->add_option("--heatmap", args->heatmap,
                   "Write a PNG of per-pixel Delta E 2000 (viridis from 0 to 10, saturating; black outside the mask)");
   cmd->add_flag("--json", args->json, "As one JSON object {\"mean\", \"max\", \"pixels\"}");
-  cmd->callback([args, &status] { run_diff(*args, status); });
+  cmd->callback([args, &ctx] { run_diff(*args, ctx); });
 }
 
 }  // namespace facetfit::cli

@@ -11,6 +11,18 @@
 
 namespace facetfit::cli {
 
+// What a command prints besides its results and errors: global -q (errors, warnings and the results
+// themselves only: no progress, no summaries) and -v (also the settings and per-item timings).
+enum class Verbosity { quiet, normal, verbose };
+
+// The state one command line runs with: its exit status and verbosity.
+struct Context {
+  int status = 0;
+  Verbosity verbosity = Verbosity::normal;
+  bool quiet() const { return verbosity == Verbosity::quiet; }
+  bool verbose() const { return verbosity == Verbosity::verbose; }
+};
+
 // The fit settings every command that fits takes, as given on the command line.
 struct FitSettings {
   std::string smith = "correlated";
@@ -24,22 +36,25 @@ void add_fit_settings(CLI::App* cmd, FitSettings& settings);
 // The FitOptions they name, or nullopt after reporting a usage error (status 2).
 std::optional<FitOptions> fit_options(const FitSettings& settings, int& status);
 
-void add_fit_command(CLI::App& app, int& status);
-void add_convert_command(CLI::App& app, int& status);
-void add_builtins_command(CLI::App& app, int& status);
-void add_bake_command(CLI::App& app, int& status);
-void add_info_command(CLI::App& app, int& status);
-void add_render_command(CLI::App& app, int& status);
-void add_deltae_command(CLI::App& app, int& status);
-void add_diff_command(CLI::App& app, int& status);
-void add_report_command(CLI::App& app, int& status);
+void add_fit_command(CLI::App& app, Context& ctx);
+void add_convert_command(CLI::App& app, Context& ctx);
+void add_builtins_command(CLI::App& app, Context& ctx);
+void add_bake_command(CLI::App& app, Context& ctx);
+void add_info_command(CLI::App& app, Context& ctx);
+void add_render_command(CLI::App& app, Context& ctx);
+void add_deltae_command(CLI::App& app, Context& ctx);
+void add_diff_command(CLI::App& app, Context& ctx);
+void add_report_command(CLI::App& app, Context& ctx);
+
+// With -v: "facetfit: COMMAND: <settings>" on stderr (the fit settings and the thread count).
+void report_settings(const Context& ctx, const std::string& command, const FitOptions& options);
 
 // "facetfit: error: <message>" on stderr, one line.
 void report_error(const std::string& message);
 
 // Parses and runs one command line on an app holding the core commands (fit, convert, list-builtins) and
 // those `register_more` adds; returns the exit status.
-int run_app(int argc, char** argv, void (*register_more)(CLI::App& app, int& status));
+int run_app(int argc, char** argv, void (*register_more)(CLI::App& app, Context& ctx));
 // Whether a subcommand is one of the core commands, which need no image I/O, colour or ray tracing.
 bool is_core_command(const std::string& name);
 

@@ -4,13 +4,13 @@
 namespace facetfit::cli {
 namespace {
 
-void add_image_commands(CLI::App& app, int& status) {
-  add_bake_command(app, status);
-  add_info_command(app, status);
-  add_render_command(app, status);
-  add_diff_command(app, status);
-  add_deltae_command(app, status);
-  add_report_command(app, status);
+void add_image_commands(CLI::App& app, Context& ctx) {
+  add_bake_command(app, ctx);
+  add_info_command(app, ctx);
+  add_render_command(app, ctx);
+  add_diff_command(app, ctx);
+  add_deltae_command(app, ctx);
+  add_report_command(app, ctx);
 }
 
 }  // namespace

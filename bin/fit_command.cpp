@@ -31,7 +31,8 @@ void print_row(const std::string& source, const FitResult& r, double seconds) {
               r.extraction.residual, seconds * 1e3);
 }
 
-void run_fit(const FitArgs& args, int& status) {
+void run_fit(const FitArgs& args, Context& ctx) {
+  int& status = ctx.status;
   const auto options = fit_options(args.settings, status);
   if (!options) return;
   std::vector<std::string> raw = args.inputs;
@@ -43,6 +44,7 @@ void run_fit(const FitArgs& args, int& status) {
     return;
   }
   const Fitter fitter(*options);
+  report_settings(ctx, "fit", *options);
 
   if (!args.json)
     std::printf("%-28s  %9s  %9s  %-17s  %-17s  %5s  %8s  %7s\n", "material", "alpha_ggx", "alpha_bkm", "f0 (r g b)",
@@ -76,14 +78,14 @@ void run_fit(const FitArgs& args, int& status) {
 
 }  // namespace
 
-void add_fit_command(CLI::App& app, int& status) {
+void add_fit_command(CLI::App& app, Context& ctx) {
   auto args = std::make_shared<FitArgs>();
   CLI::App* cmd = app.add_subcommand("fit", "Fit microfacet components to measured materials");
   cmd->add_option("inputs", args->inputs, "MERL .binary files, folders, or builtin:NAME (builtin: for all)");
   cmd->add_flag("--builtin", args->builtin, "Fit every built-in synthetic material");
   add_fit_settings(cmd, args->settings);
   cmd->add_flag("--json", args->json, "One JSON object per material on stdout");
-  cmd->callback([args, &status] { run_fit(*args, status); });
+  cmd->callback([args, &ctx] { run_fit(*args, ctx); });
 }
 
 }  // namespace facetfit::cli

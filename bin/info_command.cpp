@@ -92,13 +92,13 @@ void print_info(const Lut& lut) {
 
 }  // namespace
 
-void add_info_command(CLI::App& app, int& status) {
+void add_info_command(CLI::App& app, Context& ctx) {
   auto path = std::make_shared<std::string>();
   auto json = std::make_shared<bool>(false);
   CLI::App* cmd = app.add_subcommand("info", "Print the metadata and tables of a LUT");
   cmd->add_option("lut", *path, "LUT .exr written by facetfit bake")->required();
   cmd->add_flag("--json", *json, "As one JSON object");
-  cmd->callback([path, json, &status] {
+  cmd->callback([path, json, &ctx] {
     try {
       // A measurement named where a LUT is expected: say what to run instead of OpenImageIO's complaint.
       const std::string ext = std::filesystem::path(*path).extension().string();
@@ -109,7 +109,7 @@ void add_info_command(CLI::App& app, int& status) {
       else print_info(lut);
     } catch (const Error& e) {
       report_error(e.what());
-      status = 1;
+      ctx.status = 1;
     }
   });
 }

@@ -16,7 +16,7 @@
 
 namespace {
 
-// The subcommand named on the command line (after the global --threads N), or "".
+// The subcommand named on the command line (after the global --threads N, -q and -v), or "".
 std::string subcommand(int argc, char** argv) {
   for (int k = 1; k < argc; ++k) {
     const std::string arg = argv[k];
@@ -24,7 +24,7 @@ std::string subcommand(int argc, char** argv) {
       ++k;
       continue;
     }
-    if (arg.rfind("--threads=", 0) == 0) continue;
+    if (arg.rfind("--threads=", 0) == 0 || arg == "-q" || arg == "--quiet" || arg == "-v" || arg == "--verbose") continue;
     return arg;
   }
   return "";

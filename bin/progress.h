@@ -1,5 +1,5 @@
 // Progress of a batch on stderr: a bar redrawn in place on a terminal, one plain line per item otherwise
-// (logs, CI). Thread-safe.
+// (logs, CI) and with -v; errors alone with -q. Thread-safe.
 #pragma once
 
 #include <unistd.h>
@@ -8,11 +8,14 @@
 #include <mutex>
 #include <string>
 
+#include "commands.h"
+
 namespace facetfit::cli {
 
 class Progress {
  public:
-  explicit Progress(std::size_t total) : total_(total), tty_(::isatty(STDERR_FILENO) == 1) {}
+  Progress(std::size_t total, Verbosity verbosity)
+      : total_(total), tty_(verbosity == Verbosity::normal && ::isatty(STDERR_FILENO) == 1), quiet_(verbosity == Verbosity::quiet) {}
 
   // One item done: `name` on the bar; `line` for logs; an `error` is printed either way.
   void step(const std::string& name, const std::string& line, const std::string& error = "") {
@@ -29,7 +32,7 @@ class Progress {
       if (done_ == total_) std::fprintf(stderr, "\n");
     } else if (!error.empty()) {
       std::fprintf(stderr, "facetfit: error: %s\n", error.c_str());
-    } else {
+    } else if (!quiet_) {
       std::fprintf(stderr, "%s\n", line.c_str());
     }
     std::fflush(stderr);
@@ -38,7 +41,7 @@ class Progress {
  private:
   std::mutex mutex_;
   std::size_t total_, done_ = 0, failed_ = 0;
-  bool tty_;
+  bool tty_, quiet_;
 };
 
 }  // namespace facetfit::cli

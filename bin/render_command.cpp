@@ -1,4 +1,5 @@
 // facetfit render [SCENE.json] -o OUT.exr : the reference renderer.
+#include <tbb/global_control.h>
 #include <unistd.h>
 
 #include <cstdio>
@@ -30,7 +31,8 @@ struct RenderArgs {
   int width = 0, height = 0;
 };
 
-void run_render(const RenderArgs& args, int& status) {
+void run_render(const RenderArgs& args, Context& ctx) {
+  int& status = ctx.status;
   try {
     if (!args.save_sky.empty()) {  // the built-in sky as a lat-long EXR, for other renderers
       const Environment sky = Environment::sky();
@@ -70,16 +72,22 @@ void run_render(const RenderArgs& args, int& status) {
     RenderSettings settings;
     settings.spp = args.spp;
     settings.seed = args.seed;
-    const bool tty = ::isatty(STDERR_FILENO) == 1;
-    settings.progress = [tty](int done, int total) {
-      if (tty) std::fprintf(stderr, "\rrendering: pass %d/%d%s", done, total, done == total ? "\n" : "");
+    // A line redrawn on a terminal; with -v one line per pass anywhere; nothing with -q.
+    const bool tty = ::isatty(STDERR_FILENO) == 1 && !ctx.quiet(), lines = ctx.verbose();
+    settings.progress = [tty, lines](int done, int total) {
+      if (lines) std::fprintf(stderr, "facetfit: render: pass %d/%d\n", done, total);
+      else if (tty) std::fprintf(stderr, "\rrendering: pass %d/%d%s", done, total, done == total ? "\n" : "");
     };
+    if (ctx.verbose())
+      std::fprintf(stderr, "facetfit: render: %dx%d, %zu objects, %zu lights, threads %zu\n", scene.camera.width, scene.camera.height,
+                   scene.objects.size(), scene.lights.size(),
+                   tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
     const RenderedImage image = render(scene, settings);
     write_exr(args.output, image,
               {{"scene", args.scene.empty() ? "default" : args.scene}, {"spp", std::to_string(image.spp)},
                {"seconds", std::to_string(image.seconds)}});
     if (!args.png.empty()) write_display_png(args.png, image.rgba.data(), image.width, image.height, 4, DisplayTransform());
-    std::printf("%s (%dx%d, %d spp, %.2f s)\n", args.output.c_str(), image.width, image.height, image.spp, image.seconds);
+    if (!ctx.quiet()) std::printf("%s (%dx%d, %d spp, %.2f s)\n", args.output.c_str(), image.width, image.height, image.spp, image.seconds);
   } catch (const Error& e) {
     report_error(e.what());
     status = 1;
@@ -88,7 +96,7 @@ void run_render(const RenderArgs& args, int& status) {
 
 }  // namespace
 
-void add_render_command(CLI::App& app, int& status) {
+void add_render_command(CLI::App& app, Context& ctx) {
   auto args = std::make_shared<RenderArgs>();
   CLI::App* cmd = app.add_subcommand("render", "Render a scene (or the embedded default) with the reference renderer");
   cmd->add_option("scene", args->scene, "Scene JSON (docs/scene-format.md); omitted: a sphere under the built-in sky");
@@ -103,7 +111,7 @@ void add_render_command(CLI::App& app, int& status) {
   cmd->add_option("--material-type", args->material_type, "Default scene only: measured, lut, ggx, beckmann or lsq (a measurement is baked first for the last four)")
       ->check(CLI::IsMember({"measured", "lut", "ggx", "beckmann", "lsq", "analytic", "lambert"}))
       ->capture_default_str();
-  cmd->callback([args, &status] { run_render(*args, status); });
+  cmd->callback([args, &ctx] { run_render(*args, ctx); });
 }
 
 }  // namespace facetfit::cli

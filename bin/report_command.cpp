@@ -23,21 +23,22 @@ struct ReportArgs {
   FitSettings settings;
 };
 
-void finish(const nlohmann::json& report, const std::string& out_dir, bool fail_on_regression, int& status) {
-  std::printf("%s/index.html\n", out_dir.c_str());
+void finish(const nlohmann::json& report, const std::string& out_dir, bool fail_on_regression, Context& ctx) {
+  if (!ctx.quiet()) std::printf("%s/index.html\n", out_dir.c_str());
   for (const auto& [r, v] : report["database_mean_delta_e"].items())
-    std::printf("  mean Delta E 2000 %-10s %s\n", r.c_str(), v.is_null() ? "-" : std::to_string(v.get<double>()).c_str());
+    if (!ctx.quiet()) std::printf("  mean Delta E 2000 %-10s %s\n", r.c_str(), v.is_null() ? "-" : std::to_string(v.get<double>()).c_str());
   for (const auto& f : report["failures"]) report_error(f["error"].get<std::string>());
   for (const auto& g : report["regressions"])
     std::fprintf(stderr, "facetfit: regression: %s %s %.4f -> %.4f\n", g["name"].get<std::string>().c_str(),
                  g["representation"].get<std::string>().c_str(), g["before"].get<double>(), g["after"].get<double>());
   if (!report["failures"].empty())
-    status = 1;
+    ctx.status = 1;
   else if (fail_on_regression && !report["regressions"].empty())
-    status = 3;
+    ctx.status = 3;
 }
 
-void run_report_command(const ReportArgs& args, int& status) {
+void run_report_command(const ReportArgs& args, Context& ctx) {
+  int& status = ctx.status;
   const auto fit = fit_options(args.settings, status);
   if (!fit) return;
   ReportOptions o;
@@ -58,13 +59,14 @@ void run_report_command(const ReportArgs& args, int& status) {
     status = 2;
     return;
   }
+  report_settings(ctx, "report", o.bake.fit);
   std::shared_ptr<Progress> progress;
-  o.progress = [&progress](const std::string& name, std::size_t done, std::size_t total) {
-    if (!progress) progress = std::make_shared<Progress>(total);
+  o.progress = [&progress, &ctx](const std::string& name, std::size_t done, std::size_t total) {
+    if (!progress) progress = std::make_shared<Progress>(total, ctx.verbosity);
     progress->step(name, "report: " + std::to_string(done) + "/" + std::to_string(total) + " " + name);
   };
   try {
-    finish(run_report(o), o.out_dir, args.fail_on_regression, status);
+    finish(run_report(o), o.out_dir, args.fail_on_regression, ctx);
   } catch (const Error& e) {
     report_error(e.what());
     status = 1;
@@ -73,7 +75,7 @@ void run_report_command(const ReportArgs& args, int& status) {
 
 }  // namespace
 
-void add_report_command(CLI::App& app, int& status) {
+void add_report_command(CLI::App& app, Context& ctx) {
   auto args = std::make_shared<ReportArgs>();
   CLI::App* cmd = app.add_subcommand("report", "The database accuracy report: measured vs tabulated vs GGX vs Beckmann, mean Delta E 2000");
   cmd->add_option("db", args->inputs, "Material files, folders, globs (default: the built-in set, builtin:)");
@@ -94,22 +96,22 @@ void add_report_command(CLI::App& app, int& status) {
   merge->add_option("parts", *parts, "Report folders written with --shard")->required();
   merge->add_option("-o,--output", *merged, "Merged report folder")->required();
   merge->add_flag("--fail-on-regression", *fail_merge, "Exit 3 on regressions against the previous merged report");
-  merge->callback([parts, merged, fail_merge, &status] {
+  merge->callback([parts, merged, fail_merge, &ctx] {
     try {
-      finish(merge_reports(*parts, *merged), *merged, *fail_merge, status);
+      finish(merge_reports(*parts, *merged), *merged, *fail_merge, ctx);
     } catch (const Error& e) {
       report_error(e.what());
-      status = 1;
+      ctx.status = 1;
     }
   });
-  cmd->callback([cmd, merge, args, &status] {
+  cmd->callback([cmd, merge, args, &ctx] {
     if (merge->parsed()) return;
     if (args->out_dir.empty()) {
       report_error("report: -o REPORT is required");
-      status = 2;
+      ctx.status = 2;
       return;
     }
-    run_report_command(*args, status);
+    run_report_command(*args, ctx);
   });
 }
 

@@ -4,6 +4,7 @@
 #include <signal.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -293,6 +294,92 @@ TEST(RenderCli, DefaultMaterialAsEveryRepresentation) {
     EXPECT_EQ(r.status, 0) << type << ": " << r.err;
     EXPECT_TRUE(std::filesystem::exists(dir.file(std::string(type) + ".exr"))) << type;
   }
+}
+
+}  // namespace
+}  // namespace facetfit
+
+namespace facetfit {
+namespace {
+
+TEST(Cli, ExitCodesOfEveryCommand) {
+  // bin/commands.h: 0 success, 1 some input failed, 2 usage (parser errors included); 3 (report
+  // regressions) is ReportCli.FailOnRegressionAndMerge's.
+  TempDir dir;
+  ASSERT_EQ(facetfit("bake builtin:gold-ggx-0.15 --refine none -o " + dir.file("luts")).status, 0);
+  const std::string lut = dir.file("luts") + "/gold-ggx-0.15.exr";
+  test::write_bytes(dir.file("bad.binary"), "not a MERL table");
+  test::write_bytes(dir.file("pair.txt"), "50 0 0 50 -1 2\n");
+  test::write_bytes(dir.file("bad_pair.txt"), "50 0 0\n");
+  ASSERT_EQ(facetfit("render --spp 1 --width 8 --height 8 -o " + dir.file("a.exr")).status, 0);
+  const std::string bad = dir.file("bad.binary"), a = dir.file("a.exr");
+  struct Case {
+    std::string args;
+    int status;
+  };
+  const Case cases[] = {
+      {"fit builtin:gold-ggx-0.15 --refine none", 0},
+      {"fit " + bad, 1},
+      {"fit --frobnicate builtin:gold-ggx-0.15", 2},
+      {"convert builtin:gold-ggx-0.15 -o " + dir.file("g.binary"), 0},
+      {"convert " + bad + " -o " + dir.file("h.binary"), 1},
+      {"convert builtin:gold-ggx-0.15", 2},
+      {"list-builtins", 0},
+      {"list-builtins extra", 2},
+      {"bake builtin:gold-ggx-0.15 --refine none -o " + dir.file("luts"), 0},
+      {"bake " + bad + " -o " + dir.file("luts"), 1},
+      {"bake builtin:gold-ggx-0.15", 2},
+      {"info " + lut, 0},
+      {"info " + bad, 1},
+      {"info", 2},
+      {"render --spp 1 --width 8 --height 8 -o " + dir.file("b.exr"), 0},
+      {"render --material " + bad + " --spp 1 --width 8 --height 8 -o " + dir.file("c.exr"), 1},
+      {"render --spp x -o " + dir.file("d.exr"), 2},
+      {"diff " + a + " " + a, 0},
+      {"diff " + a + " " + bad, 1},
+      {"diff " + a, 2},
+      {"deltae <" + dir.file("pair.txt"), 0},
+      {"deltae <" + dir.file("bad_pair.txt"), 1},
+      {"deltae extra <" + dir.file("pair.txt"), 2},
+      {"report --refine none --size 8 --spp 1 -o " + dir.file("report") + " builtin:gold-ggx-0.15", 0},
+      {"report --refine none --size 8 --spp 1 -o " + dir.file("report2") + " " + bad, 1},
+      {"report --shard 3/2 -o " + dir.file("report3") + " builtin:gold-ggx-0.15", 2},
+  };
+  for (const Case& c : cases) {
+    const RunResult r = facetfit(c.args);
+    EXPECT_EQ(r.status, c.status) << c.args << "\n" << r.err;
+    if (c.status == 1) {  // the failed input named in the command's error style
+      EXPECT_NE(r.err.find("facetfit: error: "), std::string::npos) << c.args << "\n" << r.err;
+    }
+    if (c.status == 2) {  // a usage error, parser's included: one line in the same style
+      EXPECT_EQ(r.err.rfind("facetfit: error: ", 0), 0u) << c.args << "\n" << r.err;
+      EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << c.args << "\n" << r.err;
+    }
+  }
+}
+
+TEST(Cli, QuietPrintsOnlyResultsAndErrorsVerbosePrintsSettings) {
+  TempDir dir;
+  const std::string out = " -o " + dir.file("luts");
+  const RunResult quiet = facetfit("-q bake builtin:gold-ggx-0.15 --refine none" + out);
+  EXPECT_EQ(quiet.status, 0);
+  EXPECT_EQ(quiet.out + quiet.err, "");
+  const RunResult normal = facetfit("bake builtin:gold-ggx-0.15 --refine none" + out);
+  EXPECT_NE(normal.out.find("baked 0, cached 1, failed 0"), std::string::npos) << normal.out;
+  const RunResult verbose = facetfit("-v bake builtin:gold-ggx-0.15 --refine none" + out);
+  EXPECT_NE(verbose.err.find("facetfit: bake: refine none, resolution 90"), std::string::npos) << verbose.err;
+  EXPECT_NE(verbose.err.find("cached gold-ggx-0.15"), std::string::npos) << verbose.err;
+  // -q keeps results (the fit table) and errors.
+  const RunResult fit = facetfit("--quiet fit builtin:gold-ggx-0.15 --refine none");
+  EXPECT_NE(fit.out.find("gold-ggx-0.15"), std::string::npos);
+  EXPECT_EQ(fit.err, "");
+  const RunResult failed = facetfit("-q bake builtin:no-such-material" + out);
+  EXPECT_EQ(failed.status, 1);
+  EXPECT_NE(failed.err.find("facetfit: error: "), std::string::npos);
+  const RunResult render = facetfit("-q render --spp 1 --width 8 --height 8 -o " + dir.file("a.exr"));
+  EXPECT_EQ(render.status, 0);
+  EXPECT_EQ(render.out + render.err, "");
+  EXPECT_NE(facetfit("-v render --spp 1 --width 8 --height 8 -o " + dir.file("b.exr")).err.find("facetfit: render: pass 1/1"), std::string::npos);
 }
 
 }  // namespace
