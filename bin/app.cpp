@@ -6,6 +6,7 @@
 
 #include "commands.h"
 #include "core/error.h"
+#include "core/memory_budget.h"
 #include "io/input.h"
 
 namespace facetfit::cli {
@@ -17,6 +18,18 @@ void report_settings(const Context& ctx, const std::string& command, const FitOp
   std::fprintf(stderr, "facetfit: %s: refine %s, resolution %d, smith %s, merl-bins %s, threads %zu\n", command.c_str(),
                to_string(o.refine), o.resolution, to_string(o.smith), to_string(o.merl_bins),
                tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
+}
+
+void add_max_memory_option(CLI::App* cmd, std::uint64_t& bytes) {
+  cmd->add_option_function<std::string>(
+         "--max-memory",
+         [&bytes](const std::string& text) {
+           const auto parsed = parse_byte_size(text);
+           if (!parsed) throw CLI::ValidationError("--max-memory", "'" + text + "' is not a size such as 512M or 4G");
+           bytes = *parsed;
+         },
+         "Memory a render's image and environment map may take, e.g. 512M or 4G (default: half of this machine's, " +
+             format_bytes(default_memory_budget()) + ")");
 }
 
 void add_fit_settings(CLI::App* cmd, FitSettings& s) {

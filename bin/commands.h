@@ -4,6 +4,7 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
+#include <cstdint>
 #include <optional>
 #include <string>
 
@@ -35,6 +36,10 @@ struct FitSettings {
 void add_fit_settings(CLI::App* cmd, FitSettings& settings);
 // The FitOptions they name, or nullopt after reporting a usage error (status 2).
 std::optional<FitOptions> fit_options(const FitSettings& settings, int& status);
+
+// --max-memory SIZE ("4G", "512M"): what a render's image and environment map may take (default half of
+// the machine's memory); a bad size is a usage error.
+void add_max_memory_option(CLI::App* cmd, std::uint64_t& bytes);
 
 void add_fit_command(CLI::App& app, Context& ctx);
 void add_convert_command(CLI::App& app, Context& ctx);

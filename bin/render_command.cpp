@@ -29,6 +29,7 @@ struct RenderArgs {
   std::string material = "builtin:gold-ggx-0.15";
   std::string material_type = "measured";
   int width = 0, height = 0;
+  std::uint64_t max_memory = 0;
 };
 
 void run_render(const RenderArgs& args, Context& ctx) {
@@ -72,6 +73,7 @@ void run_render(const RenderArgs& args, Context& ctx) {
     RenderSettings settings;
     settings.spp = args.spp;
     settings.seed = args.seed;
+    settings.max_memory = args.max_memory;
     // A line redrawn on a terminal; with -v one line per pass anywhere; nothing with -q.
     const bool tty = ::isatty(STDERR_FILENO) == 1 && !ctx.quiet(), lines = ctx.verbose();
     settings.progress = [tty, lines](int done, int total) {
@@ -107,6 +109,7 @@ void add_render_command(CLI::App& app, Context& ctx) {
   cmd->add_option("--seed", args->seed, "Random seed (default: the scene's)");
   cmd->add_option("--width", args->width, "Image width (default: the scene's)")->check(CLI::Range(1, 16384));
   cmd->add_option("--height", args->height, "Image height (default: the scene's)")->check(CLI::Range(1, 16384));
+  add_max_memory_option(cmd, args->max_memory);
   cmd->add_option("--material", args->material, "Default scene only: the sphere's material file")->capture_default_str();
   cmd->add_option("--material-type", args->material_type, "Default scene only: measured, lut, ggx, beckmann or lsq (a measurement is baked first for the last four)")
       ->check(CLI::IsMember({"measured", "lut", "ggx", "beckmann", "lsq", "analytic", "lambert"}))

@@ -20,6 +20,7 @@ struct ReportArgs {
   bool fail_on_regression = false;
   bool force = false;
   double tolerance = 0.02;
+  std::uint64_t max_memory = 0;
   FitSettings settings;
 };
 
@@ -46,6 +47,7 @@ void run_report_command(const ReportArgs& args, Context& ctx) {
   o.out_dir = args.out_dir;
   o.size = args.size;
   o.spp = args.spp;
+  o.max_memory = args.max_memory;
   o.force = args.force;
   o.bake.fit = *fit;
   o.bake.tolerance = args.tolerance;
@@ -82,6 +84,7 @@ void add_report_command(CLI::App& app, Context& ctx) {
   cmd->add_option("-o,--output", args->out_dir, "Report folder (report.json, index.html, images/, luts/)");
   cmd->add_option("--size", args->size, "Image side in pixels")->capture_default_str();
   cmd->add_option("--spp", args->spp, "Samples per pixel")->capture_default_str();
+  add_max_memory_option(cmd, args->max_memory);
   cmd->add_option("--shard", args->shard, "K/N: render the K-th of N deterministic subsets (merge them with report merge)")
       ->capture_default_str();
   cmd->add_flag("--fail-on-regression", args->fail_on_regression, "Exit 3 when a material got worse than in the previous report");

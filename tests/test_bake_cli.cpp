@@ -335,6 +335,8 @@ TEST(Cli, ExitCodesOfEveryCommand) {
       {"render --spp 1 --width 8 --height 8 -o " + dir.file("b.exr"), 0},
       {"render --material " + bad + " --spp 1 --width 8 --height 8 -o " + dir.file("c.exr"), 1},
       {"render --spp x -o " + dir.file("d.exr"), 2},
+      {"render --max-memory 1M -o " + dir.file("e.exr"), 1},  // 256 x 256 takes 3.8 MiB
+      {"render --max-memory lots -o " + dir.file("e.exr"), 2},
       {"diff " + a + " " + a, 0},
       {"diff " + a + " " + bad, 1},
       {"diff " + a, 2},

@@ -221,10 +221,41 @@ TEST(Render, MeasuredMaterialSampledByAGivenLutRendersTheSameImage) {
 
 #include <random>
 
+#include "core/memory_budget.h"
 #include "render/environment.h"
 
 namespace facetfit {
 namespace {
+
+TEST(MemoryBudget, SizesParseAndRendersOverTheBudgetAreRefusedBeforeAllocating) {
+  EXPECT_EQ(parse_byte_size("512M"), std::uint64_t(512) << 20);
+  EXPECT_EQ(parse_byte_size("4G"), std::uint64_t(4) << 30);
+  EXPECT_EQ(parse_byte_size("1.5GiB"), std::uint64_t(3) << 29);
+  EXPECT_EQ(parse_byte_size("2KB"), 2048u);
+  EXPECT_EQ(parse_byte_size("1000"), 1000u);
+  for (const char* bad : {"", "G", "-1G", "0", "1X", "nanG", "1e30T", "4 G"}) EXPECT_FALSE(parse_byte_size(bad)) << bad;
+  EXPECT_GT(default_memory_budget(), 0u);
+
+  // An image over the budget: one line, before any buffer exists (16384^2 would take 15 GiB).
+  MaterialDesc lambert;
+  SceneDesc big = default_scene(lambert);
+  big.camera.width = big.camera.height = 16384;
+  RenderSettings settings;
+  settings.max_memory = std::uint64_t(1) << 30;
+  EXPECT_NE(test::error_of([&] { render(big, settings); }).find("render: a 16384 x 16384 image needs 15.0 GiB, over the memory budget of 1.0 GiB"),
+            std::string::npos);
+  // A 65536 x 32768 environment map announced by a 60-byte Radiance header (it asked for 24 GiB and
+  // ended in std::bad_alloc): refused from its header, under the default budget too.
+  test::TempDir dir;
+  test::write_bytes(dir.file("huge.hdr"), "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 32768 +X 65536\n\x02\x02");
+  SceneDesc sky = default_scene(lambert);
+  sky.camera.width = sky.camera.height = 8;
+  sky.environment.kind = EnvironmentDesc::Kind::file;
+  sky.environment.file = dir.file("huge.hdr");
+  const std::string e = test::error_of([&] { render(sky); });
+  EXPECT_NE(e.find("huge.hdr: a 65536 x 32768 environment map needs"), std::string::npos) << e;
+  EXPECT_NE(e.find("over the memory budget"), std::string::npos) << e;
+}
 
 TEST(PiecewiseConstant2D, DrawsCellsInProportionToTheirWeightsAndReportsTheirDensity) {
   // 3 x 2 cells, one empty, one empty row: counts within 1% of the weights' shares, density = share x 6.

@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "core/error.h"
+#include "core/memory_budget.h"
 #include "io/image_file.h"
 
 namespace facetfit {
@@ -40,10 +41,20 @@ Environment Environment::from_pixels(int width, int height, std::vector<float> r
   return env;
 }
 
-Environment Environment::load(const std::string& path) {
+std::uint64_t Environment::bytes_to_load(int width, int height, int channels) {
+  // Per pixel: the file's channels as float, two RGB copies (the map's, and the scaled one a scene may
+  // make), and PiecewiseConstant2D's weights, running sums and densities (doubles).
+  return std::uint64_t(width) * std::uint64_t(height) * (4u * std::uint64_t(channels) + 24u + 32u);
+}
+
+Environment Environment::load(const std::string& path, std::uint64_t max_bytes) {
   auto in = open_image(path, "cannot open environment map");
   const OIIO::ImageSpec& spec = in->spec();
-  if (spec.width < 2 || spec.height < 1 || spec.width > 65536 || spec.height > 32768) fail(path, "unusable environment map size");
+  if (spec.width < 2 || spec.height < 1 || spec.width > 65536 || spec.height > 32768 || spec.nchannels < 1 || spec.nchannels > 64)
+    fail(path, "environment map is " + std::to_string(spec.width) + " x " + std::to_string(spec.height) + " x " +
+                   std::to_string(spec.nchannels) + " channels; at most 65536 x 32768, at least 2 x 1, 1 to 64 channels");
+  check_memory(path, "a " + std::to_string(spec.width) + " x " + std::to_string(spec.height) + " environment map",
+               bytes_to_load(spec.width, spec.height, spec.nchannels), max_bytes);
   int channel[3];
   const char* names[3] = {"R", "G", "B"};
   for (int c = 0; c < 3; ++c) {

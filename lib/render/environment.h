@@ -6,6 +6,7 @@
 // per pixel) and radiance() agree exactly, as multiple importance sampling needs.
 #pragma once
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -20,7 +21,11 @@ class Environment {
   // `rgb` holds width x height interleaved linear Rec.709 values, row 0 at the zenith.
   static Environment from_pixels(int width, int height, std::vector<float> rgb);
   // Any image OpenImageIO reads (EXR, HDR); throws Error naming the file.
-  static Environment load(const std::string& path);
+  // Refuses, before reading its pixels, a map whose pixels and sampling tables would take more than
+  // `max_bytes`.
+  static Environment load(const std::string& path, std::uint64_t max_bytes);
+  // Bytes a loaded map of width x height x channels takes at its peak (file pixels, colour, sampling tables).
+  static std::uint64_t bytes_to_load(int width, int height, int channels);
   // The built-in sky: a zenith-to-horizon gradient, a darker ground, and a small bright sun. Needs no file.
   static Environment sky(int width = 512);
 

@@ -13,6 +13,7 @@
 
 #include "core/error.h"
 #include "io/image_file.h"
+#include "core/memory_budget.h"
 #include "render/environment.h"
 
 namespace facetfit {
@@ -93,6 +94,12 @@ void read_obj(const std::string& path, std::vector<float>& positions, std::vecto
 
 RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
   const auto start = std::chrono::steady_clock::now();
+  // The image buffers (float RGBA, double accumulation, the RGB copy a caller takes) before anything loads;
+  // the environment map gets what they leave.
+  const std::uint64_t budget = settings.max_memory > 0 ? settings.max_memory : default_memory_budget();
+  const std::uint64_t image_bytes = std::uint64_t(desc.camera.width) * std::uint64_t(desc.camera.height) * (16u + 32u + 12u);
+  check_memory("render", "a " + std::to_string(desc.camera.width) + " x " + std::to_string(desc.camera.height) + " image",
+               image_bytes, budget);
   // Only what the scene uses is loaded.
   std::vector<std::shared_ptr<const ShadingModel>> materials;
   std::map<std::string, int> material_index;
@@ -107,7 +114,7 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
     case EnvironmentDesc::Kind::builtin_sky: env = Environment::sky(); break;
     case EnvironmentDesc::Kind::constant: env = Environment::constant(desc.environment.constant * desc.environment.scale); break;
     case EnvironmentDesc::Kind::file: {
-      Environment loaded = Environment::load(resolve(desc, desc.environment.file));
+      Environment loaded = Environment::load(resolve(desc, desc.environment.file), budget - image_bytes);
       if (desc.environment.scale != 1.0) {
         std::vector<float> px = loaded.pixels();
         for (float& v : px) v *= float(desc.environment.scale);

@@ -3,6 +3,7 @@
 // pixel (the same scene and settings give the same image on any number of threads).
 #pragma once
 
+#include <cstdint>
 #include <functional>
 #include <string>
 #include <vector>
@@ -15,6 +16,9 @@ struct RenderSettings {
   int spp = 0;                // 0: the scene's
   std::uint64_t seed = 0;     // 0: the scene's
   int passes = 4;             // samples are added in passes (progressive), each over the whole image
+  // Bytes the image buffers and the environment map may take together (core/memory_budget.h); 0: half of
+  // the machine's memory. A scene over it is refused before anything is allocated.
+  std::uint64_t max_memory = 0;
   std::function<void(int done_passes, int passes)> progress;  // optional
 };
 
@@ -28,7 +32,7 @@ struct RenderedImage {
 };
 
 // Loads what the scene needs (its environment, and only the materials its objects use) and renders.
-// Throws Error for anything it cannot load.
+// Throws Error for anything it cannot load, and for a scene over settings.max_memory.
 RenderedImage render(const SceneDesc& scene, const RenderSettings& settings = {});
 
 // Linear EXR (R, G, B, A, float) with the given string metadata, through a temporary file.

@@ -272,7 +272,9 @@ json run_report(const ReportOptions& o) {
           m.type = type;
           m.file = file;
           if (type == "measured") m.proposal = lut;  // the bake's fit, not a second one
-          return render(report_scene(m, o));
+          RenderSettings settings;
+          settings.max_memory = o.max_memory;
+          return render(report_scene(m, o), settings);
         };
         const RenderedImage measured = render_as("measured", source);
         entry["seconds"]["render"]["measured"] = measured.seconds;

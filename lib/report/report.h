@@ -2,6 +2,7 @@
 // from each fitted representation, compared by mean CIE Delta E 2000 on the display-referred images.
 #pragma once
 
+#include <cstdint>
 #include <functional>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -16,6 +17,7 @@ struct ReportOptions {
   std::string out_dir;
   int size = 128;   // image side, pixels
   int spp = 32;
+  std::uint64_t max_memory = 0;  // per render (render/renderer.h); 0: half of the machine's
   int shard = 1, shards = 1;  // this run renders materials k with k % shards == shard - 1
   bool force = false;
   BakeOptions bake;

@@ -21,6 +21,7 @@
 #include "arrays.h"
 #include "color/image_diff.h"
 #include "core/error.h"
+#include "core/memory_budget.h"
 #include "fit/fit.h"
 #include "io/input.h"
 #include "lut/bake.h"
@@ -144,7 +145,7 @@ Model material(const py::dict& description, const std::string& base_dir) {
   return Model{load_material(scene, scene.materials.at("m"))};
 }
 
-py::array_t<float> render_scene(const py::object& scene, int spp, std::uint64_t seed) {
+py::array_t<float> render_scene(const py::object& scene, int spp, std::uint64_t seed, const std::string& max_memory) {
   SceneDesc desc;
   if (py::isinstance<py::dict>(scene)) {
     const std::string text = to_json_text(scene);
@@ -155,6 +156,11 @@ py::array_t<float> render_scene(const py::object& scene, int spp, std::uint64_t 
   RenderSettings settings;
   settings.spp = spp;
   settings.seed = seed;
+  if (!max_memory.empty()) {
+    const auto bytes = parse_byte_size(max_memory);
+    if (!bytes) throw py::value_error("max_memory: '" + max_memory + "' is not a size such as 512M or 4G");
+    settings.max_memory = *bytes;
+  }
   RenderedImage image;
   {
     py::gil_scoped_release release;
@@ -382,9 +388,10 @@ PYBIND11_MODULE(_facetfit, m) {
       py::arg("merl_bins") = "start",
       "Bakes OUT_DIR/NAME.exr and its JSON sidecar as `facetfit bake` does (cached by content); returns the sidecar.");
 
-  m.def("render", &render_scene, py::arg("scene"), py::arg("spp") = 0, py::arg("seed") = 0,
+  m.def("render", &render_scene, py::arg("scene"), py::arg("spp") = 0, py::arg("seed") = 0, py::arg("max_memory") = "",
         "Renders a scene (a path, or a dict as in docs/scene-format.md; relative files against the current folder): "
-        "(height, width, 4) float32, linear Rec.709 RGB and coverage.");
+        "(height, width, 4) float32, linear Rec.709 RGB and coverage. max_memory ('4G', '512M'; default half of the "
+        "machine's) bounds the image and environment map, checked before allocating.");
   m.def("delta_e", &delta_e, py::arg("a"), py::arg("b"), py::arg("mask") = py::none(), py::arg("a_display_referred") = false,
         py::arg("b_display_referred") = false,
         "CIE Delta E 2000 per pixel through the display chain (docs/colour.md): (map, mean, max) over the mask.");

@@ -169,6 +169,12 @@ def test_render_and_delta_e(gold_fit, tmp_path):
     assert dmap.shape == (48, 48) and mask.sum() > 500
     assert mean < 1.0 and worst >= mean
     assert facetfit.delta_e(truth, truth, mask)[1] == 0.0
+    # The memory budget is checked before allocating: one line, nothing rendered.
+    big = dict(scene, camera=dict(scene["camera"], width=16384, height=16384))
+    with pytest.raises(facetfit.Error, match="over the memory budget of 1.0 GiB"):
+        facetfit.render(big, max_memory="1G")
+    with pytest.raises(ValueError, match="max_memory"):
+        facetfit.render(scene, max_memory="lots")
     # A scene file renders the same image as its dict.
     path = tmp_path / "scene.json"
     path.write_text(json.dumps(scene))

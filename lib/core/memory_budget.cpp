@@ -1,0 +1,49 @@
+#include "core/memory_budget.h"
+
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+
+#include "core/error.h"
+
+namespace facetfit {
+
+std::uint64_t default_memory_budget() {
+  const long pages = ::sysconf(_SC_PHYS_PAGES), page = ::sysconf(_SC_PAGESIZE);
+  if (pages <= 0 || page <= 0) return std::uint64_t(1) << 30;
+  return std::uint64_t(pages) * std::uint64_t(page) / 2;
+}
+
+std::optional<std::uint64_t> parse_byte_size(const std::string& text) {
+  if (text.empty() || text.size() > 32) return std::nullopt;
+  char* end = nullptr;
+  const double value = std::strtod(text.c_str(), &end);
+  if (end == text.c_str() || !std::isfinite(value) || value <= 0.0) return std::nullopt;
+  std::string unit(end);  // K, M, G or T, optionally followed by iB or B; or B; or nothing
+  if (unit.size() >= 3 && unit.compare(unit.size() - 2, 2, "iB") == 0) unit.resize(unit.size() - 2);
+  else if (unit.size() == 2 && unit.back() == 'B') unit.pop_back();
+  double scale = 1.0;
+  if (unit == "K" || unit == "k") scale = 1024.0;
+  else if (unit == "M") scale = 1024.0 * 1024.0;
+  else if (unit == "G") scale = 1024.0 * 1024.0 * 1024.0;
+  else if (unit == "T") scale = 1024.0 * 1024.0 * 1024.0 * 1024.0;
+  else if (!unit.empty() && unit != "B") return std::nullopt;
+  const double bytes = value * scale;
+  if (!(bytes >= 1.0 && bytes < 1.8e19)) return std::nullopt;
+  return static_cast<std::uint64_t>(bytes);
+}
+
+std::string format_bytes(std::uint64_t bytes) {
+  char text[64];
+  if (bytes >= (std::uint64_t(1) << 30)) std::snprintf(text, sizeof text, "%.1f GiB", double(bytes) / double(std::uint64_t(1) << 30));
+  else std::snprintf(text, sizeof text, "%.1f MiB", double(bytes) / double(std::uint64_t(1) << 20));
+  return text;
+}
+
+void check_memory(const std::string& what, const std::string& needing, std::uint64_t need, std::uint64_t budget) {
+  if (need > budget) fail(what, needing + " needs " + format_bytes(need) + ", over the memory budget of " + format_bytes(budget));
+}
+
+}  // namespace facetfit
