@@ -28,31 +28,6 @@ namespace {
 
 // ---- deltae ----------------------------------------------------------------------------------------------
 
-// The six numbers of one line, or an Error naming the line.
-std::array<double, 6> parse_pair(const std::string& line, int number) {
-  const std::string what = "stdin line " + std::to_string(number);
-  std::array<double, 6> v{};
-  std::size_t count = 0, i = 0;
-  while (true) {
-    while (i < line.size() && (line[i] == ' ' || line[i] == '\t')) ++i;
-    if (i == line.size()) break;
-    std::size_t end = i;
-    while (end < line.size() && line[end] != ' ' && line[end] != '\t') ++end;
-    const std::string token = line.substr(i, end - i);
-    if (count == 6) fail(what, "more than 6 numbers (expected L1 a1 b1 L2 a2 b2)");
-    // from_chars: locale-independent, and it must consume the whole token.
-    const char* first = token.data() + (token[0] == '+' ? 1 : 0);
-    const char* last = token.data() + token.size();
-    double x = 0;
-    const auto [ptr, ec] = std::from_chars(first, last, x);
-    if (ec != std::errc() || ptr != last || !std::isfinite(x)) fail(what, "'" + token + "' is not a finite number");
-    v[count++] = x;
-    i = end;
-  }
-  if (count != 6) fail(what, std::to_string(count) + " numbers, expected 6 (L1 a1 b1 L2 a2 b2)");
-  return v;
-}
-
 void run_deltae(Context& ctx) {
   int& status = ctx.status;
   std::string line;
@@ -62,7 +37,7 @@ void run_deltae(Context& ctx) {
     if (!line.empty() && line.back() == '\r') line.pop_back();  // files written on Windows
     if (line.find_first_not_of(" \t") == std::string::npos) continue;
     try {
-      const auto v = parse_pair(line, number);
+      const auto v = parse_lab_pair(line, "stdin line " + std::to_string(number));
       std::printf("%.6f\n", ciede2000({v[0], v[1], v[2]}, {v[3], v[4], v[5]}));
     } catch (const Error& e) {
       report_error(e.what());

@@ -6,10 +6,11 @@
 set -euo pipefail
 build=$1; seconds=$2; shift 2
 here="$(cd "$(dirname "$0")" && pwd)"
-targets=("${@:-merl rgl scene obj}")
+targets=("${@:-merl rgl scene obj lut env deltae}")
 targets=(${targets[@]})
 mkdir -p "$build/findings"
 python3 "$here/make_seeds.py" "$build/seeds"
+"$build/fuzz/write_seeds" "$build/seeds"
 export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1:allocator_may_return_null=1
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 status=0
@@ -19,6 +20,7 @@ for t in "${targets[@]}"; do
   for d in "$build/seeds/$t" "$here/seeds/$t"; do [[ -d "$d" ]] && seeds+=("$d"); done
   log="$build/fuzz_$t.log"
   max_len=65536; [[ $t == rgl ]] && max_len=1048576  # a real RGL material is 0.66 MB
+  [[ $t == lut ]] && max_len=262144                   # a LUT with sampling tables is ~100 KB
   if "$build/fuzz/fuzz_$t" "$corpus" "${seeds[@]}" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 \
        -max_len="$max_len" -artifact_prefix="$build/findings/$t-" -print_final_stats=1 >"$log" 2>&1; then
     runs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' || echo "?")

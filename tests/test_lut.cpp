@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <random>
 
@@ -183,6 +184,43 @@ TEST(Lut, BadFilesGetOneClearLine) {
     EXPECT_NE(e.find(std::string("facetfit:") + name + " is "), std::string::npos) << name << ": " << e;
     EXPECT_EQ(e.find('\n'), std::string::npos) << e;
   }
+}
+
+}  // namespace
+}  // namespace facetfit
+
+namespace facetfit {
+namespace {
+
+// The bytes of `file` with the 32-bit size of header attribute `name` (after its name and type) set.
+std::string with_attribute_size(std::string bytes, const std::string& name, std::int32_t size) {
+  const std::size_t at = bytes.find(name + '\0');
+  EXPECT_NE(at, std::string::npos) << name;
+  const std::size_t type_end = bytes.find('\0', at + name.size() + 1);
+  std::memcpy(&bytes[type_end + 1], &size, 4);
+  return bytes;
+}
+
+TEST(Lut, HostileOpenExrHeadersAreRefusedBeforeOpenExrAllocates) {
+  // fuzz_lut's findings: OpenEXR 3.1 allocates what a header claims (a string attribute of 1.6 GB in a
+  // 6 KB file took 1.7 GB), and parses fixed-size values and channel lists by their own rules, so a header
+  // whose stated sizes disagree is read differently by it. Each is one line now, before OpenEXR runs.
+  const Baked b = fit_of(MicrofacetBrdf(Ndf::isotropic(NdfType::ggx, 0.2), Smith::correlated, Fresnel::schlick(Rgb(0.9))));
+  TempDir dir;
+  write_lut(dir.file("good.exr"), make_lut(b.fit, b.fitter.quadrature(), "builtin:test", "abc", 0.02, false));
+  const std::string good = test::read_bytes(dir.file("good.exr"));
+  const std::pair<std::string, std::string> cases[] = {
+      {with_attribute_size(good, "facetfit:smith", 1677721610), "attribute 'facetfit:smith' claims 1677721610 bytes"},
+      {with_attribute_size(good, "compression", 513), "attribute 'compression' of type compression has 513 bytes, not 1"},
+      {with_attribute_size(good, "channels", 40), "attribute 'channels' of type chlist does not match its size"},
+      {with_attribute_size(good, "dataWindow", -5), "attribute 'dataWindow' claims -5 bytes"},
+  };
+  for (const auto& [bytes, message] : cases) {
+    test::write_bytes(dir.file("bad.exr"), bytes);
+    const std::string e = error_of([&] { read_lut(dir.file("bad.exr")); });
+    EXPECT_NE(e.find(dir.file("bad.exr") + ": OpenEXR header: " + message), std::string::npos) << e;
+  }
+  EXPECT_NO_THROW(read_lut(dir.file("good.exr")));
 }
 
 }  // namespace

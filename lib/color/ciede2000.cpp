@@ -1,8 +1,11 @@
 #include "color/ciede2000.h"
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
+#include <system_error>
 
+#include "core/error.h"
 #include "core/vec.h"
 
 namespace facetfit {
@@ -78,6 +81,48 @@ double ciede2000(const Lab& x, const Lab& y, double kL, double kC, double kH) {
   const double l = dL / (kL * s_l), c = dC / (kC * s_c), h = dH / (kH * s_h);
   // The sum is >= 0 in exact arithmetic (|R_T| < 2); max() guards sqrt against rounding at zero.
   return std::sqrt(std::max(0.0, l * l + c * c + h * h + r_t * c * h));
+}
+
+}  // namespace facetfit
+
+namespace facetfit {
+
+namespace {
+
+// A token as a message may show it: printable ASCII, others as '?', at most 24 characters.
+std::string excerpt(const std::string& token) {
+  std::string out;
+  for (std::size_t k = 0; k < token.size() && k < 24; ++k) {
+    const unsigned char c = static_cast<unsigned char>(token[k]);
+    out += c >= 0x20 && c < 0x7f ? char(c) : '?';
+  }
+  if (token.size() > 24) out += "...";
+  return out;
+}
+
+}  // namespace
+
+std::array<double, 6> parse_lab_pair(const std::string& line, const std::string& what) {
+  std::array<double, 6> v{};
+  std::size_t count = 0, i = 0;
+  while (true) {
+    while (i < line.size() && (line[i] == ' ' || line[i] == '\t')) ++i;
+    if (i == line.size()) break;
+    std::size_t end = i;
+    while (end < line.size() && line[end] != ' ' && line[end] != '\t') ++end;
+    const std::string token = line.substr(i, end - i);
+    if (count == 6) fail(what, "more than 6 numbers (expected L1 a1 b1 L2 a2 b2)");
+    // from_chars: locale-independent, and it must consume the whole token.
+    const char* first = token.data() + (token[0] == '+' ? 1 : 0);
+    const char* last = token.data() + token.size();
+    double x = 0;
+    const auto [ptr, ec] = std::from_chars(first, last, x);
+    if (ec != std::errc() || ptr != last || !std::isfinite(x)) fail(what, "'" + excerpt(token) + "' is not a finite number");
+    v[count++] = x;
+    i = end;
+  }
+  if (count != 6) fail(what, std::to_string(count) + " numbers, expected 6 (L1 a1 b1 L2 a2 b2)");
+  return v;
 }
 
 }  // namespace facetfit

@@ -1,0 +1,10 @@
+// Environment maps (any format OpenImageIO reads), under a 256 MiB memory budget, then a sample.
+#include "fuzz_input.h"
+#include "render/environment.h"
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+  return facetfit::fuzz::run(data, size, ".exr", [](const std::string& path) {
+    const facetfit::Environment env = facetfit::Environment::load(path, std::uint64_t(256) << 20);
+    (void)env.sample(0.3, 0.7);
+  });
+}
