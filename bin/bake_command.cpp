@@ -7,12 +7,14 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <set>
 #include <thread>
 
 #include "commands.h"
 #include "core/error.h"
 #include "io/atomic_file.h"
+#include "io/folder_lock.h"
 #include "io/input.h"
 #include "lut/bake.h"
 #include "render/scene.h"
@@ -121,6 +123,22 @@ void run_bake(const BakeArgs& args, Context& ctx) {
     }, tbb::simple_partitioner());
   });
 
+  // index.json is read, merged and written under the folder's lock, from the sidecars as they are on disk:
+  // a concurrent bake of the same names may have replaced them since, and the index must agree with them.
+  std::optional<FolderLock> lock;
+  try {
+    lock.emplace(args.out_dir);
+  } catch (const Error& e) {
+    report_error(e.what());
+    status = 1;
+    return;
+  }
+  for (auto& o : outcomes) {
+    if (o.status == BakeOutcome::Status::failed) continue;
+    std::ifstream sidecar(fs::path(args.out_dir) / (o.name + ".json"));
+    nlohmann::json on_disk = nlohmann::json::parse(sidecar, nullptr, false);
+    if (on_disk.is_object() && on_disk.contains("cache_key")) o.record = std::move(on_disk);
+  }
   nlohmann::json index;
   index["facetfit_version"] = FACETFIT_VERSION;
   index["materials"] = nlohmann::json::array();

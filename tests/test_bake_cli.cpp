@@ -386,3 +386,35 @@ TEST(Cli, QuietPrintsOnlyResultsAndErrorsVerbosePrintsSettings) {
 
 }  // namespace
 }  // namespace facetfit
+
+namespace facetfit {
+namespace {
+
+TEST(Bake, ConcurrentBakesIntoOneFolderStayConsistent) {
+  // Four bakes with different --tolerance into one folder at once, five times: every index.json entry
+  // must be the sidecar on disk (same cache key), and every LUT the bake its sidecar describes (same
+  // tolerance). Without the folder lock, some rounds disagree (here about one in ten).
+  TempDir out;
+  const std::string dir = out.path().string();
+  // Half of them take the materials in the other order, so that their writes interleave.
+  const std::string forward = "builtin:gold-ggx-0.15 builtin:copper-beckmann-0.30 builtin:red-plastic builtin:blue-clearcoat-paint",
+                    backward = "builtin:blue-clearcoat-paint builtin:red-plastic builtin:copper-beckmann-0.30 builtin:gold-ggx-0.15";
+  for (int round = 0; round < 5; ++round) {
+    std::string script;
+    for (const char* tolerance : {"0.01", "0.02", "0.05", "0.1"})
+      script += std::string(FACETFIT_CLI) + " -q bake " + (tolerance[3] == '2' || tolerance[2] == '1' ? forward : backward) +
+                " --refine none --force -j 1 --tolerance " + tolerance + " -o " + dir + " & ";
+    ASSERT_EQ(test::run_command("sh -c '" + script + "wait'").status, 0);
+    const nlohmann::json index = read_json(dir + "/index.json");
+    ASSERT_EQ(index["materials"].size(), 4u) << index.dump();
+    for (const auto& entry : index["materials"]) {
+      const std::string name = entry["lut"].get<std::string>().substr(0, entry["lut"].get<std::string>().size() - 4);
+      const nlohmann::json sidecar = read_json(dir + "/" + name + ".json");
+      EXPECT_EQ(entry["cache_key"], sidecar["cache_key"]) << name << " round " << round;
+      EXPECT_EQ(float(read_lut(dir + "/" + name + ".exr").meta.tolerance), float(sidecar["tolerance"].get<double>())) << name << " round " << round;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace facetfit

@@ -10,6 +10,7 @@
 
 #include "core/error.h"
 #include "io/atomic_file.h"
+#include "io/folder_lock.h"
 #include "io/input.h"
 #include "io/sha256.h"
 #include "lut/lut.h"
@@ -98,6 +99,9 @@ BakeOutcome bake_material(const std::string& source, const std::string& name, co
     const FitResult fit = fitter.fit(*table);
     if (!fit.ok()) fail(source, "meaningless fit: " + fit.problem);
     const Lut lut = make_lut(fit, fitter.quadrature(), source, sha, options.tolerance, options.with_sampling);
+    // The LUT and its sidecar are written as a pair: another bake of the same name into this folder (another
+    // process, other settings) waits, so the two never come from different bakes.
+    const FolderLock lock(out_dir);
     write_lut(lut_path.string(), lut);
     out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
