@@ -9,6 +9,7 @@
 #include "commands.h"
 #include "color/image_diff.h"
 #include "core/error.h"
+#include "io/atomic_file.h"
 #include "lut/bake.h"
 #include "render/environment.h"
 #include "render/renderer.h"
@@ -84,6 +85,9 @@ void run_render(const RenderArgs& args, Context& ctx) {
       std::fprintf(stderr, "facetfit: render: %dx%d, %zu objects, %zu lights, threads %zu\n", scene.camera.width, scene.camera.height,
                    scene.objects.size(), scene.lights.size(),
                    tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
+    // Temporaries of renders killed before they wrote (their processes are gone) go first.
+    for (const std::string& out : {args.output, args.png})
+      if (!out.empty()) remove_stale_temporaries(fs::absolute(out).parent_path().string());
     const RenderedImage image = render(scene, settings);
     write_exr(args.output, image,
               {{"scene", args.scene.empty() ? "default" : args.scene}, {"spp", std::to_string(image.spp)},

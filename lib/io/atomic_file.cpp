@@ -1,8 +1,10 @@
 #include "io/atomic_file.h"
 
 #include <fcntl.h>
+#include <signal.h>
 #include <unistd.h>
 
+#include <cctype>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -55,6 +57,36 @@ void write_file_atomic(const std::string& path, const std::string& content) {
   const bool ok = std::fwrite(content.data(), 1, content.size(), f) == content.size();
   if (std::fclose(f) != 0 || !ok) fail(path, "cannot write: short write (disk full?)");
   out.commit();
+}
+
+namespace {
+
+// The writer's pid if `file` is an AtomicFile temporary, .<stem>.tmp-<pid>-<8 hex digits>[.<ext>]; else 0.
+long temporary_owner(const std::string& file) {
+  const std::size_t at = file.rfind(".tmp-");
+  if (file.empty() || file[0] != '.' || at == std::string::npos || at == 0) return 0;
+  std::size_t k = at + 5, digits = 0;
+  long pid = 0;
+  for (; k < file.size() && std::isdigit(static_cast<unsigned char>(file[k])) && digits < 10; ++k, ++digits) pid = pid * 10 + (file[k] - '0');
+  if (digits == 0 || k >= file.size() || file[k] != '-') return 0;
+  std::size_t hex = 0;
+  for (++k; k < file.size() && std::isxdigit(static_cast<unsigned char>(file[k])); ++k) ++hex;
+  if (hex != 8 || (k < file.size() && file[k] != '.')) return 0;
+  return pid;
+}
+
+}  // namespace
+
+int remove_stale_temporaries(const std::string& dir) {
+  int removed = 0;
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(dir, ec)) {
+    const long pid = temporary_owner(entry.path().filename().string());
+    if (pid <= 0) continue;
+    if (::kill(pid_t(pid), 0) == 0) continue;  // its writer is still running
+    if (fs::remove(entry.path(), ec)) ++removed;
+  }
+  return removed;
 }
 
 }  // namespace facetfit

@@ -27,6 +27,10 @@ class AtomicFile {
   bool committed_ = false;
 };
 
+// Removes temporaries left in `dir` by facetfit runs that no longer exist (a kill mid-write); returns
+// how many.
+int remove_stale_temporaries(const std::string& dir);
+
 // Writes `content` to `path` through an AtomicFile.
 void write_file_atomic(const std::string& path, const std::string& content);
 

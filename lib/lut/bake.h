@@ -36,7 +36,4 @@ std::string bake_cache_key(const std::string& sha256, const BakeOptions& options
 BakeOutcome bake_material(const std::string& source, const std::string& name, const std::string& out_dir,
                           const BakeOptions& options, const Fitter& fitter);
 
-// Removes temporaries left in `dir` by facetfit runs that no longer exist (a kill mid-write).
-int remove_stale_temporaries(const std::string& dir);
-
 }  // namespace facetfit

@@ -192,9 +192,21 @@ std::string report_html(const json& report) {
   return h.str();
 }
 
+// report.json last: its presence says the page and every image it names are whole.
 void write_outputs(const json& report, const std::string& out_dir) {
-  write_file_atomic((fs::path(out_dir) / "report.json").string(), report.dump(2) + "\n");
   write_file_atomic((fs::path(out_dir) / "index.html").string(), report_html(report));
+  write_file_atomic((fs::path(out_dir) / "report.json").string(), report.dump(2) + "\n");
+}
+
+// images/NAME/complete holds the key of the entry whose images are all in the folder: written after the
+// last of them, removed before the first is replaced, so that a run killed in between leaves a folder
+// that is not reused (its images may be of other settings).
+constexpr const char* kCompleteStamp = "complete";
+
+bool images_complete(const fs::path& images, const std::string& key) {
+  std::ifstream in(images / kCompleteStamp);
+  std::string stamp;
+  return in && std::getline(in, stamp) && stamp == key;
 }
 
 }  // namespace
@@ -222,6 +234,8 @@ json run_report(const ReportOptions& o) {
   if (!fs::is_directory(fs::path(o.out_dir) / "luts")) fail(o.out_dir, "cannot create report folder");
   remove_stale_temporaries(o.out_dir);
   remove_stale_temporaries((fs::path(o.out_dir) / "luts").string());
+  for (const auto& entry : fs::directory_iterator(fs::path(o.out_dir) / "images", ec))
+    if (entry.is_directory(ec)) remove_stale_temporaries(entry.path().string());
   const json previous = read_json_file(fs::path(o.out_dir) / "report.json");
   std::map<std::string, json> reusable;
   if (previous.is_object() && previous.contains("materials"))
@@ -255,10 +269,11 @@ json run_report(const ReportOptions& o) {
       const std::string key_text = baked.record["cache_key"].get<std::string>() + "|" + report["settings"].dump() + "|" + FACETFIT_VERSION;
       const std::string key = sha256_hex(key_text.data(), key_text.size());
       const auto old = reusable.find(name);
-      if (!o.force && old != reusable.end() && old->second.value("key", "") == key && fs::exists(images / "measured.png")) {
+      if (!o.force && old != reusable.end() && old->second.value("key", "") == key && images_complete(images, key)) {
         report["materials"].push_back(old->second);
       } else {
         fs::create_directories(images, ec);
+        fs::remove(images / kCompleteStamp, ec);
         const std::string lut = (fs::path(o.out_dir) / "luts" / (name + ".exr")).string();
         json entry;
         entry["name"] = name;
@@ -294,6 +309,7 @@ json run_report(const ReportOptions& o) {
         const MerlTable table = load_table(source, o.bake.fit.merl_bins);
         for (const auto& [file, svg] : material_figures(table, read_lut(lut)))
           write_file_atomic((images / file).string(), svg);
+        write_file_atomic((images / kCompleteStamp).string(), key + "\n");
         report["materials"].push_back(entry);
       }
     } catch (const Error& e) {
