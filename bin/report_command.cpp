@@ -1,10 +1,14 @@
 // facetfit report [DB] -o REPORT : the nightly database accuracy report, and `report merge` for shards.
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdio>
+#include <filesystem>
 
 #include "commands.h"
 #include "core/error.h"
+#include "farm.h"
+#include "io/input.h"
 #include "progress.h"
 #include "report/report.h"
 
@@ -12,9 +16,11 @@ namespace facetfit::cli {
 
 namespace {
 
+namespace fs = std::filesystem;
+
 struct ReportArgs {
   std::vector<std::string> inputs;
-  std::string out_dir;
+  std::string out_dir, luts_dir;
   int size = 128, spp = 32;
   std::string shard = "1/1";
   bool fail_on_regression = false;
@@ -22,7 +28,70 @@ struct ReportArgs {
   double tolerance = 0.02;
   std::uint64_t max_memory = 0;
   FitSettings settings;
+  // --farm local|slurm: the report as a plan of shards (report/farm.h) run by an adapter (bin/farm.h).
+  std::string farm;
+  int shards = 4;
+  bool wait = false, dry_run = false;
+  SlurmSettings slurm;
 };
+
+// The settings every shard of a farm passes on, as arguments of `report`.
+std::vector<std::string> shard_settings(const ReportArgs& a) {
+  std::vector<std::string> s = {"--size", std::to_string(a.size), "--spp", std::to_string(a.spp), "--tolerance", std::to_string(a.tolerance),
+                                "--smith", a.settings.smith, "--resolution", std::to_string(a.settings.resolution),
+                                "--refine", a.settings.refine, "--merl-bins", a.settings.merl_bins,
+                                "--max-iterations", std::to_string(a.settings.max_iterations)};
+  char tolerance[32];
+  std::snprintf(tolerance, sizeof tolerance, "%.17g", a.settings.iteration_tolerance);
+  s.insert(s.end(), {"--iteration-tolerance", tolerance});
+  if (a.max_memory > 0) s.insert(s.end(), {"--max-memory", std::to_string(a.max_memory)});
+  if (a.force) s.push_back("--force");
+  return s;
+}
+
+void run_farm_command(const ReportArgs& args, Context& ctx) {
+  if (!fit_options(args.settings, ctx.status)) return;
+  if (args.shard != "1/1") {
+    report_error("report: --farm splits the database itself; it takes no --shard");
+    ctx.status = 2;
+    return;
+  }
+  std::vector<std::string> sources = expand_inputs(args.inputs.empty() ? std::vector<std::string>{kBuiltinPrefix} : args.inputs);
+  // What the shards could not read is refused here, once, before anything is submitted.
+  for (const std::string& source : sources) {
+    std::error_code ec;
+    if (!is_builtin(source) && !fs::is_regular_file(source, ec)) {
+      report_error(source + ": no such material file (nothing submitted, " + args.out_dir + " not published)");
+      ctx.status = 1;
+      return;
+    }
+  }
+  std::sort(sources.begin(), sources.end());
+  const std::string out_dir = fs::absolute(args.out_dir).lexically_normal().string();
+  std::vector<std::string> absolute;
+  for (const std::string& s : sources) absolute.push_back(is_builtin(s) ? s : fs::absolute(s).lexically_normal().string());
+  const FarmPlan plan = plan_report_farm(absolute, args.shards, out_dir, shard_settings(args),
+                                         args.fail_on_regression ? std::vector<std::string>{"--fail-on-regression"} : std::vector<std::string>{});
+  if (args.dry_run) {
+    if (args.farm == "slurm") {
+      std::printf("# %s/.farm/shards.sbatch: sbatch --array=1-%zu shards.sbatch\n%s\n", out_dir.c_str(), plan.shards.size(),
+                  slurm_array_script(plan, args.slurm).c_str());
+      std::printf("# %s/.farm/merge.sbatch: sbatch --dependency=afterok:ARRAY_JOB_ID merge.sbatch\n%s", out_dir.c_str(),
+                  slurm_merge_script(plan, args.slurm).c_str());
+    } else {
+      std::printf("%s\n", plan.to_json().dump(2).c_str());
+    }
+    return;
+  }
+  try {
+    ctx.status = args.farm == "slurm" ? run_farm_slurm(plan, args.slurm, args.wait, ctx) : run_farm_local(plan, ctx);
+  } catch (const Error& e) {
+    report_error(e.what());
+    ctx.status = 1;
+  }
+  if (ctx.status == 0 || ctx.status == 3)
+    if (!ctx.quiet() && (args.farm == "local" || args.wait)) std::printf("%s/index.html\n", out_dir.c_str());
+}
 
 void finish(const nlohmann::json& report, const std::string& out_dir, bool fail_on_regression, Context& ctx) {
   if (!ctx.quiet()) std::printf("%s/index.html\n", out_dir.c_str());
@@ -45,6 +114,7 @@ void run_report_command(const ReportArgs& args, Context& ctx) {
   ReportOptions o;
   o.inputs = args.inputs;
   o.out_dir = args.out_dir;
+  o.luts_dir = args.luts_dir;
   o.size = args.size;
   o.spp = args.spp;
   o.max_memory = args.max_memory;
@@ -82,6 +152,7 @@ void add_report_command(CLI::App& app, Context& ctx) {
   CLI::App* cmd = app.add_subcommand("report", "The database accuracy report: measured vs tabulated vs GGX vs Beckmann, mean Delta E 2000");
   cmd->add_option("db", args->inputs, "Material files, folders, globs (default: the built-in set, builtin:)");
   cmd->add_option("-o,--output", args->out_dir, "Report folder (report.json, index.html, images/, luts/)");
+  cmd->add_option("--luts", args->luts_dir, "Bake cache folder (default REPORT/luts; the shards of a farm share one)");
   cmd->add_option("--size", args->size, "Image side in pixels")->capture_default_str();
   cmd->add_option("--spp", args->spp, "Samples per pixel")->capture_default_str();
   add_max_memory_option(cmd, args->max_memory);
@@ -91,6 +162,17 @@ void add_report_command(CLI::App& app, Context& ctx) {
   cmd->add_flag("--force", args->force, "Render even the materials whose previous entry is current");
   cmd->add_option("--tolerance", args->tolerance, "Representation tolerance of the bake")->capture_default_str();
   add_fit_settings(cmd, args->settings);
+  cmd->add_option("--farm", args->farm, "Split the report into shards run by: local (processes on this machine) or slurm (a job array and a merge job)")
+      ->check(CLI::IsMember({"local", "slurm"}));
+  cmd->add_option("--shards", args->shards, "--farm: number of shards, balanced by the previous report's timings")
+      ->check(CLI::Range(1, 10000))
+      ->capture_default_str();
+  cmd->add_option("--partition", args->slurm.partition, "--farm slurm: sbatch --partition");
+  cmd->add_option("--time", args->slurm.time, "--farm slurm: sbatch --time of each shard");
+  cmd->add_option("--mem", args->slurm.mem, "--farm slurm: sbatch --mem of each shard");
+  cmd->add_option("--sbatch-arg", args->slurm.extra, "--farm slurm: a further sbatch option (repeatable)");
+  cmd->add_flag("--wait", args->wait, "--farm slurm: wait for the shards (resubmitting a failed one once) and the merge; exit with the merge's status");
+  cmd->add_flag("--dry-run", args->dry_run, "--farm: print the plan (slurm: the two sbatch scripts) and submit nothing");
 
   auto parts = std::make_shared<std::vector<std::string>>();
   auto merged = std::make_shared<std::string>();
@@ -114,7 +196,8 @@ void add_report_command(CLI::App& app, Context& ctx) {
       ctx.status = 2;
       return;
     }
-    run_report_command(*args, ctx);
+    if (!args->farm.empty()) run_farm_command(*args, ctx);
+    else run_report_command(*args, ctx);
   });
 }
 

@@ -230,10 +230,13 @@ json find_regressions(const json& previous, const json& current) {
 
 json run_report(const ReportOptions& o) {
   std::error_code ec;
-  fs::create_directories(fs::path(o.out_dir) / "luts", ec);
-  if (!fs::is_directory(fs::path(o.out_dir) / "luts")) fail(o.out_dir, "cannot create report folder");
+  const fs::path luts = o.luts_dir.empty() ? fs::path(o.out_dir) / "luts" : fs::path(o.luts_dir);
+  fs::create_directories(fs::path(o.out_dir), ec);
+  fs::create_directories(luts, ec);
+  if (!fs::is_directory(o.out_dir) || !fs::is_directory(luts))
+    fail(fs::is_directory(o.out_dir) ? luts.string() : o.out_dir, "cannot create folder" + (ec ? ": " + ec.message() : std::string()));
   remove_stale_temporaries(o.out_dir);
-  remove_stale_temporaries((fs::path(o.out_dir) / "luts").string());
+  remove_stale_temporaries(luts.string());
   for (const auto& entry : fs::directory_iterator(fs::path(o.out_dir) / "images", ec))
     if (entry.is_directory(ec)) remove_stale_temporaries(entry.path().string());
   const json previous = read_json_file(fs::path(o.out_dir) / "report.json");
@@ -262,7 +265,7 @@ json run_report(const ReportOptions& o) {
     const fs::path images = fs::path(o.out_dir) / "images" / name;
     try {
       const auto bake_start = std::chrono::steady_clock::now();
-      const BakeOutcome baked = bake_material(source, name, (fs::path(o.out_dir) / "luts").string(), o.bake, fitter);
+      const BakeOutcome baked = bake_material(source, name, luts.string(), o.bake, fitter);
       if (baked.status == BakeOutcome::Status::failed) throw Error(baked.error);
       const double bake_seconds = seconds_since(bake_start);
       // An entry is reused when its bake, the render settings and facetfit are unchanged.
@@ -274,7 +277,7 @@ json run_report(const ReportOptions& o) {
       } else {
         fs::create_directories(images, ec);
         fs::remove(images / kCompleteStamp, ec);
-        const std::string lut = (fs::path(o.out_dir) / "luts" / (name + ".exr")).string();
+        const std::string lut = (luts / (name + ".exr")).string();
         json entry;
         entry["name"] = name;
         entry["source"] = source;

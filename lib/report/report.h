@@ -15,6 +15,7 @@ namespace facetfit {
 struct ReportOptions {
   std::vector<std::string> inputs;  // files, folders, globs, builtin:...
   std::string out_dir;
+  std::string luts_dir;  // the bake cache; empty: out_dir/luts (shards of a farm share one)
   int size = 128;   // image side, pixels
   int spp = 32;
   std::uint64_t max_memory = 0;  // per render (render/renderer.h); 0: half of the machine's
