@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <chrono>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <thread>
@@ -414,6 +415,35 @@ TEST(Bake, ConcurrentBakesIntoOneFolderStayConsistent) {
       EXPECT_EQ(float(read_lut(dir + "/" + name + ".exr").meta.tolerance), float(sidecar["tolerance"].get<double>())) << name << " round " << round;
     }
   }
+}
+
+}  // namespace
+}  // namespace facetfit
+
+namespace facetfit {
+namespace {
+
+TEST(ReportCli, LocalFarmPublishesTheSameReportAsOneProcess) {
+  TempDir dir;
+  const std::string settings = " builtin:gold-ggx-0.15 builtin:red-plastic builtin:silver-ggx-0.60 --refine none --size 16 --spp 2 -o ";
+  ASSERT_EQ(facetfit("-q report" + settings + dir.file("one")).status, 0);
+  const RunResult farm = facetfit("-q report" + settings + dir.file("farm") + " --farm local --shards 2");
+  ASSERT_EQ(farm.status, 0) << farm.err;
+  const auto delta_e = [](const nlohmann::json& r) {
+    std::map<std::string, nlohmann::json> m;
+    for (const auto& e : r["materials"]) m[e["name"].get<std::string>()] = e["delta_e"];
+    return m;
+  };
+  EXPECT_EQ(delta_e(read_json(dir.file("one") + "/report.json")), delta_e(read_json(dir.file("farm") + "/report.json")));
+  // The plan as sbatch scripts; a farm splits the database itself, so --shard is a usage error.
+  const RunResult dry = facetfit("report builtin: --farm slurm --shards 3 --partition night --time 1:00:00 --sbatch-arg=--qos=low --dry-run -o " +
+                                 dir.file("plan"));
+  EXPECT_EQ(dry.status, 0) << dry.err;
+  for (const char* line : {"sbatch --array=1-3", "#SBATCH --partition=night", "#SBATCH --time=1:00:00", "#SBATCH --qos=low", "3) (",
+                           "--dependency=afterok", "'report' 'merge'"})
+    EXPECT_NE(dry.out.find(line), std::string::npos) << line << "\n" << dry.out;
+  EXPECT_FALSE(std::filesystem::exists(dir.file("plan") + "/.farm")) << "a dry run writes nothing";
+  EXPECT_EQ(facetfit("report builtin: --farm local --shard 2/3 -o " + dir.file("x")).status, 2);
 }
 
 }  // namespace

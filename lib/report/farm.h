@@ -10,8 +10,8 @@
 namespace facetfit {
 
 // Splits weighted items over `shards` bins, longest first onto the least loaded bin (ties: the name, then
-// the lower bin), so that the largest bin is within one item of the best split. Empty bins are dropped;
-// each bin keeps its items sorted by name.
+// the lower bin): the largest bin is at most 4/3 of the best split's (Graham's bound). Empty bins are
+// dropped; each bin keeps its items sorted by name.
 std::vector<std::vector<std::string>> balance_shards(std::vector<std::pair<std::string, double>> costs, int shards);
 
 // Seconds each material took in a previous report.json (bake and every render), by source; materials it
