@@ -16,13 +16,16 @@ stop() {
     [[ -f "$dir/$daemon.pid" ]] && kill -9 "$(cat "$dir/$daemon.pid")" 2>/dev/null
     rm -f "$dir/$daemon.pid"
   done
+  pkill -9 -f -- "-f $dir/slurm.conf" 2>/dev/null  # any that had not written its pid file yet
+  # munged too, if this script started it.
+  if [[ -f "$dir/munged.started" ]]; then pkill -x munged; rm -f "$dir/munged.started"; fi
   return 0
 }
 
 if [[ $action == stop ]]; then stop; exit 0; fi
 
 [[ $(id -u) -eq 0 ]] || skip "the Slurm test cluster needs root (slurmd runs jobs as their user)"
-for tool in munged slurmctld slurmd sbatch squeue scancel; do
+for tool in munged munge unmunge slurmctld slurmd sbatch squeue scancel sinfo; do
   command -v "$tool" >/dev/null || skip "$tool not installed (Debian packages slurm-wlm and munge; make deps installs them)"
 done
 mkdir -p "$dir/state" "$dir/spool" "$dir/log"
@@ -58,11 +61,18 @@ PartitionName=test Nodes=$host Default=YES MaxTime=INFINITE State=UP OverSubscri
 CONF
 export SLURM_CONF=$dir/slurm.conf
 # munge: the packaged key, a daemon if none is running.
-if ! pgrep -x munged >/dev/null; then
+munge_works() { munge -n 2>/dev/null | unmunge >/dev/null 2>&1; }
+if ! munge_works; then  # (a process list may show a dead munged: ask it instead)
   [[ -f /etc/munge/munge.key ]] || skip "no /etc/munge/munge.key"
   mkdir -p /run/munge && chown munge:munge /run/munge 2>/dev/null
   /usr/sbin/munged --force >"$dir/log/munged.log" 2>&1 || skip "munged does not start: $(tail -1 "$dir/log/munged.log")"
+  touch "$dir/munged.started"
 fi
+for _ in $(seq 1 50); do  # munged answers a moment after it forks
+  munge_works && break
+  sleep 0.2
+done
+munge_works || { stop; skip "munged does not answer"; }
 slurmctld -c -f "$SLURM_CONF" >"$dir/log/start.log" 2>&1 || { stop; skip "slurmctld does not start: $(tail -1 "$dir/log/start.log")"; }
 slurmd -f "$SLURM_CONF" >>"$dir/log/start.log" 2>&1 || { stop; skip "slurmd does not start: $(tail -1 "$dir/log/start.log")"; }
 for _ in $(seq 1 30); do
