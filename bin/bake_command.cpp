@@ -17,8 +17,9 @@
 #include "io/folder_lock.h"
 #include "io/input.h"
 #include "lut/bake.h"
-#include "render/scene.h"
+#include "lut/record.h"
 #include "progress.h"
+#include "render/scene.h"
 
 namespace facetfit::cli {
 
@@ -167,7 +168,7 @@ void run_bake(const BakeArgs& args, Context& ctx) {
     }
   }
   try {
-    write_file_atomic((fs::path(args.out_dir) / "index.json").string(), index.dump(2) + "\n");
+    write_file_atomic((fs::path(args.out_dir) / "index.json").string(), json_text(index, 2) + "\n");
   } catch (const Error& e) {
     report_error(e.what());
     status = 1;

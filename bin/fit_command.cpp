@@ -61,7 +61,7 @@ void run_fit(const FitArgs& args, Context& ctx) {
       }
       for (const std::string& w : result.warnings) std::fprintf(stderr, "facetfit: warning: %s: %s\n", source.c_str(), w.c_str());
       if (args.json)
-        std::printf("%s\n", fit_record(source, result, seconds).dump().c_str());
+        std::printf("%s\n", json_text(fit_record(source, result, seconds)).c_str());
       else
         print_row(source_name(source), result, seconds);
       std::fflush(stdout);

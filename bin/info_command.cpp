@@ -6,8 +6,8 @@
 #include "commands.h"
 #include "core/error.h"
 #include "io/input.h"
-#include "lut/record.h"
 #include "lut/lut.h"
+#include "lut/record.h"
 
 namespace facetfit::cli {
 
@@ -105,7 +105,7 @@ void add_info_command(CLI::App& app, Context& ctx) {
       if (is_builtin(*path) || ext == ".binary" || ext == ".bsdf")
         throw Error(*path + ": a measurement, not a LUT: `facetfit fit` it, or `facetfit bake` it and run info on the LUT");
       const Lut lut = read_lut(*path);
-      if (*json) std::printf("%s\n", info_json(lut).dump().c_str());
+      if (*json) std::printf("%s\n", json_text(info_json(lut)).c_str());
       else print_info(lut);
     } catch (const Error& e) {
       report_error(e.what());

@@ -9,6 +9,7 @@
 #include "core/error.h"
 #include "farm.h"
 #include "io/input.h"
+#include "lut/record.h"
 #include "progress.h"
 #include "report/report.h"
 
@@ -79,7 +80,7 @@ void run_farm_command(const ReportArgs& args, Context& ctx) {
       std::printf("# %s/.farm/merge.sbatch: sbatch --dependency=afterok:ARRAY_JOB_ID merge.sbatch\n%s", out_dir.c_str(),
                   slurm_merge_script(plan, args.slurm).c_str());
     } else {
-      std::printf("%s\n", plan.to_json().dump(2).c_str());
+      std::printf("%s\n", json_text(plan.to_json(), 2).c_str());
     }
     return;
   }

@@ -448,3 +448,23 @@ TEST(ReportCli, LocalFarmPublishesTheSameReportAsOneProcess) {
 
 }  // namespace
 }  // namespace facetfit
+
+namespace facetfit {
+namespace {
+
+TEST(Cli, FileNamesThatAreNotUtf8AreWrittenNotRefused) {
+  // A name's bytes need not be UTF-8; JSON must be. fit --json and bake wrote nothing and said
+  // "internal: [json.exception.type_error.316] invalid UTF-8 byte": now the byte becomes U+FFFD.
+  TempDir dir;
+  const std::string name = "\"" + dir.path().string() + "/m$(printf '\\376').binary\"";
+  ASSERT_EQ(facetfit("convert builtin:gold-ggx-0.15 -o " + name).status, 0);
+  const RunResult fit = facetfit("fit --refine none --json " + name);
+  ASSERT_EQ(fit.status, 0) << fit.err;
+  EXPECT_NE(nlohmann::json::parse(fit.out)["source"].get<std::string>().find("m\xEF\xBF\xBD.binary"), std::string::npos);
+  const RunResult bake = facetfit("bake --refine none -o " + dir.file("luts") + " " + name);
+  EXPECT_EQ(bake.status, 0) << bake.err;
+  EXPECT_EQ(read_json(dir.file("luts") + "/index.json")["materials"].size(), 1u);
+}
+
+}  // namespace
+}  // namespace facetfit

@@ -3,6 +3,7 @@
 
 #include <cmath>
 
+#include "lut/lut.h"
 #include "model/analytic.h"
 #include "model/tabulated.h"
 #include "render/renderer.h"
@@ -152,6 +153,9 @@ TEST(Render, ObjMeshes) {
   read_obj(dir.file("quad.obj"), p, idx);
   EXPECT_EQ(p.size(), 12u);
   EXPECT_EQ(idx, (std::vector<unsigned>{0, 1, 2, 0, 2, 3}));
+  // Devices are refused before reading (/dev/zero is one endless line; a LUT or map on it hung OpenImageIO).
+  EXPECT_NE(test::error_of([&] { read_obj("/dev/zero", p, idx); }).find("/dev/zero: not a regular file"), std::string::npos);
+  EXPECT_NE(test::error_of([&] { read_lut("/dev/zero"); }).find("/dev/zero: not a regular file"), std::string::npos);
   test::write_bytes(dir.file("bad.obj"), "v 0 0 0\nf 1 2 3\n");
   p.clear();
   idx.clear();

@@ -137,6 +137,9 @@ void check_exr_header(const std::string& path) {
 }  // namespace
 
 std::unique_ptr<OIIO::ImageInput> open_image(const std::string& path, const std::string& fallback) {
+  // A device or a FIFO never ends: OpenImageIO would try every format reader on it, forever.
+  std::error_code ec;
+  if (std::filesystem::exists(path, ec) && !std::filesystem::is_regular_file(path, ec)) fail(path, "not a regular file");
   check_exr_header(path);
   auto in = OIIO::ImageInput::open(path);
   if (!in) {

@@ -39,7 +39,7 @@ std::string bake_cache_key(const std::string& sha256, const BakeOptions& o) {
   k["merl_bins"] = to_string(o.fit.merl_bins);
   k["tolerance"] = o.tolerance;
   k["sampling"] = o.with_sampling;
-  const std::string text = k.dump();
+  const std::string text = json_text(k);
   return sha256_hex(text.data(), text.size());
 }
 
@@ -117,7 +117,7 @@ BakeOutcome bake_material(const std::string& source, const std::string& name, co
     r["facetfit_version"] = FACETFIT_VERSION;
     r["cache_key"] = key;
     // The sidecar goes last: its presence with this key is what marks the bake complete.
-    write_file_atomic(json_path.string(), r.dump(2) + "\n");
+    write_file_atomic(json_path.string(), json_text(r, 2) + "\n");
     out.status = BakeOutcome::Status::baked;
   } catch (const Error& e) {
     out.status = BakeOutcome::Status::failed;

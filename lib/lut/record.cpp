@@ -11,6 +11,10 @@ nlohmann::json parametric_json(double alpha, const Rgb& body, const Rgb& f0, con
   return {{"alpha", alpha}, {"body", rgb(body)}, {"f0", rgb(f0)}, {"f82", rgb(f82)}, {"coat", coat_json(coat)}, {"error", error}};
 }
 
+std::string json_text(const nlohmann::json& j, int indent) {
+  return j.dump(indent, ' ', false, nlohmann::json::error_handler_t::replace);
+}
+
 nlohmann::json fit_record(const std::string& source, const FitResult& fit, double seconds) {
   const auto rgb = [](const Rgb& c) { return nlohmann::json{c.r, c.g, c.b}; };
   nlohmann::json j;

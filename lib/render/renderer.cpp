@@ -7,6 +7,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <limits>
 #include <sstream>
@@ -62,6 +63,9 @@ struct Geometry {
 }  // namespace
 
 void read_obj(const std::string& path, std::vector<float>& positions, std::vector<unsigned>& indices) {
+  // A device or a FIFO would be read forever (/dev/zero is one endless line).
+  std::error_code ec;
+  if (std::filesystem::exists(path, ec) && !std::filesystem::is_regular_file(path, ec)) fail(path, "not a regular file");
   std::ifstream in(path);
   if (!in) fail(path, "cannot open mesh");
   std::string line;

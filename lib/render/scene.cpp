@@ -13,6 +13,7 @@
 #include "io/input.h"
 #include "io/rgl.h"
 #include "lut/lut.h"
+#include "lut/record.h"
 #include "model/analytic.h"
 #include "model/builtin.h"
 #include "model/parametric.h"
@@ -271,7 +272,7 @@ std::vector<std::string> scene_materials(const std::string& scene_path) {
     std::string file;
     if (item.is_string()) file = item.get<std::string>();
     else if (item.is_object() && item.contains("file") && item["file"].is_string()) file = item["file"].get<std::string>();
-    else fail(scene_path, "material entry " + item.dump() + " is neither a path nor an object with \"file\"");
+    else fail(scene_path, "material entry " + json_text(item) + " is neither a path nor an object with \"file\"");
     add(resolve_source(base, file));
   }
   return out;

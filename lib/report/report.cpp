@@ -13,6 +13,7 @@
 #include "io/input.h"
 #include "io/sha256.h"
 #include "lut/lut.h"
+#include "lut/record.h"
 #include "render/renderer.h"
 #include "report/plots.h"
 
@@ -195,7 +196,7 @@ std::string report_html(const json& report) {
 // report.json last: its presence says the page and every image it names are whole.
 void write_outputs(const json& report, const std::string& out_dir) {
   write_file_atomic((fs::path(out_dir) / "index.html").string(), report_html(report));
-  write_file_atomic((fs::path(out_dir) / "report.json").string(), report.dump(2) + "\n");
+  write_file_atomic((fs::path(out_dir) / "report.json").string(), json_text(report, 2) + "\n");
 }
 
 // images/NAME/complete holds the key of the entry whose images are all in the folder: written after the
@@ -269,7 +270,7 @@ json run_report(const ReportOptions& o) {
       if (baked.status == BakeOutcome::Status::failed) throw Error(baked.error);
       const double bake_seconds = seconds_since(bake_start);
       // An entry is reused when its bake, the render settings and facetfit are unchanged.
-      const std::string key_text = baked.record["cache_key"].get<std::string>() + "|" + report["settings"].dump() + "|" + FACETFIT_VERSION;
+      const std::string key_text = baked.record["cache_key"].get<std::string>() + "|" + json_text(report["settings"]) + "|" + FACETFIT_VERSION;
       const std::string key = sha256_hex(key_text.data(), key_text.size());
       const auto old = reusable.find(name);
       if (!o.force && old != reusable.end() && old->second.value("key", "") == key && images_complete(images, key)) {

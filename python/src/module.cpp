@@ -36,7 +36,7 @@
 namespace facetfit::python {
 namespace {
 
-py::object to_python(const nlohmann::json& j) { return py::module_::import("json").attr("loads")(j.dump()); }
+py::object to_python(const nlohmann::json& j) { return py::module_::import("json").attr("loads")(json_text(j)); }
 std::string to_json_text(const py::object& o) { return py::module_::import("json").attr("dumps")(o).cast<std::string>(); }
 
 // A measured material as the fit reads it: the MERL-layout table of any input.
