@@ -201,6 +201,13 @@ std::string with_attribute_size(std::string bytes, const std::string& name, std:
   return bytes;
 }
 
+// The bytes of `file` with the data window's xMax set (fuzz_env's finding: OpenEXR sizes buffers by it).
+std::string wider(std::string bytes, std::int32_t x_max) {
+  const std::size_t at = bytes.find(std::string("dataWindow") + '\0' + "box2i" + '\0');
+  std::memcpy(&bytes[at + 11 + 6 + 4 + 8], &x_max, 4);
+  return bytes;
+}
+
 TEST(Lut, HostileOpenExrHeadersAreRefusedBeforeOpenExrAllocates) {
   // fuzz_lut's findings: OpenEXR 3.1 allocates what a header claims (a string attribute of 1.6 GB in a
   // 6 KB file took 1.7 GB), and parses fixed-size values and channel lists by their own rules, so a header
@@ -214,6 +221,7 @@ TEST(Lut, HostileOpenExrHeadersAreRefusedBeforeOpenExrAllocates) {
       {with_attribute_size(good, "compression", 513), "attribute 'compression' of type compression has 513 bytes, not 1"},
       {with_attribute_size(good, "channels", 40), "attribute 'channels' of type chlist does not match its size"},
       {with_attribute_size(good, "dataWindow", -5), "attribute 'dataWindow' claims -5 bytes"},
+      {wider(good, 8388623), "a 8388624 x 3 image; at most 65536 x 65536"},
   };
   for (const auto& [bytes, message] : cases) {
     test::write_bytes(dir.file("bad.exr"), bytes);

@@ -118,6 +118,10 @@ void check_exr_header(const std::string& path) {
   if (multipart || !has_window) return;  // OpenImageIO refuses a header without a data window
   const std::int64_t width = std::int64_t(window[2]) - window[0] + 1, height = std::int64_t(window[3]) - window[1] + 1;
   if (width < 1 || height < 1) fail(path, "OpenEXR header: empty data window");
+  // OpenEXR sizes its line buffers by the width as it opens the file: nothing facetfit reads is wider or
+  // taller than 65536 (an 8-million-pixel-wide 416-byte file took seconds to open and close).
+  if (width > 65536 || height > 65536)
+    fail(path, "OpenEXR header: a " + std::to_string(width) + " x " + std::to_string(height) + " image; at most 65536 x 65536");
   // Scanlines per chunk of each compression (OpenEXR's table), or tiles of the first level.
   static constexpr int kLines[] = {1, 1, 1, 16, 32, 16, 32, 32, 32, 256};
   std::uint64_t chunks;
