@@ -1,6 +1,7 @@
 #include "io/image_file.h"
 
 #include <algorithm>
+#include <cerrno>
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
@@ -13,6 +14,8 @@
 namespace facetfit {
 
 namespace {
+
+std::string first_line(const std::string& text) { return text.substr(0, text.find('\n')); }
 
 // Whether a channel list, read as OpenEXR reads it (entries of a name, 16 bytes of type, linearity and
 // sampling, until an empty name), ends exactly at the end of its value.
@@ -157,8 +160,13 @@ void write_image_atomic(const std::string& path, const OIIO::ImageSpec& spec, co
   AtomicFile out(path);
   auto image = OIIO::ImageOutput::create(out.temp_path());
   if (!image) fail(path, "cannot write: " + OIIO::geterror());
-  if (!image->open(out.temp_path(), spec) || !image->write_image(spec.format, pixels) || !image->close())
-    fail(path, "cannot write: " + image->geterror());
+  errno = 0;
+  if (!image->open(out.temp_path(), spec)) {
+    // OpenImageIO names the temporary and not the reason; the system's reason says more.
+    const int error = errno;
+    fail(path, "cannot write: " + (error != 0 ? std::string(std::strerror(error)) : first_line(image->geterror())));
+  }
+  if (!image->write_image(spec.format, pixels) || !image->close()) fail(path, "cannot write: " + first_line(image->geterror()));
   image.reset();
   // Some writers (PNG) report no error when the disk fills and leave a truncated file: read it back
   // whole before it takes the target's name.
