@@ -160,10 +160,16 @@ std::string submit(const std::string& script_path, const std::string& options) {
   return id;
 }
 
+// Until squeue no longer lists the job (or no longer knows it). A controller that cannot be reached for
+// a minute is an error, not a reason to wait forever.
 void wait_for(const std::string& job) {
+  int unreachable = 0;
   for (std::string out;; std::this_thread::sleep_for(std::chrono::seconds(2))) {
-    if (run_shell("squeue -h -j " + job + " -o %i 2>/dev/null", &out) == 0 && out.find_first_not_of(" \n") == std::string::npos) return;
-    if (run_shell("squeue -h -j " + job + " -o %i 2>&1", &out) != 0 && out.find("Invalid job id") != std::string::npos) return;
+    const int status = run_shell("squeue -h -j " + job + " -o %i 2>&1", &out);
+    if (status == 0 && out.find_first_not_of(" \n") == std::string::npos) return;
+    if (status != 0 && out.find("Invalid job id") != std::string::npos) return;
+    unreachable = status == 0 ? 0 : unreachable + 1;
+    if (unreachable == 30) throw Error("squeue: " + out.substr(0, out.find('\n')) + " (for a minute, waiting for job " + job + ")");
   }
 }
 
