@@ -5,7 +5,6 @@
 
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <map>
 #include <optional>
 #include <set>
@@ -136,8 +135,7 @@ void run_bake(const BakeArgs& args, Context& ctx) {
   }
   for (auto& o : outcomes) {
     if (o.status == BakeOutcome::Status::failed) continue;
-    std::ifstream sidecar(fs::path(args.out_dir) / (o.name + ".json"));
-    nlohmann::json on_disk = nlohmann::json::parse(sidecar, nullptr, false);
+    nlohmann::json on_disk = read_json_file((fs::path(args.out_dir) / (o.name + ".json")).string());
     if (on_disk.is_object() && on_disk.contains("cache_key")) o.record = std::move(on_disk);
   }
   nlohmann::json index;
@@ -149,8 +147,7 @@ void run_bake(const BakeArgs& args, Context& ctx) {
   std::set<std::string> luts_now;
   for (const auto& o : outcomes)
     if (o.status != BakeOutcome::Status::failed) luts_now.insert(o.record.value("lut", ""));
-  std::ifstream previous_file(fs::path(args.out_dir) / "index.json");
-  const nlohmann::json previous = nlohmann::json::parse(previous_file, nullptr, false);
+  const nlohmann::json previous = read_json_file((fs::path(args.out_dir) / "index.json").string());
   if (previous.is_object() && previous.contains("materials") && previous["materials"].is_array())
     for (const auto& m : previous["materials"]) {
       const std::string lut = m.is_object() ? m.value("lut", "") : "";

@@ -10,6 +10,7 @@
 
 #include "core/error.h"
 #include "io/atomic_file.h"
+#include "io/input.h"
 
 namespace facetfit {
 
@@ -144,14 +145,12 @@ void check_exr_header(const std::string& path) {
 }  // namespace
 
 std::unique_ptr<OIIO::ImageInput> open_image(const std::string& path, const std::string& fallback) {
-  // A device or a FIFO never ends: OpenImageIO would try every format reader on it, forever.
-  std::error_code ec;
-  if (std::filesystem::exists(path, ec) && !std::filesystem::is_regular_file(path, ec)) fail(path, "not a regular file");
+  require_regular_file(path);  // OpenImageIO would probe a device with every format reader, forever
   check_exr_header(path);
   auto in = OIIO::ImageInput::open(path);
   if (!in) {
     const std::string why = OIIO::geterror();
-    fail(path, why.empty() ? fallback : why.substr(0, why.find('\n')));
+    fail(path, why.empty() ? fallback : first_line(why));
   }
   return in;
 }
@@ -175,7 +174,7 @@ void write_image_atomic(const std::string& path, const OIIO::ImageSpec& spec, co
   if (!check || !check->read_image(0, 0, 0, check->spec().nchannels, check->spec().format, back.data())) {
     const std::string why = check ? check->geterror() : OIIO::geterror();
     fail(path, "cannot write: the written file does not read back whole (disk full?)" +
-                   (why.empty() ? std::string() : ": " + why.substr(0, why.find('\n'))));
+                   (why.empty() ? std::string() : ": " + first_line(why)));
   }
   check->close();
   out.commit();

@@ -79,6 +79,11 @@ std::vector<std::string> expand_inputs(const std::vector<std::string>& args) {
   return out;
 }
 
+void require_regular_file(const std::string& path) {
+  std::error_code ec;
+  if (fs::exists(path, ec) && !fs::is_regular_file(path, ec)) fail(path, "not a regular file");
+}
+
 std::string source_name(const std::string& source) {
   if (is_builtin(source)) return source.substr(std::string(kBuiltinPrefix).size());
   return fs::path(source).stem().string();

@@ -35,6 +35,10 @@ bool is_builtin(const std::string& source);
 // absolute paths stay as they are.
 std::string resolve_source(const std::string& base_dir, const std::string& source);
 
+// Throws Error("<path>: not a regular file") for a device, a FIFO or a folder, which a reader would read
+// without end (/dev/zero) or probe forever; a missing path is left to the reader's own message.
+void require_regular_file(const std::string& path);
+
 // The short name of a source: file stem, or the built-in's name.
 std::string source_name(const std::string& source);
 

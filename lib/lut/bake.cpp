@@ -4,7 +4,6 @@
 
 #include <chrono>
 #include <filesystem>
-#include <fstream>
 
 #include "core/error.h"
 #include "io/atomic_file.h"
@@ -49,9 +48,8 @@ namespace {
 std::optional<nlohmann::json> cached_record(const fs::path& json_path, const fs::path& lut_path, const std::string& key) {
   std::error_code ec;
   if (!fs::is_regular_file(json_path, ec) || !fs::is_regular_file(lut_path, ec)) return std::nullopt;
-  std::ifstream in(json_path);
-  const nlohmann::json j = nlohmann::json::parse(in, nullptr, false);
-  if (j.is_discarded() || !j.is_object() || j.value("cache_key", "") != key) return std::nullopt;
+  const nlohmann::json j = read_json_file(json_path.string());
+  if (!j.is_object() || j.value("cache_key", "") != key) return std::nullopt;
   return j;
 }
 

@@ -1,5 +1,7 @@
 #include "lut/record.h"
 
+#include <fstream>
+
 namespace facetfit {
 
 nlohmann::json coat_json(const Coat& coat) {
@@ -13,6 +15,13 @@ nlohmann::json parametric_json(double alpha, const Rgb& body, const Rgb& f0, con
 
 std::string json_text(const nlohmann::json& j, int indent) {
   return j.dump(indent, ' ', false, nlohmann::json::error_handler_t::replace);
+}
+
+nlohmann::json read_json_file(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) return nullptr;
+  nlohmann::json j = nlohmann::json::parse(in, nullptr, false);
+  return j.is_discarded() ? nlohmann::json(nullptr) : j;
 }
 
 nlohmann::json fit_record(const std::string& source, const FitResult& fit, double seconds) {

@@ -8,13 +8,17 @@
 
 namespace facetfit {
 
-// Keys: source, alpha_ggx, alpha_beckmann, f0, f82 (of the tabulated representation), refine, body,
-// coat, error, error_extraction, ggx / beckmann / lsq (parametric_json), warnings, iterations, residual,
-// seconds. A meaningless fit has null parameters (JSON has no NaN).
 // The JSON text of `j` (indented when indent >= 0). Strings that are not UTF-8 (a file name's bytes)
 // are written with U+FFFD in place of the bad bytes rather than failing the whole write.
 std::string json_text(const nlohmann::json& j, int indent = -1);
 
+// The JSON a file holds (a sidecar, index.json, report.json); null when it is absent or not JSON, which
+// the callers all treat as "nothing there yet".
+nlohmann::json read_json_file(const std::string& path);
+
+// Keys: source, alpha_ggx, alpha_beckmann, f0, f82 (of the tabulated representation), refine, body,
+// coat, error, error_extraction, ggx / beckmann / lsq (parametric_json), warnings, iterations, residual,
+// seconds. A meaningless fit has null parameters (JSON has no NaN).
 nlohmann::json fit_record(const std::string& source, const FitResult& fit, double seconds);
 
 // A coat as {alpha, f0}, null when absent; a parametric fit as {alpha, body, f0, f82, coat, error}.

@@ -7,14 +7,14 @@
 
 #include <chrono>
 #include <cmath>
-#include <filesystem>
 #include <fstream>
 #include <limits>
 #include <sstream>
 
 #include "core/error.h"
-#include "io/image_file.h"
 #include "core/memory_budget.h"
+#include "io/image_file.h"
+#include "io/input.h"
 #include "render/environment.h"
 
 namespace facetfit {
@@ -63,9 +63,7 @@ struct Geometry {
 }  // namespace
 
 void read_obj(const std::string& path, std::vector<float>& positions, std::vector<unsigned>& indices) {
-  // A device or a FIFO would be read forever (/dev/zero is one endless line).
-  std::error_code ec;
-  if (std::filesystem::exists(path, ec) && !std::filesystem::is_regular_file(path, ec)) fail(path, "not a regular file");
+  require_regular_file(path);  // /dev/zero is one endless line
   std::ifstream in(path);
   if (!in) fail(path, "cannot open mesh");
   std::string line;

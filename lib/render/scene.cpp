@@ -118,8 +118,7 @@ MaterialDesc parse_material(const std::string& name, const json& j, const std::s
 }  // namespace
 
 SceneDesc parse_scene(const std::string& path) {
-  std::error_code ec;
-  if (fs::exists(path, ec) && !fs::is_regular_file(path, ec)) fail(path, "not a regular file");
+  require_regular_file(path);
   std::ifstream in(path);
   if (!in) fail(path, "cannot open scene");
   std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());

@@ -34,13 +34,6 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
-json read_json_file(const fs::path& path) {
-  std::ifstream in(path);
-  if (!in) return json();
-  json j = json::parse(in, nullptr, false);
-  return j.is_discarded() ? json() : j;
-}
-
 // The scene every material is rendered in: the default sphere under the built-in sky.
 SceneDesc report_scene(const MaterialDesc& m, const ReportOptions& o) {
   SceneDesc s = default_scene(m);
@@ -240,7 +233,7 @@ json run_report(const ReportOptions& o) {
   remove_stale_temporaries(luts.string());
   for (const auto& entry : fs::directory_iterator(fs::path(o.out_dir) / "images", ec))
     if (entry.is_directory(ec)) remove_stale_temporaries(entry.path().string());
-  const json previous = read_json_file(fs::path(o.out_dir) / "report.json");
+  const json previous = read_json_file((fs::path(o.out_dir) / "report.json").string());
   std::map<std::string, json> reusable;
   if (previous.is_object() && previous.contains("materials"))
     for (const json& m : previous["materials"]) reusable[m["name"].get<std::string>()] = m;
@@ -330,12 +323,12 @@ json run_report(const ReportOptions& o) {
 json merge_reports(const std::vector<std::string>& parts, const std::string& out_dir) {
   std::error_code ec;
   fs::create_directories(fs::path(out_dir) / "images", ec);
-  const json previous = read_json_file(fs::path(out_dir) / "report.json");
+  const json previous = read_json_file((fs::path(out_dir) / "report.json").string());
   json merged;
   merged["materials"] = json::array();
   merged["failures"] = json::array();
   for (const std::string& part : parts) {
-    const json r = read_json_file(fs::path(part) / "report.json");
+    const json r = read_json_file((fs::path(part) / "report.json").string());
     if (!r.is_object() || !r.contains("materials")) fail(part, "no report.json (not a facetfit report folder)");
     if (merged.contains("settings") && merged["settings"] != r["settings"]) fail(part, "rendered with other settings than the first part");
     merged["facetfit_version"] = r["facetfit_version"];
