@@ -3,11 +3,10 @@
 // only when every shard succeeded.
 #include "farm.h"
 
+#include <fcntl.h>
 #include <spawn.h>
 #include <sys/wait.h>
 #include <unistd.h>
-
-#include <fcntl.h>
 
 #include <chrono>
 #include <cstdio>
@@ -83,6 +82,13 @@ int run_shell(const std::string& command, std::string* output) {
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
+// The exit status of a spawned process (spawn's pid), or -1 when it did not start or did not exit.
+int exit_status(pid_t pid) {
+  int status = 0;
+  if (pid < 0 || ::waitpid(pid, &status, 0) != pid || !WIFEXITED(status)) return -1;
+  return WEXITSTATUS(status);
+}
+
 std::string done_marker(const FarmPlan& plan, std::size_t k) { return plan.part(k) + ".done"; }
 
 }  // namespace
@@ -96,8 +102,7 @@ int run_farm_local(const FarmPlan& plan, const Context& ctx) {
     for (std::size_t k : todo) running.emplace_back(k, spawn(plan.commands[k], plan.part(k) + ".log"));
     std::vector<std::size_t> failed;
     for (const auto& [k, pid] : running) {
-      int status = 0;
-      if (pid < 0 || ::waitpid(pid, &status, 0) != pid || !WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+      if (exit_status(pid) != 0) {
         failed.push_back(k);
         if (!ctx.quiet() || attempt == 1)
           std::fprintf(stderr, "facetfit: %s: shard %zu (%s) failed%s; its log: %s.log\n", attempt == 0 ? "warning" : "error", k + 1,
@@ -111,11 +116,12 @@ int run_farm_local(const FarmPlan& plan, const Context& ctx) {
                  " shards failed twice");
     return 1;
   }
-  const pid_t merge = spawn(plan.merge, plan.parts_dir + "/merge.log");
-  int status = 0;
-  if (merge < 0 || ::waitpid(merge, &status, 0) != merge || !WIFEXITED(status)) return 1;
-  if (WEXITSTATUS(status) != 0) report_error(plan.out_dir + ": merge failed; its log: " + plan.parts_dir + "/merge.log");
-  return WEXITSTATUS(status);
+  const int status = exit_status(spawn(plan.merge, plan.parts_dir + "/merge.log"));
+  if (status != 0 && status != 3) {
+    report_error(plan.out_dir + ": merge failed; its log: " + plan.parts_dir + "/merge.log");
+    return 1;
+  }
+  return status;
 }
 
 std::string slurm_array_script(const FarmPlan& plan, const SlurmSettings& s) {

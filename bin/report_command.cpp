@@ -36,15 +36,20 @@ struct ReportArgs {
   SlurmSettings slurm;
 };
 
+// A number as an argument that reads back as the same double (std::to_string keeps 6 decimals).
+std::string exact(double x) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.17g", x);
+  return text;
+}
+
 // The settings every shard of a farm passes on, as arguments of `report`.
 std::vector<std::string> shard_settings(const ReportArgs& a) {
-  std::vector<std::string> s = {"--size", std::to_string(a.size), "--spp", std::to_string(a.spp), "--tolerance", std::to_string(a.tolerance),
+  std::vector<std::string> s = {"--size", std::to_string(a.size), "--spp", std::to_string(a.spp), "--tolerance", exact(a.tolerance),
                                 "--smith", a.settings.smith, "--resolution", std::to_string(a.settings.resolution),
                                 "--refine", a.settings.refine, "--merl-bins", a.settings.merl_bins,
-                                "--max-iterations", std::to_string(a.settings.max_iterations)};
-  char tolerance[32];
-  std::snprintf(tolerance, sizeof tolerance, "%.17g", a.settings.iteration_tolerance);
-  s.insert(s.end(), {"--iteration-tolerance", tolerance});
+                                "--max-iterations", std::to_string(a.settings.max_iterations),
+                                "--iteration-tolerance", exact(a.settings.iteration_tolerance)};
   if (a.max_memory > 0) s.insert(s.end(), {"--max-memory", std::to_string(a.max_memory)});
   if (a.force) s.push_back("--force");
   return s;
@@ -71,7 +76,8 @@ void run_farm_command(const ReportArgs& args, Context& ctx) {
   const std::string out_dir = fs::absolute(args.out_dir).lexically_normal().string();
   std::vector<std::string> absolute;
   for (const std::string& s : sources) absolute.push_back(is_builtin(s) ? s : fs::absolute(s).lexically_normal().string());
-  const FarmPlan plan = plan_report_farm(absolute, args.shards, out_dir, shard_settings(args),
+  const std::string luts_dir = args.luts_dir.empty() ? "" : fs::absolute(args.luts_dir).lexically_normal().string();
+  const FarmPlan plan = plan_report_farm(absolute, args.shards, out_dir, luts_dir, shard_settings(args),
                                          args.fail_on_regression ? std::vector<std::string>{"--fail-on-regression"} : std::vector<std::string>{});
   if (args.dry_run) {
     if (args.farm == "slurm") {

@@ -162,10 +162,12 @@ TEST(Farm, CostsComeFromThePreviousReportAndDefaultToItsMedian) {
 }
 
 TEST(Farm, PlanCommandsShareTheBakeCacheAndMergeEveryPart) {
-  const FarmPlan plan = plan_report_farm({"builtin:a", "builtin:b", "builtin:c"}, 2, "/r", {"--size", "16"}, {"--fail-on-regression"});
+  const FarmPlan plan = plan_report_farm({"builtin:a", "builtin:b", "builtin:c"}, 2, "/r", "", {"--size", "16"}, {"--fail-on-regression"});
   ASSERT_EQ(plan.shards.size(), 2u);
   EXPECT_EQ(plan.commands[0], (std::vector<std::string>{"report", "builtin:a", "builtin:c", "-o", "/r/.farm/1", "--luts", "/r/luts", "--size", "16"}));
   EXPECT_EQ(plan.merge, (std::vector<std::string>{"report", "merge", "/r/.farm/1", "/r/.farm/2", "-o", "/r", "--fail-on-regression"}));
+  EXPECT_EQ(plan_report_farm({"builtin:a"}, 1, "/r", "/cache", {}, {}).commands[0],
+            (std::vector<std::string>{"report", "builtin:a", "-o", "/r/.farm/1", "--luts", "/cache"}));
 }
 
 }  // namespace

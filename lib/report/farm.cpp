@@ -2,10 +2,9 @@
 
 #include <algorithm>
 #include <filesystem>
-#include <fstream>
 #include <map>
 
-#include "io/input.h"
+#include "lut/record.h"
 
 namespace facetfit {
 
@@ -54,15 +53,13 @@ nlohmann::json FarmPlan::to_json() const {
   return {{"out_dir", out_dir}, {"parts_dir", parts_dir}, {"luts_dir", luts_dir}, {"shards", shards}, {"commands", commands}, {"merge", merge}};
 }
 
-FarmPlan plan_report_farm(const std::vector<std::string>& sources, int shards, const std::string& out_dir,
+FarmPlan plan_report_farm(const std::vector<std::string>& sources, int shards, const std::string& out_dir, const std::string& luts_dir,
                           const std::vector<std::string>& report_args, const std::vector<std::string>& merge_args) {
   FarmPlan plan;
   plan.out_dir = out_dir;
   plan.parts_dir = (fs::path(out_dir) / ".farm").string();
-  plan.luts_dir = (fs::path(out_dir) / "luts").string();
-  std::ifstream in(fs::path(out_dir) / "report.json");
-  const nlohmann::json previous = nlohmann::json::parse(in, nullptr, false);
-  plan.shards = balance_shards(material_costs(sources, previous), shards);
+  plan.luts_dir = luts_dir.empty() ? (fs::path(out_dir) / "luts").string() : luts_dir;
+  plan.shards = balance_shards(material_costs(sources, read_json_file((fs::path(out_dir) / "report.json").string())), shards);
   plan.merge = {"report", "merge"};
   for (std::size_t k = 0; k < plan.shards.size(); ++k) {
     std::vector<std::string> c = {"report"};

@@ -21,7 +21,7 @@ std::vector<std::pair<std::string, double>> material_costs(const std::vector<std
 struct FarmPlan {
   std::string out_dir;    // where the merged report goes
   std::string parts_dir;  // out_dir/.farm: part K in parts_dir/K, logs beside them
-  std::string luts_dir;   // the bake cache all shards share (out_dir/luts)
+  std::string luts_dir;   // the bake cache all shards share (out_dir/luts unless given)
   std::vector<std::vector<std::string>> shards;       // the sources of each shard
   std::vector<std::vector<std::string>> commands;     // each shard's facetfit arguments (no executable)
   std::vector<std::string> merge;                     // the merge's facetfit arguments
@@ -29,9 +29,10 @@ struct FarmPlan {
   nlohmann::json to_json() const;
 };
 
-// The plan of `report` over `shards` shards: sources already expanded; `report_args` are the settings
-// every shard passes on (--size, --spp, fit settings ...), `merge_args` the merge's (--fail-on-regression).
-FarmPlan plan_report_farm(const std::vector<std::string>& sources, int shards, const std::string& out_dir,
+// The plan of `report` over `shards` shards: sources already expanded; `luts_dir` the shared bake cache
+// (empty: out_dir/luts); `report_args` are the settings every shard passes on (--size, --spp, fit
+// settings ...), `merge_args` the merge's (--fail-on-regression).
+FarmPlan plan_report_farm(const std::vector<std::string>& sources, int shards, const std::string& out_dir, const std::string& luts_dir,
                           const std::vector<std::string>& report_args, const std::vector<std::string>& merge_args);
 
 }  // namespace facetfit
