@@ -292,6 +292,24 @@ std::shared_ptr<const TabulatedMicrofacet> sampled_lut_model(const std::string& 
 
 }  // namespace
 
+std::shared_ptr<const ShadingModel> lut_parametric_model(const Lut& lut, const std::string& family, Smith smith, bool fresnel_curve) {
+  const LutMetadata::Parametric* p = lut.meta.fit(family);
+  if (!p) fail("family '" + family + "'", "must be ggx, beckmann or lsq");
+  // The LUT's fit of this family on the whole measurement: its alpha, body and coat, with its own F82-tint
+  // (lsq: Schlick) Fresnel or the tabulated curve.
+  const Ndf ndf = Ndf::isotropic(family == "beckmann" ? NdfType::beckmann : NdfType::ggx, p->alpha);
+  const auto brdf = fresnel_curve ? std::make_shared<ParametricBrdf>(ndf, smith, lut.tables.fresnel, p->body, p->coat)
+                                  : std::make_shared<ParametricBrdf>(*lut.parametric(family, smith));
+  // The proposal samples the lobe, the body and the coat (model/tabulated.h), weighted by f0 and the body.
+  MicrofacetTables tables;
+  tables.smith = smith;
+  tables.ndf = tabulate_ndf(ndf);
+  std::fill(tables.fresnel.value.begin(), tables.fresnel.value.end(), p->f0);
+  tables.body = p->body;
+  tables.coat = p->coat;
+  return std::make_shared<ShadingModel>(brdf, std::make_shared<TabulatedMicrofacet>(tables));
+}
+
 std::shared_ptr<const ShadingModel> load_material(const SceneDesc& scene, const MaterialDesc& m) {
   if (m.type == "lambert") return std::make_shared<ShadingModel>(std::make_shared<LambertBrdf>(m.albedo), nullptr);
   if (m.type == "analytic") {  // a built-in's analytic model itself: the ground truth
@@ -334,30 +352,14 @@ std::shared_ptr<const ShadingModel> load_material(const SceneDesc& scene, const 
   // ggx | beckmann | lsq (the LUT's classical baseline: Lambert + GGX + Schlick); nothing else renders as them
   if (m.type != "ggx" && m.type != "beckmann" && m.type != "lsq")
     fail("material type '" + m.type + "'", "must be measured, lut, ggx, beckmann, lsq, lambert or analytic");
-  const NdfType type = m.type == "beckmann" ? NdfType::beckmann : NdfType::ggx;
-  std::shared_ptr<const Brdf> brdf;
-  Ndf ndf;
-  // The proposal samples the lobe, the body and the coat (model/tabulated.h), weighted by f0 and the body.
+  if (!m.file.empty()) return lut_parametric_model(read_lut(resolve(scene, m.file)), m.type, m.smith, m.fresnel == "curve");
+  const Ndf ndf = Ndf::isotropic(m.type == "beckmann" ? NdfType::beckmann : NdfType::ggx, m.alpha);
+  // The proposal samples the lobe (model/tabulated.h), weighted by f0.
   MicrofacetTables tables;
   tables.smith = m.smith;
-  if (!m.file.empty()) {
-    // The LUT's fit of this family on the whole measurement: its alpha and body, with its own F82-tint
-    // Fresnel or the tabulated curve.
-    const Lut lut = read_lut(resolve(scene, m.file));
-    const LutMetadata::Parametric& p = *lut.meta.fit(m.type);  // m.type is ggx, beckmann or lsq here
-    ndf = Ndf::isotropic(type, p.alpha);
-    brdf = m.fresnel == "curve" ? std::make_shared<ParametricBrdf>(ndf, m.smith, lut.tables.fresnel, p.body, p.coat)
-                                : std::make_shared<ParametricBrdf>(*lut.parametric(m.type, m.smith));
-    std::fill(tables.fresnel.value.begin(), tables.fresnel.value.end(), p.f0);
-    tables.body = p.body;
-    tables.coat = p.coat;
-  } else {
-    ndf = Ndf::isotropic(type, m.alpha);
-    brdf = std::make_shared<ParametricBrdf>(ndf, m.smith, m.f0, m.f82);
-    std::fill(tables.fresnel.value.begin(), tables.fresnel.value.end(), m.f0);
-  }
   tables.ndf = tabulate_ndf(ndf);
-  return std::make_shared<ShadingModel>(brdf, std::make_shared<TabulatedMicrofacet>(tables));
+  std::fill(tables.fresnel.value.begin(), tables.fresnel.value.end(), m.f0);
+  return std::make_shared<ShadingModel>(std::make_shared<ParametricBrdf>(ndf, m.smith, m.f0, m.f82), std::make_shared<TabulatedMicrofacet>(tables));
 }
 
 }  // namespace facetfit

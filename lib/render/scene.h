@@ -87,6 +87,13 @@ std::vector<std::string> scene_materials(const std::string& scene_path);
 // Resolves a file name of the scene: relative names against the scene's folder, builtin: as is.
 std::string resolve(const SceneDesc& scene, const std::string& file);
 
+struct Lut;
+
+// One of the parametric fits a LUT carries ("ggx", "beckmann" or "lsq") as a shading model, evaluated
+// with `smith`, with the fit's F82-tint (lsq: Schlick) Fresnel or, with `fresnel_curve`, the LUT's curve.
+// Throws Error for another family.
+std::shared_ptr<const ShadingModel> lut_parametric_model(const Lut& lut, const std::string& family, Smith smith, bool fresnel_curve);
+
 // The shading model of a material: loads its file (and fits or tabulates what sampling needs).
 std::shared_ptr<const ShadingModel> load_material(const SceneDesc& scene, const MaterialDesc& m);
 

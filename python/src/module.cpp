@@ -344,16 +344,8 @@ PYBIND11_MODULE(_facetfit, m) {
       .def(
           "parametric",
           [](const Lut& l, const std::string& family) {
-            const auto p = l.parametric(family, l.tables.smith);
-            if (!p) throw py::value_error("family: must be ggx, beckmann or lsq, not '" + family + "'");
-            const LutMetadata::Parametric& fit = *l.meta.fit(family);
-            MicrofacetTables proposal;
-            proposal.ndf = tabulate_ndf(Ndf::isotropic(family == "beckmann" ? NdfType::beckmann : NdfType::ggx, fit.alpha));
-            proposal.smith = l.tables.smith;
-            std::fill(proposal.fresnel.value.begin(), proposal.fresnel.value.end(), fit.f0);
-            proposal.body = fit.body;
-            proposal.coat = fit.coat;
-            return Model{std::make_shared<ShadingModel>(std::make_shared<ParametricBrdf>(*p), std::make_shared<TabulatedMicrofacet>(proposal))};
+            if (!l.meta.fit(family)) throw py::value_error("family: must be ggx, beckmann or lsq, not '" + family + "'");
+            return Model{lut_parametric_model(l, family, l.tables.smith, false)};
           },
           py::arg("family"), "One of the parametric fits the LUT carries: 'ggx', 'beckmann' or 'lsq'.");
   m.def(
