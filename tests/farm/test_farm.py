@@ -6,7 +6,6 @@ it afterwards, whatever happens. Checks, against a report made on this machine a
   1. the built-in database in 3 shards (--wait) gives the same materials and Delta E values to the digit;
   2. a shard cancelled (scancel) mid-run is submitted again and the published report is whole and equal;
   3. a database path that does not exist fails with one message, submits nothing and publishes nothing.
-Prints the wall times of 1 and 3 local shards too (docs/farm.md).
 """
 import json
 import os
@@ -41,9 +40,7 @@ def main(facetfit):
         env = dict(os.environ, SLURM_CONF=start.stdout.strip())
         try:
             single = os.path.join(tmp, "single")
-            t0 = time.time()
             assert subprocess.run([facetfit, "-q", "report", *SETTINGS, "-o", single], env=env).returncode == 0
-            t_single = time.time() - t0
             reference, _ = delta_e(single)
 
             # 1. Three shards on Slurm, waited for.
@@ -86,12 +83,6 @@ def main(facetfit):
             after = subprocess.run(["squeue", "-h", "-o", "%i"], env=env, capture_output=True, text=True).stdout
             check(before == after, "a missing database submits nothing")
 
-            # Speed-up on this machine, local processes: 1 shard against 3.
-            for shards in (1, 3):
-                out_dir = os.path.join(tmp, f"local{shards}")
-                t0 = time.time()
-                subprocess.run([facetfit, "-q", "report", *SETTINGS, "--farm", "local", "--shards", str(shards), "-o", out_dir], env=env)
-                print(f"local farm, {shards} shard(s): {time.time() - t0:.2f} s (single process: {t_single:.2f} s)")
         finally:
             subprocess.run([os.path.join(HERE, "slurm_cluster.sh"), "stop", cluster])
     print(f"{len(failures)} failed")
