@@ -60,7 +60,7 @@ double measurement_error(const MeasuredBins& bins, const Brdf& model) {
     const Rgb m = f ? *f : Rgb(0.0);
     for (int c = 0; c < 3; ++c) {
       if (!(bins.valid[b] >> c & 1u)) continue;
-      const double r = metric_residual(m[c], bins.cos_mean[b], bins.lightness[b][c]);
+      const double r = metric_residual(m[c], bins.cos_mean[b], bins.lightness[b][c]).value;
       sum += bins.weight[b] * r * r;
       norm += bins.weight[b];
     }

@@ -73,10 +73,15 @@ inline double metric_slope(double x) {
   return t > kDelta3 ? kPi / (3.0 * std::cbrt(t * t)) : kPi / (3.0 * kDelta * kDelta);
 }
 
-// The metric's per-bin residual of one channel, given the measurement's `lightness` (MeasuredBins: the
-// model is nonnegative; the measurement is kept as it is).
-inline double metric_residual(double model, double cos_mean, double lightness) {
-  return metric_transform(std::max(model, 0.0) * cos_mean) - lightness;
+// The metric's per-bin residual of one channel given the measurement's `lightness` (MeasuredBins: the
+// model is nonnegative; the measurement is kept as it is), and its derivative with respect to the model.
+struct MetricResidual {
+  double value = 0.0, slope = 0.0;
+};
+inline MetricResidual metric_residual(double model, double cos_mean, double lightness) {
+  const double r = metric_transform(std::max(model, 0.0) * cos_mean) - lightness;
+  const double slope = model >= 0.0 ? cos_mean * metric_slope(model * cos_mean) : 0.0;
+  return {r, slope};
 }
 
 // Root of the metric's weighted mean square: how far `model` is from the measurement.

@@ -137,9 +137,10 @@ class RowCost final : public ceres::CostFunction {
         }
         const double m = body[e] * kInvPi + fresnel * lobe + coat;
         // F82-tint can dip below zero for extreme f82: no negative reflectance, and no slope there.
-        residuals[r] = w * metric_residual(m, c, bins_.lightness[k][e]);
+        const MetricResidual res = metric_residual(m, c, bins_.lightness[k][e]);
+        residuals[r] = w * res.value;
         if (!jacobians || m < 0.0) continue;
-        const double dm = w * c * metric_slope(m * c);
+        const double dm = w * res.slope;
         if (jacobians[0]) jacobians[0][3 * r + std::size_t(e)] = dm * kInvPi;
         if (jacobians[1]) jacobians[1][r] = dm * fresnel * lobe_slope;
         if (jacobians[2]) jacobians[2][3 * r + std::size_t(e)] = dm * fresnel_d_f0 * lobe;

@@ -58,10 +58,10 @@ class RowCost final : public ceres::CostFunction {
         const std::size_t r = 3 * b + std::size_t(ch);
         const bool valid = bins_.valid[k] >> ch & 1u;
         const double m = body[ch] * kInvPi + fresnel[ch] * d * g + coat_[k];
-        residuals[r] = valid ? s * metric_residual(m, c, bins_.lightness[k][ch]) : 0.0;
+        const MetricResidual res = valid ? metric_residual(m, c, bins_.lightness[k][ch]) : MetricResidual{};
+        residuals[r] = s * res.value;
         if (!jacobians) continue;
-        // d/dm of the residual: the chain rule for every parameter below.
-        const double dm = valid && m >= 0.0 ? s * c * metric_slope(m * c) : 0.0;
+        const double dm = s * res.slope;  // d/dm of the residual: the chain rule for every parameter below
         if (jacobians[0])
           for (int e = 0; e < 3; ++e) jacobians[0][3 * r + std::size_t(e)] = e == ch ? dm * kInvPi : 0.0;
         if (jacobians[1])
