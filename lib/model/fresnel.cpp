@@ -47,13 +47,15 @@ double fresnel_dielectric(double eta, double cos_d) {
 
 Rgb fresnel_f82_tint(const Rgb& f0, const Rgb& f82, double cos_d) {
   // F(mu) = Schlick(f0, mu) - a mu (1 - mu)^6, with a chosen so that F(1/7) = f82.
+  // The sixth powers multiplied out: std::pow was 3% of a render.
+  const auto basis = [](double mu) {
+    const double m2 = (1.0 - mu) * (1.0 - mu);
+    return mu * m2 * m2 * m2;
+  };
   constexpr double mu82 = 1.0 / 7.0;
-  const double m82 = 1.0 - mu82;
-  const Rgb schlick82 = fresnel_schlick(f0, mu82);
-  const double basis82 = mu82 * std::pow(m82, 6.0);
-  const Rgb a = (schlick82 - f82) / basis82;
+  const Rgb a = (fresnel_schlick(f0, mu82) - f82) / basis(mu82);
   const double mu = clamp(cos_d, 0.0, 1.0);
-  const Rgb f = fresnel_schlick(f0, mu) - a * (mu * std::pow(1.0 - mu, 6.0));
+  const Rgb f = fresnel_schlick(f0, mu) - a * basis(mu);
   return glm::max(f, Rgb(0.0));
 }
 

@@ -103,7 +103,8 @@ double sample_phi(double a, double b, double u) {
   const double total = a * std::sin(phi_max) + b * phi_max;  // CDF a sin(phi) + b phi on [0, phi_max]
   if (!(total > 0.0)) return sign * u * kPi;
   const double target = u * total;
-  // Newton on the monotone CDF, kept inside the bracket.
+  // Newton on the monotone CDF, kept inside the bracket. Near phi_max the density vanishes and the last
+  // digits of f are rounding noise: a tighter stop there costs ~7 more iterations (11 instead of 4).
   double lo = 0.0, hi = phi_max, phi = u * phi_max;
   for (int it = 0; it < 40; ++it) {
     const double s = std::sin(phi), c = std::cos(phi);  // one sincos
@@ -112,7 +113,7 @@ double sample_phi(double a, double b, double u) {
     const double df = a * c + b;
     double next = df > 0.0 ? phi - f / df : 0.5 * (lo + hi);
     if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
-    if (std::abs(next - phi) < 1e-10) {
+    if (std::abs(next - phi) < 1e-7) {  // radians: below what a float ray direction resolves
       phi = next;
       break;
     }
