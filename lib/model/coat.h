@@ -10,6 +10,7 @@
 
 #include "core/vec.h"
 #include "model/fresnel.h"
+#include "model/ggx_visible.h"
 #include "model/ndf.h"
 #include "model/smith.h"
 
@@ -29,31 +30,11 @@ struct Coat {
     return f * ndf.D(h) * smith_g2(Smith::correlated, ndf.lambda(i), ndf.lambda(o)) / (4.0 * i.z * o.z);
   }
 
-  // A direction i for o from the GGX visible normals seen from o (Heitz 2018: the visible part of the
-  // stretched hemisphere is a disk and a half-disk, sampled by warping one disk), reflected about h.
+  // A direction i for o from the coat's visible normals (model/ggx_visible.h), and its density.
   std::optional<Vec3> sample_direction(const Vec3& o, double u1, double u2) const {
-    if (!present() || o.z <= 0.0) return std::nullopt;
-    const Vec3 v = glm::normalize(Vec3(alpha * o.x, alpha * o.y, o.z));  // to the unit-roughness frame
-    const double len2 = v.x * v.x + v.y * v.y;
-    const Vec3 t1 = len2 > 0.0 ? Vec3(-v.y, v.x, 0.0) / std::sqrt(len2) : Vec3(1.0, 0.0, 0.0);
-    const Vec3 t2 = glm::cross(v, t1);
-    const double r = std::sqrt(u1), phi = 2.0 * kPi * u2;
-    const double p1 = r * std::cos(phi), s = 0.5 * (1.0 + v.z);
-    const double p2 = (1.0 - s) * std::sqrt(std::max(0.0, 1.0 - p1 * p1)) + s * r * std::sin(phi);
-    const Vec3 n = p1 * t1 + p2 * t2 + std::sqrt(std::max(0.0, 1.0 - p1 * p1 - p2 * p2)) * v;
-    const Vec3 h = glm::normalize(Vec3(alpha * n.x, alpha * n.y, std::max(0.0, n.z)));
-    const Vec3 i = 2.0 * glm::dot(o, h) * h - o;
-    if (i.z <= 0.0) return std::nullopt;
-    return i;
+    return present() ? ggx_visible_direction(o, alpha, u1, u2) : std::nullopt;
   }
-  // Density of sample_direction() per steradian of i: G1(o) D(h) / (4 cos(theta_o)).
-  double pdf(const Vec3& o, const Vec3& i) const {
-    if (!present() || o.z <= 0.0 || i.z <= 0.0) return 0.0;
-    const Vec3 h = glm::normalize(i + o);
-    if (glm::dot(o, h) <= 0.0) return 0.0;
-    const Ndf ndf = Ndf::isotropic(NdfType::ggx, alpha);
-    return ndf.g1(o) * ndf.D(h) / (4.0 * o.z);
-  }
+  double pdf(const Vec3& o, const Vec3& i) const { return present() ? ggx_visible_pdf(o, i, alpha) : 0.0; }
 };
 
 }  // namespace facetfit

@@ -57,12 +57,7 @@ TabulatedMicrofacet::TabulatedMicrofacet(MicrofacetTables tables)
 TabulatedMicrofacet::TabulatedMicrofacet(MicrofacetTables tables, VisibleNormalTables sampling)
     : tables_(std::move(tables)), sampling_(std::move(sampling)) {
   for (int j = 0; j < tables_.ndf.grid.size(); ++j) cos_nodes_.push_back(std::cos(tables_.ndf.grid.theta(j)));
-  const double lobe = std::max(luminance(tables_.fresnel.value[0]), 0.1), body = std::max(luminance(tables_.body), 0.0);
-  const double coat = tables_.coat.present() ? std::max(tables_.coat.f0, 0.1) : 0.0;
-  if (std::isfinite(lobe + body + coat)) {
-    weight_lobe_ = lobe / (lobe + body + coat);
-    weight_body_ = body / (lobe + body + coat);
-  }
+  parts_ = ProposalParts(tables_.fresnel.value[0], tables_.body, tables_.coat);
 }
 
 double TabulatedMicrofacet::D(const Vec3& h) const {
@@ -142,9 +137,7 @@ double TabulatedMicrofacet::visible_normal_pdf(const Vec3& o, const Vec3& h) con
 
 double TabulatedMicrofacet::pdf(const Vec3& o, const Vec3& i) const {
   if (i.z <= 0.0 || o.z <= 0.0 || sampling_.empty()) return 0.0;
-  double p = weight_lobe_ * lobe_pdf(o, i) + weight_body_ * i.z * kInvPi;
-  if (tables_.coat.present()) p += coat_weight() * tables_.coat.pdf(o, i);
-  return p;
+  return parts_.pdf(o, i, lobe_pdf(o, i));
 }
 
 double TabulatedMicrofacet::lobe_pdf(const Vec3& o, const Vec3& i) const {
@@ -166,16 +159,7 @@ std::optional<TabulatedMicrofacet::Sample> TabulatedMicrofacet::sample(const Vec
 
 std::optional<Vec3> TabulatedMicrofacet::sample_direction(const Vec3& o, double u1, double u2) const {
   if (o.z <= 0.0 || sampling_.empty()) return std::nullopt;
-  // The part u1 falls in, and u1 rescaled to [0, 1) within it.
-  if (u1 < weight_lobe_) return lobe_direction(o, u1 / weight_lobe_, u2);
-  u1 -= weight_lobe_;
-  if (u1 < weight_body_) {  // the cosine: r = sqrt(u) on the unit disk, lifted to the hemisphere
-    const double r = std::sqrt(u1 / weight_body_), phi = 2.0 * kPi * u2;
-    const Vec3 i(r * std::cos(phi), r * std::sin(phi), std::sqrt(std::max(0.0, 1.0 - r * r)));
-    if (i.z <= 0.0) return std::nullopt;
-    return i;
-  }
-  return tables_.coat.sample_direction(o, clamp((u1 - weight_body_) / coat_weight(), 0.0, 1.0 - 1e-16), u2);
+  return parts_.sample(o, u1, u2, [&](double a, double b) { return lobe_direction(o, a, b); });
 }
 
 std::optional<Vec3> TabulatedMicrofacet::lobe_direction(const Vec3& o, double u1, double u2) const {

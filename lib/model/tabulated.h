@@ -16,6 +16,7 @@
 #include "model/fresnel_curve.h"
 #include "model/tabulated_ndf.h"
 #include "model/coat.h"
+#include "model/proposal.h"
 #include "model/smith.h"
 
 namespace facetfit {
@@ -42,7 +43,7 @@ struct VisibleNormalTables {
   bool empty() const { return cdf.empty(); }
 };
 
-class TabulatedMicrofacet final : public Brdf {
+class TabulatedMicrofacet final : public Brdf, public Proposal {
  public:
   // Builds the sampling tables from the NDF.
   explicit TabulatedMicrofacet(MicrofacetTables tables);
@@ -62,10 +63,10 @@ class TabulatedMicrofacet final : public Brdf {
   // or below the horizon, or when the model has no sampling tables.
   std::optional<Sample> sample(const Vec3& o, double u1, double u2) const;
   // The direction sample() would draw, without its pdf and weight (for callers that mix proposals).
-  std::optional<Vec3> sample_direction(const Vec3& o, double u1, double u2) const;
+  std::optional<Vec3> sample_direction(const Vec3& o, double u1, double u2) const override;
   // Density of sample() per steradian of i. Integrates over the upper hemisphere to the fraction of
   // samples that land there.
-  double pdf(const Vec3& o, const Vec3& i) const;
+  double pdf(const Vec3& o, const Vec3& i) const override;
 
   double D(const Vec3& h) const;
   double g1(const Vec3& w) const;
@@ -76,19 +77,19 @@ class TabulatedMicrofacet final : public Brdf {
   double lobe_pdf(const Vec3& o, const Vec3& i) const;
   // The probabilities of the three parts (they sum to 1): luminance of the body albedo, of F(0) for
   // the lobe and the coat's f0, the last two at least 0.1 so that a dark lobe is still found.
-  double lobe_weight() const { return weight_lobe_; }
-  double body_weight() const { return weight_body_; }
-  double coat_weight() const { return 1.0 - weight_lobe_ - weight_body_; }
+  double lobe_weight() const { return parts_.lobe; }
+  double body_weight() const { return parts_.body; }
+  double coat_weight() const { return parts_.coat_weight(); }
 
   const MicrofacetTables& tables() const { return tables_; }
   const VisibleNormalTables& sampling() const { return sampling_; }
-  bool can_sample() const { return !sampling_.empty(); }
+  bool can_sample() const override { return !sampling_.empty(); }
 
  private:
   MicrofacetTables tables_;
   VisibleNormalTables sampling_;
   std::vector<double> cos_nodes_;  // cos(theta_j)
-  double weight_lobe_ = 1.0, weight_body_ = 0.0;
+  ProposalParts parts_;
 
   std::optional<Vec3> lobe_direction(const Vec3& o, double u1, double u2) const;
 };

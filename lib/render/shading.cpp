@@ -6,7 +6,7 @@
 
 namespace facetfit {
 
-ShadingModel::ShadingModel(std::shared_ptr<const Brdf> brdf, std::shared_ptr<const TabulatedMicrofacet> proposal)
+ShadingModel::ShadingModel(std::shared_ptr<const Brdf> brdf, std::shared_ptr<const Proposal> proposal)
     : brdf_(std::move(brdf)), proposal_(std::move(proposal)), lobe_weight_(proposal_ && proposal_->can_sample() ? 0.85 : 0.0) {}
 
 Rgb ShadingModel::f(const Vec3& o, const Vec3& i) const {

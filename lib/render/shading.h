@@ -1,9 +1,9 @@
 // What the renderer shades with: a BRDF to evaluate, and a proposal to sample it.
 //
 // Every material, measured, tabulated or parametric, is sampled the same way: the visible normals of
-// a tabulated microfacet model (the fitted LUT for a measured material, the material itself for a LUT,
-// the analytic NDF tabulated on the grid for GGX and Beckmann), mixed with cosine sampling so that
-// whatever a single lobe does not explain (diffuse reflection) is still found. pdf() is that mixture.
+// a microfacet proposal (model/proposal.h: the fitted LUT for a measured material, the material itself
+// for a LUT, GGX's in closed form, Beckmann's NDF tabulated on the grid), mixed with cosine sampling so
+// that whatever a single lobe does not explain (diffuse reflection) is still found. pdf() is that mixture.
 #pragma once
 
 #include <memory>
@@ -11,14 +11,14 @@
 
 #include "core/brdf.h"
 #include "model/ndf.h"
-#include "model/tabulated.h"
+#include "model/proposal.h"
 
 namespace facetfit {
 
 class ShadingModel {
  public:
   // `proposal` may be null: cosine sampling alone (a Lambertian surface).
-  ShadingModel(std::shared_ptr<const Brdf> brdf, std::shared_ptr<const TabulatedMicrofacet> proposal);
+  ShadingModel(std::shared_ptr<const Brdf> brdf, std::shared_ptr<const Proposal> proposal);
 
   // f(o, i) in the local frame (missing measurements count as zero).
   Rgb f(const Vec3& o, const Vec3& i) const;
@@ -35,7 +35,7 @@ class ShadingModel {
 
  private:
   std::shared_ptr<const Brdf> brdf_;
-  std::shared_ptr<const TabulatedMicrofacet> proposal_;
+  std::shared_ptr<const Proposal> proposal_;
   double lobe_weight_;  // probability of sampling the microfacet proposal
 };
 

@@ -1,0 +1,40 @@
+// Sampling GGX's visible normals (Heitz 2018, "Sampling the GGX Distribution of Visible Normals"): seen
+// from o, the visible part of the stretched unit hemisphere projects to a disk and a half-disk, sampled by
+// warping one disk; the normal is stretched back and o reflected about it. Density per steradian of the
+// reflected direction i: G1(o) D(h) / (4 cos(theta_o)). Used by the coat and by the proposal of every
+// GGX material (model/proposal.h).
+#pragma once
+
+#include <cmath>
+#include <optional>
+
+#include "core/vec.h"
+#include "model/ndf.h"
+
+namespace facetfit {
+
+inline std::optional<Vec3> ggx_visible_direction(const Vec3& o, double alpha, double u1, double u2) {
+  if (o.z <= 0.0) return std::nullopt;
+  const Vec3 v = glm::normalize(Vec3(alpha * o.x, alpha * o.y, o.z));  // to the unit-roughness frame
+  const double len2 = v.x * v.x + v.y * v.y;
+  const Vec3 t1 = len2 > 0.0 ? Vec3(-v.y, v.x, 0.0) / std::sqrt(len2) : Vec3(1.0, 0.0, 0.0);
+  const Vec3 t2 = glm::cross(v, t1);
+  const double r = std::sqrt(u1), phi = 2.0 * kPi * u2;
+  const double p1 = r * std::cos(phi), s = 0.5 * (1.0 + v.z);
+  const double p2 = (1.0 - s) * std::sqrt(std::max(0.0, 1.0 - p1 * p1)) + s * r * std::sin(phi);
+  const Vec3 n = p1 * t1 + p2 * t2 + std::sqrt(std::max(0.0, 1.0 - p1 * p1 - p2 * p2)) * v;
+  const Vec3 h = glm::normalize(Vec3(alpha * n.x, alpha * n.y, std::max(0.0, n.z)));
+  const Vec3 i = 2.0 * glm::dot(o, h) * h - o;
+  if (i.z <= 0.0) return std::nullopt;
+  return i;
+}
+
+inline double ggx_visible_pdf(const Vec3& o, const Vec3& i, double alpha) {
+  if (o.z <= 0.0 || i.z <= 0.0) return 0.0;
+  const Vec3 h = glm::normalize(i + o);
+  if (glm::dot(o, h) <= 0.0) return 0.0;
+  const Ndf ndf = Ndf::isotropic(NdfType::ggx, alpha);
+  return ndf.g1(o) * ndf.D(h) / (4.0 * o.z);
+}
+
+}  // namespace facetfit
