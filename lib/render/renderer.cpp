@@ -179,26 +179,15 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
   // a ray leaving a sphere at a grazing angle can otherwise find the sphere it starts on.
   const double eps = 2e-4 * scene_scale;
 
-  const auto occluded = [&](const Vec3& origin, const Vec3& dir, double tfar) {
-    RTCIntersectContext ctx;
-    rtcInitIntersectContext(&ctx);
-    RTCRay ray{};
-    ray.org_x = float(origin.x), ray.org_y = float(origin.y), ray.org_z = float(origin.z);
-    ray.dir_x = float(dir.x), ray.dir_y = float(dir.y), ray.dir_z = float(dir.z);
-    ray.tnear = float(eps);
-    ray.tfar = float(tfar);
-    ray.mask = 0xFFFFFFFFu;
-    rtcOccluded1(es.scene, &ctx, &ray);
-    return ray.tfar < 0.0f;
-  };
-
-  // One sample of pixel (x, y): radiance and coverage.
-  const auto sample_pixel = [&](int x, int y, Random& rng, Rgb& radiance, double& alpha) {
-    const double sx = (2.0 * (x + rng.next()) / width - 1.0) * tan_half * aspect;
-    const double sy = (1.0 - 2.0 * (y + rng.next()) / height) * tan_half;
-    const Vec3 dir = glm::normalize(forward + sx * right + sy * up);
-    RTCIntersectContext ctx;
-    rtcInitIntersectContext(&ctx);
+  // A sample is traced in three stages shared by both paths below: its camera ray; shading at the hit,
+  // which yields the radiance no visibility test can change and the shadow rays whose value counts if
+  // nothing blocks them; the shadow rays. The one-ray-at-a-time path runs them per sample, the stream
+  // path per tile, through Embree's ray streams. Each sample draws its seven numbers before its camera ray
+  // and sums its shadow rays in the same order either way, so both give the same image.
+  const auto camera_ray = [&](int x, int y, const double u[2], Vec3& dir) {
+    const double sx = (2.0 * (x + u[0]) / width - 1.0) * tan_half * aspect;
+    const double sy = (1.0 - 2.0 * (y + u[1]) / height) * tan_half;
+    dir = glm::normalize(forward + sx * right + sy * up);
     RTCRayHit rh{};
     rh.ray.org_x = float(cam.position.x), rh.ray.org_y = float(cam.position.y), rh.ray.org_z = float(cam.position.z);
     rh.ray.dir_x = float(dir.x), rh.ray.dir_y = float(dir.y), rh.ray.dir_z = float(dir.z);
@@ -206,14 +195,28 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
     rh.ray.tfar = std::numeric_limits<float>::infinity();
     rh.ray.mask = 0xFFFFFFFFu;
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-    rtcIntersect1(es.scene, &ctx, &rh);
-    // Five numbers per sample whatever happens, so that pixels never share or shift their sequences.
-    const double u[5] = {rng.next(), rng.next(), rng.next(), rng.next(), rng.next()};
+    return rh;
+  };
+  const auto shadow_ray = [&](const Vec3& origin, const Vec3& dir, double tfar) {
+    RTCRay ray{};
+    ray.org_x = float(origin.x), ray.org_y = float(origin.y), ray.org_z = float(origin.z);
+    ray.dir_x = float(dir.x), ray.dir_y = float(dir.y), ray.dir_z = float(dir.z);
+    ray.tnear = float(eps);
+    ray.tfar = float(tfar);
+    ray.mask = 0xFFFFFFFFu;
+    return ray;
+  };
+
+  // Shades the camera ray's hit with u[2..6]: radiance and coverage, and appends the shadow rays and their
+  // values (rtcOccluded sets tfar to -inf where something blocks the ray).
+  const auto shade = [&](const RTCRayHit& rh, const Vec3& dir, const double* u, Rgb& radiance, double& alpha,
+                         std::vector<RTCRay>& rays, std::vector<Rgb>& values) {
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) {
       radiance = env ? env->radiance(dir) : Rgb(0.0);
       alpha = 0.0;
       return;
     }
+    radiance = Rgb(0.0);
     alpha = 1.0;
     const Geometry& geo = geometries[rh.hit.geomID];
     const Vec3 p = cam.position + double(rh.ray.tfar) * dir;
@@ -224,27 +227,29 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
     const Vec3 o = frame.to_local(-dir);
     const ShadingModel& model = *materials[std::size_t(geo.material)];
     const Vec3 origin = p + eps * n;
-    Rgb sum(0.0);
+    const auto visible_if_unblocked = [&](const Vec3& d, double tfar, const Rgb& value) {
+      rays.push_back(shadow_ray(origin, d, tfar));
+      values.push_back(value);
+    };
+    const double infinity = std::numeric_limits<float>::infinity();
     if (env && o.z > 0.0) {
       // Light sampling, weighted against the BRDF's proposal.
       const Environment::Sample ls = env->sample(u[0], u[1]);
       const Vec3 il = frame.to_local(ls.d);
-      if (il.z > 0.0 && ls.pdf > 0.0 && !occluded(origin, ls.d, std::numeric_limits<float>::infinity())) {
+      if (il.z > 0.0 && ls.pdf > 0.0) {
         const double w = power_heuristic(ls.pdf, model.pdf(o, il));
-        sum += model.f(o, il) * ls.radiance * (il.z * w / ls.pdf);
+        visible_if_unblocked(ls.d, infinity, model.f(o, il) * ls.radiance * (il.z * w / ls.pdf));
       }
       // BRDF sampling, weighted against the environment's.
       if (const auto bs = model.sample(o, u[2], u[3], u[4])) {
         const Vec3 d = frame.to_world(bs->i);
-        if (!occluded(origin, d, std::numeric_limits<float>::infinity())) {
-          const Environment::Sample e = env->lookup(d);
-          sum += bs->weight * e.radiance * power_heuristic(bs->pdf, e.pdf);
-        }
+        const Environment::Sample e = env->lookup(d);
+        visible_if_unblocked(d, infinity, bs->weight * e.radiance * power_heuristic(bs->pdf, e.pdf));
       }
     }
     for (const LightDesc& light : desc.lights) {
       Vec3 d;
-      double dist = std::numeric_limits<float>::infinity();
+      double dist = infinity;
       Rgb e = light.value;
       if (light.kind == LightDesc::Kind::directional) {
         d = light.vector;
@@ -256,9 +261,24 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
         dist *= 1.0 - 1e-6;
       }
       const Vec3 il = frame.to_local(d);
-      if (il.z > 0.0 && o.z > 0.0 && !occluded(origin, d, dist)) sum += model.f(o, il) * e * il.z;
+      if (il.z > 0.0 && o.z > 0.0) visible_if_unblocked(d, dist, model.f(o, il) * e * il.z);
     }
-    radiance = sum;
+  };
+  // The radiance of shadow rays [first, last) that nothing blocks, added in order.
+  const auto add_unblocked = [](const std::vector<RTCRay>& rays, const std::vector<Rgb>& values, std::size_t first,
+                                std::size_t last, Rgb& radiance) {
+    for (std::size_t q = first; q < last; ++q)
+      if (!(rays[q].tfar < 0.0f)) radiance += values[q];
+  };
+  // The sequence of sample s of pixel (x, y): independent of passes, tiles, threads and paths.
+  const auto sample_numbers = [&](int x, int y, int s, double u[7]) {
+    Random rng{seed * 0x100000001B3ull ^ (std::uint64_t(y) * 73856093u + std::uint64_t(x) * 19349663u) * 0x9E3779B97F4A7C15ull ^
+               std::uint64_t(s) << 40};
+    for (int k = 0; k < 7; ++k) u[k] = rng.next();
+  };
+  const auto accumulate = [](double* acc, Rgb radiance, double alpha) {
+    if (!std::isfinite(radiance.r) || !std::isfinite(radiance.g) || !std::isfinite(radiance.b)) radiance = Rgb(0.0);
+    acc[0] += radiance.r, acc[1] += radiance.g, acc[2] += radiance.b, acc[3] += alpha;
   };
 
   RenderedImage image;
@@ -268,24 +288,81 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
   image.rgba.assign(std::size_t(width) * height * 4, 0.0f);
   std::vector<double> accum(std::size_t(width) * height * 4, 0.0);
   const int passes = std::max(1, std::min(settings.passes, spp));
+  const auto pixel_accum = [&](int x, int y) { return accum.data() + (std::size_t(y) * width + x) * 4; };
+
+  // One ray at a time.
+  const auto render_tile_scalar = [&](const tbb::blocked_range2d<int>& tile, int first, int last) {
+    std::vector<RTCRay> rays;
+    std::vector<Rgb> values;
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    for (int y = tile.rows().begin(); y < tile.rows().end(); ++y)
+      for (int x = tile.cols().begin(); x < tile.cols().end(); ++x)
+        for (int s = first; s < last; ++s) {
+          double u[7];
+          sample_numbers(x, y, s, u);
+          Vec3 dir;
+          RTCRayHit rh = camera_ray(x, y, u, dir);
+          rtcIntersect1(es.scene, &ctx, &rh);
+          Rgb radiance;
+          double alpha;
+          rays.clear(), values.clear();
+          shade(rh, dir, u + 2, radiance, alpha, rays, values);
+          for (RTCRay& ray : rays) rtcOccluded1(es.scene, &ctx, &ray);
+          add_unblocked(rays, values, 0, rays.size(), radiance);
+          accumulate(pixel_accum(x, y), radiance, alpha);
+        }
+  };
+  // Every pixel of the tile at once, one sample index after the other: camera rays, then shadow rays, as
+  // Embree ray streams (coherent camera rays travel together).
+  const auto render_tile_streams = [&](const tbb::blocked_range2d<int>& tile, int first, int last) {
+    const int tw = int(tile.cols().size()), count = tw * int(tile.rows().size());
+    const std::size_t n = std::size_t(count);
+    std::vector<RTCRayHit> hits(n);
+    std::vector<Vec3> dirs(n);
+    std::vector<double> numbers(n * 7);
+    std::vector<Rgb> radiance(n);
+    std::vector<double> alpha(n);
+    std::vector<std::size_t> owned(n + 1);  // shadow rays of pixel k: [owned[k], owned[k + 1])
+    std::vector<RTCRay> rays;
+    std::vector<Rgb> values;
+    for (int s = first; s < last; ++s) {
+      for (int k = 0; k < count; ++k) {
+        const int x = tile.cols().begin() + k % tw, y = tile.rows().begin() + k / tw;
+        double* u = numbers.data() + std::size_t(k) * 7;
+        sample_numbers(x, y, s, u);
+        hits[std::size_t(k)] = camera_ray(x, y, u, dirs[std::size_t(k)]);
+      }
+      RTCIntersectContext coherent;
+      rtcInitIntersectContext(&coherent);
+      coherent.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+      rtcIntersect1M(es.scene, &coherent, hits.data(), unsigned(count), sizeof(RTCRayHit));
+      rays.clear(), values.clear();
+      for (int k = 0; k < count; ++k) {
+        owned[std::size_t(k)] = rays.size();
+        shade(hits[std::size_t(k)], dirs[std::size_t(k)], numbers.data() + std::size_t(k) * 7 + 2, radiance[std::size_t(k)],
+              alpha[std::size_t(k)], rays, values);
+      }
+      owned[std::size_t(count)] = rays.size();
+      RTCIntersectContext incoherent;
+      rtcInitIntersectContext(&incoherent);
+      if (!rays.empty()) rtcOccluded1M(es.scene, &incoherent, rays.data(), unsigned(rays.size()), sizeof(RTCRay));
+      for (int k = 0; k < count; ++k) {
+        add_unblocked(rays, values, owned[std::size_t(k)], owned[std::size_t(k) + 1], radiance[std::size_t(k)]);
+        accumulate(pixel_accum(tile.cols().begin() + k % tw, tile.rows().begin() + k / tw), radiance[std::size_t(k)],
+                   alpha[std::size_t(k)]);
+      }
+    }
+  };
+
   int done = 0;
   for (int pass = 0; pass < passes; ++pass) {
     const int first = spp * pass / passes, last = spp * (pass + 1) / passes;
     tbb::parallel_for(tbb::blocked_range2d<int>(0, height, 16, 0, width, 16), [&](const tbb::blocked_range2d<int>& tile) {
-      for (int y = tile.rows().begin(); y < tile.rows().end(); ++y)
-        for (int x = tile.cols().begin(); x < tile.cols().end(); ++x) {
-          double* acc = accum.data() + (std::size_t(y) * width + x) * 4;
-          for (int s = first; s < last; ++s) {
-            // The sequence of sample s of this pixel: independent of passes, tiles and threads.
-            Random rng{seed * 0x100000001B3ull ^ (std::uint64_t(y) * 73856093u + std::uint64_t(x) * 19349663u) * 0x9E3779B97F4A7C15ull ^
-                       std::uint64_t(s) << 40};
-            Rgb radiance;
-            double alpha;
-            sample_pixel(x, y, rng, radiance, alpha);
-            if (!std::isfinite(radiance.r) || !std::isfinite(radiance.g) || !std::isfinite(radiance.b)) radiance = Rgb(0.0);
-            acc[0] += radiance.r, acc[1] += radiance.g, acc[2] += radiance.b, acc[3] += alpha;
-          }
-        }
+      if (settings.ray_streams)
+        render_tile_streams(tile, first, last);
+      else
+        render_tile_scalar(tile, first, last);
     });
     done = last;
     for (std::size_t k = 0; k < accum.size(); ++k) image.rgba[k] = float(accum[k] / done);
