@@ -11,6 +11,10 @@ if(FACETFIT_BUILD_TOOLS)
   find_package(benchmark REQUIRED)
 endif()
 find_package(Ceres REQUIRED)  # least-squares refinement of fits on the whole measurement
+# FFTW 3: Debian's CMake config for it is incomplete, so the library itself (the anisotropic extraction's
+# azimuthal convolutions)
+find_path(FFTW3_INCLUDE_DIR fftw3.h REQUIRED)
+find_library(FFTW3_LIBRARY fftw3 REQUIRED)
 find_package(OpenSSL REQUIRED)  # SHA-256 of sources (LUT metadata, bake cache)
 find_package(Imath CONFIG REQUIRED)
 find_package(OpenImageIO CONFIG REQUIRED)

@@ -15,4 +15,9 @@ python3 "$root/scripts/bench_to_md.py" "$json" "$root/docs/benchmarks.md" "$star
 # Cycles through Blender's bpy wheel, in a venv of the build.
 py=$("$root/scripts/setup-bpy.sh" "$build/../bpy-venv" | tail -n 1)
 "$py" "$root/scripts/cycles_compare.py" "$build/bin/facetfit" "$root/docs/cycles.md"
+# Mitsuba 3 (PyPI; llvm_ad_rgb through Debian's libllvm19) on the realref scene, with an RGL sphere where
+# the shared data is present.
+mpy=$("$root/scripts/setup-mitsuba.sh" "$build/../mitsuba-venv" | tail -n 1)
+python3 "$root/bench/render_compare.py" "$build/bin/facetfit" "$mpy" "$root/docs/render-speed.md" \
+  "$root/../shared/data/rgl/cc_ibiza_sunset_rgb.bsdf"
 echo "wrote docs/benchmarks.md"

@@ -12,6 +12,8 @@ namespace {
 // linearly in u past the last one. For masking and correlated q = f(k,k) cos(theta_k): it stays finite at
 // grazing angles where f(k,k) itself grows like 1 / cos(theta_k). Linear interpolation between MERL's
 // bins would cost a smooth material about 0.7% of alpha at any resolution but 90 (docs/accuracy.md).
+}  // namespace
+
 std::vector<double> kernel_factor(const Backscatter& back, const ThetaGrid& grid, Smith smith) {
   const bool times_cos = smith != Smith::separable;
   const std::size_t m = back.theta.size();
@@ -44,6 +46,8 @@ std::vector<double> kernel_factor(const Backscatter& back, const ThetaGrid& grid
   }
   return q;
 }
+
+namespace {
 
 double dot(const double* a, const std::vector<double>& b) {
   double s = 0.0;

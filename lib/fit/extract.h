@@ -42,4 +42,8 @@ struct Extraction {
 
 Extraction extract_ndf(const Backscatter& backscatter, const Quadrature& quadrature, const ExtractOptions& options);
 
+// The kernel factor q(theta_j) on the grid nodes: f(k, k) cos(theta_k) (masking, correlated) or f(k, k)
+// (separable), interpolated from the measurements by a cubic Hermite spline in u.
+std::vector<double> kernel_factor(const Backscatter& backscatter, const ThetaGrid& grid, Smith smith);
+
 }  // namespace facetfit

@@ -1,0 +1,223 @@
+#!/usr/bin/env python3
+"""facetfit's renderer against Mitsuba 3 on the same scene (make bench; docs/render-speed.md).
+
+usage: render_compare.py FACETFIT MITSUBA_PYTHON OUT.md [RGL_FILE]
+
+The scene of ../shared/data/realref (a unit sphere seen from (0, 0.6, 4), vertical field of view 30
+degrees, constant environment 0.3, one directional light of irradiance 3 toward (0.3, 1, 0.5), direct
+lighting) at 256 x 256, 64 and 1024 samples per pixel, both renderers on every core. Spheres: GGX
+alpha 0.3 with F = 1 and separable Smith masking (Mitsuba's roughconductor with material none, sampling
+visible normals), a facetfit LUT of GGX 0.3 (Mitsuba cannot read it: compared with its GGX time), a
+measured MERL table (facetfit's writer, builtin:gold-ggx-0.15; Mitsuba 3 has no MERL reader: compared
+with its GGX time) and a measured RGL file (Mitsuba's `measured` plugin, the format authors' own).
+
+Two times per renderer: one render (facetfit: the time it prints, which covers loading the material,
+building the scene and rendering; Mitsuba: the second render in its process, after its kernels are
+compiled and with the scene loaded) and the whole process from launch to exit (Mitsuba llvm_ad_rgb: with
+its kernel cache warm, the second process). Median of RUNS. Mitsuba's llvm_ad_rgb variant needs LLVM >= 16:
+Debian's libllvm19, through DRJIT_LIBLLVM_PATH; without it that column says so.
+"""
+import json
+import os
+import re
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+
+SIZE, RUNS = 256, 3
+SPPS = (64, 1024)
+LLVM = "/usr/lib/x86_64-linux-gnu/libLLVM.so.19.1"
+
+# The Mitsuba side, run in the Mitsuba venv's python as its own process: VARIANT SPP MATERIAL_JSON.
+MITSUBA_SCRIPT = r"""
+import json, sys, time
+import mitsuba as mi
+variant, spp, material = sys.argv[1], int(sys.argv[2]), json.loads(sys.argv[3])
+mi.set_variant(variant)
+T = mi.ScalarTransform4f
+if material["type"] == "ggx":
+    bsdf = {"type": "roughconductor", "distribution": "ggx", "alpha": material["alpha"], "material": "none",
+            "sample_visible": True}
+else:
+    bsdf = {"type": "measured", "filename": material["file"]}
+scene = mi.load_dict({
+    "type": "scene",
+    "integrator": {"type": "direct"},
+    "sensor": {"type": "perspective", "fov": 30, "fov_axis": "y",
+               "to_world": T().look_at(origin=[0, 0.6, 4], target=[0, 0, 0], up=[0, 1, 0]),
+               "film": {"type": "hdrfilm", "width": %(size)d, "height": %(size)d, "rfilter": {"type": "box"}},
+               "sampler": {"type": "independent", "sample_count": spp}},
+    "sphere": {"type": "sphere", "center": [0, 0, 0], "radius": 1, "bsdf": bsdf},
+    "env": {"type": "constant", "radiance": {"type": "rgb", "value": 0.3}},
+    "sun": {"type": "directional", "direction": [-0.3, -1, -0.5], "irradiance": {"type": "rgb", "value": 3}},
+})
+times = []
+for seed in range(2):
+    start = time.perf_counter()
+    image = mi.render(scene, spp=spp, seed=seed)
+    mi.Bitmap(image)  # forces the evaluation of the JIT variant
+    times.append(time.perf_counter() - start)
+print("\nfacetfit-times " + json.dumps(times))  # Mitsuba leaves its loading line unterminated
+""" % {"size": SIZE}
+
+
+def median(xs):
+    return statistics.median(xs)
+
+
+def facetfit_run(binary, work, material, spp, prefix=()):
+    prefix = list(prefix)
+    scene = {
+        "camera": {"position": [0, 0.6, 4], "look_at": [0, 0, 0], "up": [0, 1, 0], "fov": 30, "width": SIZE, "height": SIZE},
+        "render": {"spp": spp, "seed": 1},
+        "environment": {"constant": [0.3, 0.3, 0.3]},
+        "lights": [{"type": "directional", "direction": [0.3, 1, 0.5], "irradiance": [3, 3, 3]}],
+        "materials": {"m": material},
+        "objects": [{"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "m"}],
+    }
+    path = os.path.join(work, "scene.json")
+    with open(path, "w") as f:
+        json.dump(scene, f)
+    renders, processes, memory = [], [], []
+    for _ in range(RUNS):
+        start = time.perf_counter()
+        run = subprocess.run(prefix + ["/usr/bin/time", "-f", "%M", binary, "render", path, "-o", os.path.join(work, "facetfit.exr")],
+                             check=True, capture_output=True, text=True)
+        processes.append(time.perf_counter() - start)
+        renders.append(float(re.search(r"spp, ([0-9.]+) s\)", run.stdout).group(1)))
+        memory.append(float(run.stderr.strip().splitlines()[-1]) / 1024.0)
+    return median(renders), median(processes), median(memory)
+
+
+def mitsuba_run(python, variant, material, spp, env, prefix=()):
+    renders, processes, memory = [], [], []
+    for run in range(RUNS + 1):  # the first process warms the kernel cache
+        start = time.perf_counter()
+        out = subprocess.run(list(prefix) + ["/usr/bin/time", "-f", "%M", python, "-c", MITSUBA_SCRIPT, variant, str(spp),
+                              json.dumps(material)], check=True, capture_output=True, text=True, env=env)
+        wall = time.perf_counter() - start
+        if run == 0:
+            continue
+        renders.append(json.loads(out.stdout.split("facetfit-times ")[-1])[1])
+        processes.append(wall)
+        memory.append(float(out.stderr.strip().splitlines()[-1]) / 1024.0)
+    return median(renders), median(processes), median(memory)
+
+
+def profile(binary, work, material):
+    """The hottest symbols of one facetfit render (64 spp) under linux-perf: [(percent, library, symbol)]."""
+    facetfit_run(binary, work, material, 64)  # writes scene.json
+    data = os.path.join(work, "perf.data")
+    try:
+        subprocess.run(["perf", "record", "-o", data, binary, "render", os.path.join(work, "scene.json"), "-o",
+                        os.path.join(work, "profile.exr")], check=True, capture_output=True)
+        out = subprocess.run(["perf", "report", "-i", data, "--no-children", "--sort", "dso,symbol", "--stdio"],
+                             check=True, capture_output=True, text=True).stdout
+    except (OSError, subprocess.CalledProcessError):
+        return []
+    rows = []
+    for line in out.splitlines():
+        m = re.match(r"\s+([0-9.]+)%\s+(\S+)\s+\[[.k]\]\s+(.*)", line)
+        if m:
+            symbol = re.sub(r"\(.*", "", m.group(3).strip())  # no argument lists
+            rows.append((float(m.group(1)), m.group(2), symbol[:70]))
+    return rows[:14]
+
+
+def main(facetfit, mitsuba_python, dst, rgl=None):
+    work = tempfile.mkdtemp()
+    env = dict(os.environ)
+    llvm = os.path.exists(LLVM)
+    if llvm:
+        env["DRJIT_LIBLLVM_PATH"] = LLVM
+    merl = os.path.join(work, "gold.binary")
+    lut_dir = os.path.join(work, "luts")
+    subprocess.run([facetfit, "convert", "builtin:gold-ggx-0.15", "-o", merl], check=True, capture_output=True)
+    ggx_ff = {"type": "ggx", "alpha": 0.3, "f0": [1, 1, 1], "f82": [1, 1, 1], "smith": "separable"}
+    ggx_mi = {"type": "ggx", "alpha": 0.3}
+    # The LUT sphere: GGX 0.3 with F = 1 and separable masking, through facetfit's own MERL writer and bake.
+    subprocess.run([facetfit, "bake", merl, "-o", lut_dir, "--smith", "separable"], check=True, capture_output=True)
+    cases = [("GGX 0.3", ggx_ff, ggx_mi), ("tabulated LUT (gold)", {"type": "lut", "file": os.path.join(lut_dir, "gold.exr")}, ggx_mi),
+             ("measured MERL (gold)", {"type": "measured", "file": merl, "proposal": os.path.join(lut_dir, "gold.exr")}, ggx_mi)]
+    if rgl and os.path.exists(rgl):
+        name = os.path.splitext(os.path.basename(rgl))[0]
+        subprocess.run([facetfit, "bake", rgl, "-o", lut_dir], check=True, capture_output=True)
+        cases.append(("measured RGL (%s)" % name, {"type": "measured", "file": rgl, "proposal": os.path.join(lut_dir, name + ".exr")},
+                      {"type": "measured", "file": rgl}))
+    rows, mitsuba_cache = [], {}
+    for spp in SPPS:
+        for label, ff, mi_material in cases:
+            f_render, f_process, f_memory = facetfit_run(facetfit, work, ff, spp)
+            key = (json.dumps(mi_material), spp)
+            if key not in mitsuba_cache:
+                scalar = mitsuba_run(mitsuba_python, "scalar_rgb", mi_material, spp, env)
+                jit = mitsuba_run(mitsuba_python, "llvm_ad_rgb", mi_material, spp, env) if llvm else None
+                mitsuba_cache[key] = (scalar, jit)
+            scalar, jit = mitsuba_cache[key]
+            rows.append((label, spp, f_render, f_process, f_memory, scalar, jit, mi_material["type"] == "ggx" and ff["type"] != "ggx"))
+            print("%s %d spp: facetfit %.3f / %.3f s, scalar %.3f / %.3f s, llvm %s" % (
+                label, spp, f_render, f_process, scalar[0], scalar[1], "%.3f / %.3f s" % jit[:2] if jit else "absent"), file=sys.stderr)
+
+    cpus = os.cpu_count()
+    one_cpu = ["taskset", "-c", "0"]
+    scaling = [("facetfit", facetfit_run(facetfit, work, ggx_ff, 64, one_cpu)[0], rows[0][2]),
+               ("Mitsuba scalar_rgb", mitsuba_run(mitsuba_python, "scalar_rgb", ggx_mi, 64, env, one_cpu)[0], rows[0][5][0])]
+    if llvm:
+        scaling.append(("Mitsuba llvm_ad_rgb", mitsuba_run(mitsuba_python, "llvm_ad_rgb", ggx_mi, 64, env, one_cpu)[0], rows[0][6][0]))
+    profiles = [(label, profile(facetfit, work, ff)) for label, ff, _ in cases[:2]]
+    report = (0, 0.0)
+    if rgl:
+        db = os.path.dirname(rgl)
+        start = time.perf_counter()
+        subprocess.run([facetfit, "report", db, "-o", os.path.join(work, "report")], check=True, capture_output=True)
+        report = (len([f for f in os.listdir(db) if f.endswith(".bsdf")]), time.perf_counter() - start)
+    with open(dst + ".tmp", "w") as out:
+        out.write("# Reference renderer against Mitsuba 3\n\nGenerated by `make bench` (bench/render_compare.py); do not edit by hand.\n\n")
+        out.write("The scene of `../shared/data/realref` at %d x %d (constant environment 0.3, one directional light, a unit\n"
+                  "sphere; direct lighting), %d CPUs, every renderer on all of them, median of %d runs, Mitsuba 3 from PyPI.\n"
+                  "*render*: one render (facetfit: the time it prints, including loading the material and building the\n"
+                  "scene; Mitsuba: the second render in its process, scene loaded and kernels compiled). *process*: launch\n"
+                  "to exit (llvm_ad_rgb with a warm kernel cache). Ratios are facetfit's time over Mitsuba's: below 1,\n"
+                  "facetfit is faster. Rows marked * compare with Mitsuba's GGX sphere, which it renders instead.\n\n"
+                  % (SIZE, SIZE, cpus, RUNS))
+        out.write("| sphere | spp | facetfit render | process | Mitsuba llvm_ad_rgb render | process | scalar_rgb render | process | render / llvm | process / llvm | render / scalar |\n")
+        out.write("|---|---|---|---|---|---|---|---|---|---|---|\n")
+        for label, spp, fr, fp, fm, scalar, jit, proxy in rows:
+            jr = "%.3f s" % jit[0] if jit else "n/a"
+            jp = "%.3f s" % jit[1] if jit else "n/a"
+            rr = "%.2f" % (fr / jit[0]) if jit else "n/a"
+            rp = "%.2f" % (fp / jit[1]) if jit else "n/a"
+            out.write("| %s%s | %d | %.3f s | %.3f s | %s | %s | %.3f s | %.3f s | %s | %s | %.2f |\n" % (
+                label, " *" if proxy else "", spp, fr, fp, jr, jp, scalar[0], scalar[1], rr, rp, fr / scalar[0]))
+        if not llvm:
+            out.write("\nMitsuba's llvm_ad_rgb variant was not run: %s is absent (Debian package libllvm19).\n" % LLVM)
+        out.write("\nPeak memory of one render process (resident set): facetfit %s; Mitsuba llvm_ad_rgb %s, scalar_rgb %s\n"
+                  "(GGX sphere, 64 and 1024 spp).\n" % (
+                      ", ".join("%.0f MiB" % r[4] for r in rows if r[0] == "GGX 0.3"),
+                      ", ".join("%.0f MiB" % r[6][2] for r in rows if r[0] == "GGX 0.3" and r[6]) or "n/a",
+                      ", ".join("%.0f MiB" % r[5][2] for r in rows if r[0] == "GGX 0.3")))
+        out.write("\n## Scaling\n\nThe GGX sphere at 64 spp on one CPU (`taskset -c 0`) and on all %d; speed-up = one CPU's time over all.\n\n" % cpus)
+        out.write("| renderer | render, 1 CPU | render, %d CPUs | speed-up |\n|---|---|---|---|\n" % cpus)
+        for name, one, all_ in scaling:
+            out.write("| %s | %.3f s | %.3f s | %.2f |\n" % (name, one, all_, one / all_))
+        out.write("\n## Where the time goes\n\n`perf record` of one facetfit render (64 spp, whole process), self time by\n"
+                  "library and symbol (unnamed addresses in libembree3 are its stripped traversal kernels).\n")
+        for label, rows_ in profiles:
+            out.write("\n%s:\n\n| self | library | symbol |\n|---|---|---|\n" % label)
+            if not rows_:
+                out.write("| n/a | linux-perf is not installed or not permitted | |\n")
+            for pct, dso, sym in rows_:
+                out.write("| %.1f%% | %s | `%s` |\n" % (pct, dso, sym.replace("|", "\\|")))
+        if report[0]:
+            out.write("\n## Report throughput\n\n`facetfit report` at its default quality (128 x 128, 32 spp) on the %d RGL materials\n"
+                      "beside the RGL file above, cold bake cache: %.1f s, %.1f materials per minute (bake, four renders and\n"
+                      "their Delta E per material).\n" % (report[0], report[1], 60.0 * report[0] / report[1]))
+    os.replace(dst + ".tmp", dst)
+
+
+if __name__ == "__main__":
+    if len(sys.argv) < 4:
+        sys.exit(__doc__)
+    main(*sys.argv[1:5])
