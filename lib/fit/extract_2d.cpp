@@ -21,6 +21,23 @@ Backscatter2D backscatter_2d(const Brdf& brdf, const Quadrature2D& quad) {
   return b;
 }
 
+Backscatter2D backscatter_2d(const UtiaBrdf& utia, const Quadrature2D& quad) {
+  Backscatter2D b;
+  for (int m = 0; m < quad.phi_count(); ++m) {
+    double x = quad.phi(m) * 180.0 / kPi / UtiaBrdf::kPhiStep;
+    const int lo = std::min(int(x), UtiaBrdf::kPhi - 1), hi = (lo + 1) % UtiaBrdf::kPhi;
+    const double t = x - lo;
+    Backscatter slice;
+    for (int p = 0; p < UtiaBrdf::kTheta; ++p) {
+      const Rgb f = utia.node(p, lo, p, lo) * (1.0 - t) + utia.node(p, hi, p, hi) * t;
+      slice.theta.push_back(p * UtiaBrdf::kThetaStep * kPi / 180.0);
+      slice.value.push_back(std::max(0.0, luminance(f)));
+    }
+    b.slices.push_back(std::move(slice));
+  }
+  return b;
+}
+
 Extraction2D extract_ndf_2d(const Backscatter2D& back, const Quadrature2D& quad, const ExtractOptions& options) {
   Extraction2D out;
   const int n = quad.size(), m = quad.phi_count();

@@ -20,6 +20,7 @@
 #include "core/brdf.h"
 #include "fit/extract.h"
 #include "fit/quadrature_2d.h"
+#include "io/utia.h"
 
 namespace facetfit {
 
@@ -31,6 +32,9 @@ struct Backscatter2D {
 
 // f(k, k) of a BRDF (e.g. an analytic anisotropic model) at MERL's theta_h bins and the quadrature's azimuths.
 Backscatter2D backscatter_2d(const Brdf& brdf, const Quadrature2D& quadrature);
+// f(k, k) of a UTIA file: its diagonal nodes (theta_i = theta_v, phi_i = phi_v), six polar angles per
+// azimuth, linear in phi between the file's azimuths (eval() would mix in nodes that are not back-scattering).
+Backscatter2D backscatter_2d(const UtiaBrdf& utia, const Quadrature2D& quadrature);
 
 struct Extraction2D {
   int phi_count = 0;

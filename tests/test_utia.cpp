@@ -1,0 +1,103 @@
+// UTIA anisotropic BRDF files (io/utia.h): the writer and reader are inverse, the lookup is the
+// database readers' quadrilinear one, bad files get one line, and an anisotropic GGX written as UTIA
+// comes back from the 2D extraction (fit/extract_2d.h).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <fstream>
+
+#include "core/error.h"
+#include "fit/extract_2d.h"
+#include "io/utia.h"
+#include "model/analytic.h"
+#include "test_util.h"
+
+namespace facetfit {
+namespace {
+
+// A BRDF whose frame is turned by `angle` about the normal: the analytic models are axis-aligned.
+class Rotated final : public Brdf {
+ public:
+  Rotated(const Brdf& base, double angle) : base_(base), c_(std::cos(angle)), s_(std::sin(angle)) {}
+  std::optional<Rgb> eval(const Vec3& o, const Vec3& i) const override { return base_.eval(turn(o), turn(i)); }
+
+ private:
+  Vec3 turn(const Vec3& v) const { return {c_ * v.x + s_ * v.y, -s_ * v.x + c_ * v.y, v.z}; }  // by -angle
+  const Brdf& base_;
+  double c_, s_;
+};
+
+TEST(Utia, EncodingRoundTripsAndKeepsNegatives) {
+  for (double f : {-0.5, -1e-3, 0.0, 1e-4, 0.01, 0.29, 0.2904, 0.3, 1.0, 12.5, 100.0, 400.0})
+    EXPECT_NEAR(UtiaBrdf::decode(UtiaBrdf::encode(f)), f, 1e-9 * std::max(1.0, std::abs(f))) << f;
+  // The decoding's branches leave a gap of 4e-4 relative at 0.0375 (f 0.29025-0.29036 / sr): its edge.
+  EXPECT_NEAR(UtiaBrdf::decode(UtiaBrdf::encode(0.29027)), 0.29027, 4e-4 * 0.29027);
+  EXPECT_NEAR(UtiaBrdf::decode(1.0), 100.0, 1e-12);  // full scale: 100 / sr
+  EXPECT_LT(UtiaBrdf::decode(-0.01), 0.0);
+}
+
+TEST(Utia, WriteReadAndLookUp) {
+  test::TempDir dir;
+  const MicrofacetBrdf ggx(Ndf{NdfType::ggx, 0.4, 0.2}, Smith::correlated, Fresnel::schlick(Rgb(0.9, 0.6, 0.3)));
+  const Rotated turned(ggx, 0.5);
+  UtiaBrdf::tabulate(turned).write(dir.file("a.bin"));
+  EXPECT_EQ(std::filesystem::file_size(dir.file("a.bin")), UtiaBrdf::kFileBytes);
+  const UtiaBrdf read = UtiaBrdf::read(dir.file("a.bin"));
+  // At the nodes: the BRDF itself.
+  for (int ti : {0, 2, 5})
+    for (int pv : {0, 7, 47}) {
+      const Vec3 i = spherical_direction(ti * 15.0 * kPi / 180.0, 30.0 * kPi / 180.0);
+      const Vec3 o = spherical_direction(45.0 * kPi / 180.0, pv * 7.5 * kPi / 180.0);
+      const Rgb want = *turned.eval(o, i), got = *read.eval(o, i);
+      for (int c = 0; c < 3; ++c) EXPECT_NEAR(got[c], want[c], 1e-9 * std::max(1.0, want[c]));
+    }
+  // Between them: the mean of the two neighbours halfway along one azimuth, periodic across 360 degrees.
+  const Vec3 o = spherical_direction(30.0 * kPi / 180.0, 0.0), i = spherical_direction(45.0 * kPi / 180.0, 358.5 * kPi / 180.0);
+  const Rgb a = read.node(3, 47, 2, 0), b = read.node(3, 0, 2, 0), mid = *read.eval(o, i);
+  const double t = (358.5 - 352.5) / 7.5;
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(mid[c], (1.0 - t) * a[c] + t * b[c], 1e-9);
+}
+
+TEST(Utia, BadFilesGetOneLine) {
+  test::TempDir dir;
+  test::write_bytes(dir.file("short.bin"), std::string(100, '\0'));
+  EXPECT_NE(test::error_of([&] { UtiaBrdf::read(dir.file("short.bin")); }).find("size is 100 bytes"), std::string::npos);
+  EXPECT_NE(test::error_of([&] { UtiaBrdf::read(dir.file("missing.bin")); }).find("no such file"), std::string::npos);
+  std::string bytes(UtiaBrdf::kFileBytes, '\0');
+  const double nan = std::nan("");
+  std::memcpy(&bytes[800], &nan, sizeof nan);
+  test::write_bytes(dir.file("nan.bin"), bytes);
+  EXPECT_NE(test::error_of([&] { UtiaBrdf::read(dir.file("nan.bin")); }).find("byte offset 800"), std::string::npos);
+  EXPECT_NE(test::error_of([&] { UtiaBrdf::read("/dev/zero"); }).find("not a regular file"), std::string::npos);
+}
+
+// The bar: alpha_x and alpha_y within 3% for alpha >= 0.2 from the 15-degree grid.
+struct Case {
+  NdfType type;
+  double alpha_x, alpha_y, angle_degrees;
+};
+class UtiaGroundTruth : public ::testing::TestWithParam<Case> {};
+
+TEST_P(UtiaGroundTruth, AlphasComeBackThroughTheFile) {
+  const Case c = GetParam();
+  test::TempDir dir;
+  const MicrofacetBrdf brdf(Ndf{c.type, c.alpha_x, c.alpha_y}, Smith::masking, Fresnel::one());
+  const double angle = c.angle_degrees * kPi / 180.0;
+  UtiaBrdf::tabulate(Rotated(brdf, angle)).write(dir.file("m.bin"));
+  const Quadrature2D quad(90, 48);
+  const Extraction2D e = extract_ndf_2d(backscatter_2d(UtiaBrdf::read(dir.file("m.bin")), quad), quad, {Smith::masking, 1e-10, 1000});
+  ASSERT_TRUE(e.problem.empty()) << e.problem;
+  const AnisotropicAlpha a = c.type == NdfType::ggx ? alpha_ggx_2d(e.ndf, quad) : alpha_beckmann_2d(e.ndf, quad);
+  EXPECT_NEAR(a.alpha_x, c.alpha_x, 0.03 * c.alpha_x);
+  EXPECT_NEAR(a.alpha_y, c.alpha_y, 0.03 * c.alpha_y);
+  EXPECT_NEAR(a.angle, angle, 2.0 * kPi / 180.0);
+}
+
+INSTANTIATE_TEST_SUITE_P(Utia, UtiaGroundTruth,
+                         ::testing::Values(Case{NdfType::ggx, 0.5, 0.25, 30.0}, Case{NdfType::ggx, 0.8, 0.3, -60.0},
+                                           Case{NdfType::ggx, 0.3, 0.2, 45.0}, Case{NdfType::beckmann, 0.5, 0.25, 30.0},
+                                           Case{NdfType::beckmann, 0.3, 0.2, -20.0}));
+
+}  // namespace
+}  // namespace facetfit
