@@ -256,6 +256,35 @@ TEST(Render, MeasuredMaterialSampledByAGivenLutRendersTheSameImage) {
   EXPECT_NE(test::error_of([&] { render(default_scene(measured)); }).find("none.exr"), std::string::npos);
 }
 
+TEST(Render, StretchedLutMaterials) {
+  // The scene's stretch reaches the model (tests/test_stretch.cpp checks the model against the analytic
+  // anisotropic GGX): the identity renders the LUT as it is, a stretch changes the image, and bad values
+  // get one line.
+  test::TempDir dir;
+  const Fitter fitter{FitOptions::paper()};
+  write_lut(dir.file("gold.exr"),
+            make_lut(fitter.fit(load_table("builtin:gold-ggx-0.15")), fitter.quadrature(), "builtin:gold-ggx-0.15", "x", 0.02, true));
+  const auto scene = [&](const std::string& extra) {
+    SceneDesc s = parse_scene_text(R"({"camera": {"width": 32, "height": 32}, "render": {"spp": 8},
+      "environment": {"builtin": "sky"},
+      "materials": {"m": {"type": "lut", "file": "gold.exr")" + extra + R"(}},
+      "objects": [{"type": "sphere", "material": "m"}]})", "s.json", dir.path().string());
+    return s;
+  };
+  const RenderedImage plain = render(scene("")), identity = render(scene(R"(, "stretch": [1, 1], "rotation": 40)"));
+  EXPECT_EQ(plain.rgba, identity.rgba);
+  const RenderedImage stretched = render(scene(R"(, "stretch": [3, 0.5], "rotation": 30)"));
+  double diff = 0.0;
+  for (std::size_t k = 0; k < plain.rgba.size(); ++k) diff += std::abs(plain.rgba[k] - stretched.rgba[k]);
+  EXPECT_GT(diff / double(plain.rgba.size()), 1e-3);
+  EXPECT_NE(test::error_of([&] { scene(R"(, "stretch": [0, 1])"); }).find("stretch must be in [0.01, 100]"), std::string::npos);
+  EXPECT_NE(test::error_of([&] { scene(R"(, "stretch": 2)"); }).find("stretch must be [x, y]"), std::string::npos);
+  EXPECT_NE(test::error_of([&] {
+              parse_scene_text(R"({"materials": {"m": {"type": "ggx", "alpha": 0.2, "stretch": [2, 1]}},
+                                   "objects": [{"type": "sphere", "material": "m"}]})", "t.json", ".");
+            }).find("are for lut materials"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace facetfit
 

@@ -54,17 +54,25 @@ VisibleNormalTables VisibleNormalTables::build(const TabulatedNdf& ndf) {
 TabulatedMicrofacet::TabulatedMicrofacet(MicrofacetTables tables)
     : TabulatedMicrofacet(tables, VisibleNormalTables::build(tables.ndf)) {}
 
-TabulatedMicrofacet::TabulatedMicrofacet(MicrofacetTables tables, VisibleNormalTables sampling)
-    : tables_(std::move(tables)), sampling_(std::move(sampling)) {
+TabulatedMicrofacet::TabulatedMicrofacet(MicrofacetTables tables, VisibleNormalTables sampling, Stretch stretch)
+    : tables_(std::move(tables)), sampling_(std::move(sampling)), stretch_(stretch) {
   for (int j = 0; j < tables_.ndf.grid.size(); ++j) cos_nodes_.push_back(std::cos(tables_.ndf.grid.theta(j)));
   parts_ = ProposalParts(tables_.fresnel.value[0], tables_.body, tables_.coat);
 }
 
 double TabulatedMicrofacet::D(const Vec3& h) const {
-  return h.z > 0.0 ? tables_.ndf.D(std::acos(std::min(h.z, 1.0))) : 0.0;
+  if (h.z <= 0.0) return 0.0;
+  if (stretch_.identity()) return tables_.ndf.D(std::acos(std::min(h.z, 1.0)));
+  // D_s(h) = P(slopes / s) / (s_x s_y cos^4) with P = D cos^4 of the measured normal.
+  const Vec3 m = stretch_.measured_normal(stretch_.to_frame(h));
+  const double r = m.z / h.z;
+  return tables_.ndf.D(std::acos(std::min(m.z, 1.0))) * r * r * r * r / (stretch_.x * stretch_.y);
 }
 
-double TabulatedMicrofacet::g1(const Vec3& w) const { return tables_.ndf.g1(w.z); }
+double TabulatedMicrofacet::g1(const Vec3& w) const {
+  if (stretch_.identity() || w.z <= 0.0) return tables_.ndf.g1(w.z);
+  return tables_.ndf.g1(stretch_.direction(stretch_.to_frame(w)).z);  // Lambda_s(w) = Lambda(w')
+}
 
 Rgb TabulatedMicrofacet::fresnel(double cos_d) const { return tables_.fresnel.eval(std::acos(clamp(cos_d, 0.0, 1.0))); }
 
@@ -120,6 +128,15 @@ double sample_phi(double a, double b, double u) {
 }  // namespace
 
 double TabulatedMicrofacet::visible_normal_pdf(const Vec3& o, const Vec3& h) const {
+  if (stretch_.identity()) return measured_visible_normal_pdf(o, h);
+  if (o.z <= 0.0 || h.z <= 0.0 || glm::dot(o, h) <= 0.0) return 0.0;
+  // The measured lobe's density at the measured normal, seen from the stretched view, times the Jacobian
+  // of the normals (model/stretch.h): exactly the stretched lobe's visible normals.
+  const Vec3 m = stretch_.measured_normal(stretch_.to_frame(h));
+  return measured_visible_normal_pdf(stretch_.direction(stretch_.to_frame(o)), m) * stretch_.normal_jacobian(h.z, m.z);
+}
+
+double TabulatedMicrofacet::measured_visible_normal_pdf(const Vec3& o, const Vec3& h) const {
   const double oh = glm::dot(o, h);
   if (o.z <= 0.0 || h.z <= 0.0 || oh <= 0.0 || sampling_.empty()) return 0.0;
   const ThetaGrid& grid = tables_.ndf.grid;
@@ -163,6 +180,19 @@ std::optional<Vec3> TabulatedMicrofacet::sample_direction(const Vec3& o, double 
 }
 
 std::optional<Vec3> TabulatedMicrofacet::lobe_direction(const Vec3& o, double u1, double u2) const {
+  Vec3 h;
+  if (stretch_.identity()) {
+    h = measured_visible_normal(o, u1, u2);
+  } else {  // the measured lobe's visible normals seen from the stretched view, stretched back
+    const Vec3 m = measured_visible_normal(stretch_.direction(stretch_.to_frame(o)), u1, u2);
+    h = stretch_.from_frame(stretch_.stretched_normal(m));
+  }
+  const Vec3 i = 2.0 * glm::dot(o, h) * h - o;
+  if (i.z <= 0.0) return std::nullopt;
+  return i;
+}
+
+Vec3 TabulatedMicrofacet::measured_visible_normal(const Vec3& o, double u1, double u2) const {
   const ThetaGrid& grid = tables_.ndf.grid;
   const int r = grid.resolution;
   // Pick one of the two view slices around o with the weights of the mixture, reusing u1.
@@ -183,10 +213,7 @@ std::optional<Vec3> TabulatedMicrofacet::lobe_direction(const Vec3& o, double u1
   const double sin_h = std::sqrt(std::max(0.0, 1.0 - cos_h * cos_h));
   const double sin_o = std::sqrt(std::max(0.0, 1.0 - o.z * o.z));
   const double phi = sample_phi(sin_o * sin_h, o.z * cos_h, u2) + (sin_o > 0.0 ? std::atan2(o.y, o.x) : 0.0);
-  const Vec3 h(sin_h * std::cos(phi), sin_h * std::sin(phi), cos_h);
-  const Vec3 i = 2.0 * glm::dot(o, h) * h - o;
-  if (i.z <= 0.0) return std::nullopt;
-  return i;
+  return {sin_h * std::cos(phi), sin_h * std::sin(phi), cos_h};
 }
 
 }  // namespace facetfit

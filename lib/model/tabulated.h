@@ -18,6 +18,7 @@
 #include "model/coat.h"
 #include "model/proposal.h"
 #include "model/smith.h"
+#include "model/stretch.h"
 
 namespace facetfit {
 
@@ -47,8 +48,9 @@ class TabulatedMicrofacet final : public Brdf, public Proposal {
  public:
   // Builds the sampling tables from the NDF.
   explicit TabulatedMicrofacet(MicrofacetTables tables);
-  // Uses given sampling tables (from a LUT); empty tables make sample() and pdf() unavailable.
-  TabulatedMicrofacet(MicrofacetTables tables, VisibleNormalTables sampling);
+  // Uses given sampling tables (from a LUT); empty tables make sample() and pdf() unavailable. A stretch
+  // (model/stretch.h) reshapes the lobe, not the tables: D, masking, sampling and pdf follow it.
+  TabulatedMicrofacet(MicrofacetTables tables, VisibleNormalTables sampling, Stretch stretch = {});
 
   std::optional<Rgb> eval(const Vec3& o, const Vec3& i) const override;
 
@@ -83,6 +85,7 @@ class TabulatedMicrofacet final : public Brdf, public Proposal {
 
   const MicrofacetTables& tables() const { return tables_; }
   const VisibleNormalTables& sampling() const { return sampling_; }
+  const Stretch& stretch() const { return stretch_; }
   bool can_sample() const override { return !sampling_.empty(); }
 
  private:
@@ -90,8 +93,12 @@ class TabulatedMicrofacet final : public Brdf, public Proposal {
   VisibleNormalTables sampling_;
   std::vector<double> cos_nodes_;  // cos(theta_j)
   ProposalParts parts_;
+  Stretch stretch_;
 
   std::optional<Vec3> lobe_direction(const Vec3& o, double u1, double u2) const;
+  // The measured (unstretched) lobe's visible normals: a draw, and the density per steradian of h.
+  Vec3 measured_visible_normal(const Vec3& o, double u1, double u2) const;
+  double measured_visible_normal_pdf(const Vec3& o, const Vec3& h) const;
 };
 
 }  // namespace facetfit

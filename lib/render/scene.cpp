@@ -112,6 +112,20 @@ MaterialDesc parse_material(const std::string& name, const json& j, const std::s
   if (!smith) fail(path, "material " + name + ": smith must be masking, correlated or separable");
   m.smith = *smith;
   if (j.contains("albedo")) m.albedo = nonnegative(j["albedo"], "material " + name + ": albedo", path);
+  if (j.contains("stretch") || j.contains("rotation")) {
+    if (m.type != "lut") fail(path, "material " + name + ": \"stretch\" and \"rotation\" are for lut materials");
+    if (j.contains("stretch")) {
+      const json& st = j["stretch"];
+      if (!st.is_array() || st.size() != 2 || !st[0].is_number() || !st[1].is_number())
+        fail(path, "material " + name + ": stretch must be [x, y]");
+      m.stretch.x = st[0].get<double>(), m.stretch.y = st[1].get<double>();
+      if (!(m.stretch.x >= 0.01 && m.stretch.x <= 100.0 && m.stretch.y >= 0.01 && m.stretch.y <= 100.0))
+        fail(path, "material " + name + ": stretch must be in [0.01, 100]");
+    }
+    const double degrees = get<double>(j, "rotation", 0.0, path);
+    if (!(std::abs(degrees) <= 360.0)) fail(path, "material " + name + ": rotation must be in [-360, 360] degrees");
+    m.stretch.rotation = degrees * kPi / 180.0;
+  }
   return m;
 }
 
@@ -350,6 +364,7 @@ std::shared_ptr<const ShadingModel> load_material(const SceneDesc& scene, const 
   }
   if (m.type == "lut") {
     std::shared_ptr<const TabulatedMicrofacet> model = sampled_lut_model(resolve(scene, m.file));
+    if (!m.stretch.identity()) model = std::make_shared<TabulatedMicrofacet>(model->tables(), model->sampling(), m.stretch);
     return std::make_shared<ShadingModel>(model, model);
   }
   // ggx | beckmann | lsq (the LUT's classical baseline: Lambert + GGX + Schlick); nothing else renders as them

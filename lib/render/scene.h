@@ -10,6 +10,7 @@
 
 #include "core/vec.h"
 #include "model/smith.h"
+#include "model/stretch.h"
 #include "render/shading.h"
 
 namespace facetfit {
@@ -48,6 +49,9 @@ struct MaterialDesc {
   std::string proposal;
   Smith smith = Smith::correlated;
   Rgb albedo{0.8};
+  // lut: the artist's stretch of the tabulated lobe (model/stretch.h): "stretch": [x, y] (roughness
+  // grows with it), "rotation" of its x axis in degrees.
+  Stretch stretch;
 };
 
 struct ObjectDesc {
