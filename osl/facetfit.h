@@ -28,6 +28,12 @@ struct FacetfitLut {
   float coat_f0;
   float weight_lobe;  // probabilities of the sampler's parts: lobe, body, then coat (lib/model/tabulated.h)
   float weight_body;
+  // The artist's stretch of the lobe (lib/model/stretch.h): slopes scaled by (stretch_x, stretch_y) along
+  // axes turned by the rotation (its cosine and sine) about the normal; (1, 1): the LUT as fitted.
+  float stretch_x;
+  float stretch_y;
+  float rotation_cos;
+  float rotation_sin;
   int ok;
 };
 
@@ -145,15 +151,53 @@ float facetfit_spline(FacetfitLut lut, int row, float theta) {
          w3 * facetfit_texel(lut, row, i3);
 }
 
-// D of a unit half vector h.
-float facetfit_D(FacetfitLut lut, vector h) {
-  if (h[2] <= 0.0) return 0.0;
-  return max(0.0, facetfit_spline(lut, FACETFIT_NDF_ROW, facetfit_theta(h)));
+// ---- the artist's stretch (lib/model/stretch.h): the tables stay, directions are transformed ----
+
+int facetfit_stretched(FacetfitLut lut) { return lut.stretch_x != 1.0 || lut.stretch_y != 1.0; }
+
+// The LUT with its lobe's slopes stretched by (x, y) along axes at `rotation` radians from the tangent:
+// roughness in proportion (textures may drive all three per shading point).
+FacetfitLut facetfit_stretch(FacetfitLut lut_in, float x, float y, float rotation) {
+  FacetfitLut lut = lut_in;
+  lut.stretch_x = x;
+  lut.stretch_y = y;
+  facetfit_sincos(rotation, lut.rotation_sin, lut.rotation_cos);
+  return lut;
 }
 
-// Smith masking G1 = cos / sigma of a unit direction w.
-float facetfit_G1(FacetfitLut lut, vector w) {
-  if (w[2] <= 0.0) return 0.0;
+// Into and out of the stretch's frame (its x axis at the rotation).
+vector facetfit_to_stretch(FacetfitLut lut, vector v) {
+  return vector(lut.rotation_cos * v[0] + lut.rotation_sin * v[1], -lut.rotation_sin * v[0] + lut.rotation_cos * v[1], v[2]);
+}
+vector facetfit_from_stretch(FacetfitLut lut, vector v) {
+  return vector(lut.rotation_cos * v[0] - lut.rotation_sin * v[1], lut.rotation_sin * v[0] + lut.rotation_cos * v[1], v[2]);
+}
+// A direction as the measured lobe sees it; a stretched normal as the measured lobe's, and back.
+vector facetfit_stretch_direction(FacetfitLut lut, vector w) {
+  vector f = facetfit_to_stretch(lut, w);
+  return normalize(vector(lut.stretch_x * f[0], lut.stretch_y * f[1], f[2]));
+}
+vector facetfit_measured_normal(FacetfitLut lut, vector h) {
+  vector f = facetfit_to_stretch(lut, h);
+  return normalize(vector(f[0] / lut.stretch_x, f[1] / lut.stretch_y, f[2]));
+}
+vector facetfit_stretched_normal(FacetfitLut lut, vector m) {
+  return facetfit_from_stretch(lut, normalize(vector(lut.stretch_x * m[0], lut.stretch_y * m[1], m[2])));
+}
+
+// D of a unit half vector h: P(slopes / s) / (s_x s_y cos^4) when stretched.
+float facetfit_D(FacetfitLut lut, vector h) {
+  if (h[2] <= 0.0) return 0.0;
+  if (!facetfit_stretched(lut)) return max(0.0, facetfit_spline(lut, FACETFIT_NDF_ROW, facetfit_theta(h)));
+  vector m = facetfit_measured_normal(lut, h);
+  float r = m[2] / h[2], r2 = r * r;
+  return max(0.0, facetfit_spline(lut, FACETFIT_NDF_ROW, facetfit_theta(m))) * r2 * r2 / (lut.stretch_x * lut.stretch_y);
+}
+
+// Smith masking G1 = cos / sigma of a unit direction w (stretch-invariant: of the transformed direction).
+float facetfit_G1(FacetfitLut lut, vector w_in) {
+  if (w_in[2] <= 0.0) return 0.0;
+  vector w = facetfit_stretched(lut) ? facetfit_stretch_direction(lut, w_in) : w_in;
   float s = facetfit_spline(lut, FACETFIT_SIGMA_ROW, facetfit_theta(w));
   return s > w[2] ? w[2] / s : 1.0;
 }
@@ -186,6 +230,10 @@ FacetfitLut facetfit_open(string file) {
   lut.coat_f0 = 0.0;
   lut.weight_lobe = 1.0;
   lut.weight_body = 0.0;
+  lut.stretch_x = 1.0;
+  lut.stretch_y = 1.0;
+  lut.rotation_cos = 1.0;
+  lut.rotation_sin = 0.0;
   int res[2] = {0, 0};
   int version = 0, resolution = 0, sampling = 0;
   if (gettextureinfo(file, "resolution", res) && gettextureinfo(file, "facetfit:format_version", version) &&
@@ -270,8 +318,8 @@ float facetfit_phi_integral(float a, float b) {
   return 2.0 * (sqrt(a * a - b * b) + b * facetfit_acos(-b / a));
 }
 
-// Density of the visible normals h seen from o, per steradian of h.
-float facetfit_visible_normal_pdf(FacetfitLut lut, vector o, vector h) {
+// Density of the measured lobe's visible normals h seen from o, per steradian of h.
+float facetfit_measured_visible_normal_pdf(FacetfitLut lut, vector o, vector h) {
   float oh = dot(o, h);
   if (o[2] <= 0.0 || h[2] <= 0.0 || oh <= 0.0 || !lut.sampling) return 0.0;
   int vj, nj;
@@ -286,6 +334,16 @@ float facetfit_visible_normal_pdf(FacetfitLut lut, vector o, vector h) {
   float sin_o = sqrt(o[0] * o[0] + o[1] * o[1]), sin_h = sqrt(h[0] * h[0] + h[1] * h[1]);
   float total = facetfit_phi_integral(sin_o * sin_h, o[2] * h[2]);
   return total > 0.0 ? mass / band * oh / total : 0.0;
+}
+
+// Density of the visible normals h seen from o, per steradian of h; stretched, the measured lobe's seen
+// from the transformed view at the measured normal, times the normals' Jacobian.
+float facetfit_visible_normal_pdf(FacetfitLut lut, vector o, vector h) {
+  if (!facetfit_stretched(lut)) return facetfit_measured_visible_normal_pdf(lut, o, h);
+  if (o[2] <= 0.0 || h[2] <= 0.0 || dot(o, h) <= 0.0) return 0.0;
+  vector m = facetfit_measured_normal(lut, h);
+  float r = m[2] / h[2];
+  return facetfit_measured_visible_normal_pdf(lut, facetfit_stretch_direction(lut, o), m) * r * r * r / (lut.stretch_x * lut.stretch_y);
 }
 
 // Density of the lobe's part of facetfit_sample alone, per steradian of i.
@@ -335,8 +393,8 @@ float facetfit_sample_phi(float a, float b, float u_in) {
   return sgn * phi;
 }
 
-// The lobe's part: its visible normals, o reflected about them.
-int facetfit_sample_lobe(FacetfitLut lut, vector o, float u1_in, float u2, output vector i) {
+// A visible normal of the measured lobe seen from o.
+vector facetfit_measured_visible_normal(FacetfitLut lut, vector o, float u1_in, float u2) {
   int vj;
   float vt;
   facetfit_locate(lut, o, vj, vt);
@@ -365,7 +423,14 @@ int facetfit_sample_lobe(FacetfitLut lut, vector o, float u1_in, float u2, outpu
   float phi = facetfit_sample_phi(sin_o * sin_h, o[2] * cos_h, u2) + (sin_o > 0.0 ? facetfit_azimuth(o[0], o[1]) : 0.0);
   float sin_phi, cos_phi;
   facetfit_sincos(phi, sin_phi, cos_phi);
-  vector h = vector(sin_h * cos_phi, sin_h * sin_phi, cos_h);
+  return vector(sin_h * cos_phi, sin_h * sin_phi, cos_h);
+}
+
+// The lobe's part: its visible normals (stretched: the measured lobe's seen from the transformed view,
+// stretched back), o reflected about them.
+int facetfit_sample_lobe(FacetfitLut lut, vector o, float u1, float u2, output vector i) {
+  vector h = facetfit_stretched(lut) ? facetfit_stretched_normal(lut, facetfit_measured_visible_normal(lut, facetfit_stretch_direction(lut, o), u1, u2))
+                                     : facetfit_measured_visible_normal(lut, o, u1, u2);
   i = 2.0 * dot(o, h) * h - o;
   return i[2] > 0.0;
 }
