@@ -481,6 +481,18 @@ void facetfit_frame(normal Nn, output vector T, output vector B) {
   B = cross(Nn, T);
 }
 
+// The local frame with x along the surface projection of `along` (world space; an anisotropic or
+// stretched lobe's axes follow it), or facetfit_frame's where that projection vanishes.
+void facetfit_frame_along(normal Nn, vector along, output vector T, output vector B) {
+  vector projected = along - Nn * dot(along, Nn);
+  if (length(projected) > 1e-6) {
+    T = normalize(projected);
+    B = cross(Nn, T);
+  } else {
+    facetfit_frame(Nn, T, B);
+  }
+}
+
 vector facetfit_to_local(vector v, vector T, vector B, normal Nn) { return vector(dot(v, T), dot(v, B), dot(v, Nn)); }
 vector facetfit_to_world(vector v, vector T, vector B, normal Nn) { return v[0] * T + v[1] * B + v[2] * Nn; }
 

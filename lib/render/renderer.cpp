@@ -40,6 +40,15 @@ struct Frame {  // orthonormal basis around n (Duff et al. 2017)
     t = Vec3(1.0 + sign * n.x * n.x * a, sign * c, -sign * n.x);
     b = Vec3(c, sign + n.y * n.y * a, -n.y);
   }
+  // With its x axis along the projection of a given direction on the surface (an anisotropic lobe's axes
+  // follow it); the frame above where that projection vanishes.
+  Frame(const Vec3& normal, const Vec3& along) : Frame(normal) {
+    const Vec3 projected = along - glm::dot(along, n) * n;
+    const double len = glm::length(projected);
+    if (!(len > 1e-9)) return;
+    t = projected / len;
+    b = glm::cross(n, t);
+  }
   Vec3 to_local(const Vec3& v) const { return {glm::dot(v, t), glm::dot(v, b), glm::dot(v, n)}; }
   Vec3 to_world(const Vec3& v) const { return v.x * t + v.y * b + v.z * n; }
 };
@@ -104,11 +113,13 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
                image_bytes, budget);
   // Only what the scene uses is loaded.
   std::vector<std::shared_ptr<const ShadingModel>> materials;
+  std::vector<std::optional<Vec3>> tangents;  // per material: the world direction its tangent follows
   std::map<std::string, int> material_index;
   for (const ObjectDesc& o : desc.objects) {
     if (material_index.count(o.material)) continue;
     material_index[o.material] = int(materials.size());
     materials.push_back(load_material(desc, desc.materials.at(o.material)));
+    tangents.push_back(desc.materials.at(o.material).tangent);
   }
   std::optional<Environment> env;
   switch (desc.environment.kind) {
@@ -223,7 +234,8 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
     Vec3 n = geo.object->kind == ObjectDesc::Kind::sphere ? glm::normalize(p - geo.object->center)
                                                           : glm::normalize(Vec3(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z));
     if (glm::dot(n, dir) > 0.0) n = -n;  // shade the side the camera sees
-    const Frame frame(n);
+    const std::optional<Vec3>& tangent = tangents[std::size_t(geo.material)];
+    const Frame frame = tangent ? Frame(n, *tangent) : Frame(n);
     const Vec3 o = frame.to_local(-dir);
     const ShadingModel& model = *materials[std::size_t(geo.material)];
     const Vec3 origin = p + eps * n;

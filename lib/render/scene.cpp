@@ -112,8 +112,9 @@ MaterialDesc parse_material(const std::string& name, const json& j, const std::s
   if (!smith) fail(path, "material " + name + ": smith must be masking, correlated or separable");
   m.smith = *smith;
   if (j.contains("albedo")) m.albedo = nonnegative(j["albedo"], "material " + name + ": albedo", path);
-  if (j.contains("stretch") || j.contains("rotation")) {
-    if (m.type != "lut") fail(path, "material " + name + ": \"stretch\" and \"rotation\" are for lut materials");
+  if (j.contains("stretch") || j.contains("rotation") || j.contains("tangent")) {
+    if (m.type != "lut") fail(path, "material " + name + ": \"stretch\", \"rotation\" and \"tangent\" are for lut materials");
+    if (j.contains("tangent")) m.tangent = direction(j["tangent"], "material " + name + ": tangent", path);
     if (j.contains("stretch")) {
       const json& st = j["stretch"];
       if (!st.is_array() || st.size() != 2 || !st[0].is_number() || !st[1].is_number())

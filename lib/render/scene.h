@@ -50,8 +50,10 @@ struct MaterialDesc {
   Smith smith = Smith::correlated;
   Rgb albedo{0.8};
   // lut: the artist's stretch of the tabulated lobe (model/stretch.h): "stretch": [x, y] (roughness
-  // grows with it), "rotation" of its x axis in degrees.
+  // grows with it), "rotation" of its x axis in degrees from the tangent; "tangent": a world direction
+  // whose projection on the surface is the tangent (else any tangent: fine for an isotropic lobe).
   Stretch stretch;
+  std::optional<Vec3> tangent;
 };
 
 struct ObjectDesc {

@@ -7,7 +7,7 @@
         The reference renderer's default view (docs/scene-format.md) of a unit sphere shaded by SHADER
         under the lat-long map ENV.exr, direct lighting, box pixel filter, transparent film.
 
-NAME=VALUE set the shader's parameters (ints, floats or strings, as the parameter's type). Output: float
+NAME=VALUE set the shader's parameters (ints, floats, strings, or vectors as x,y,z, as the parameter's type). Output: float
 RGBA OpenEXR, scene-linear, no view transform.
 """
 import glob
@@ -59,7 +59,10 @@ def script_material(shader, params):
             sys.exit(f"{shader}: no parameter '{name}' (has {[i.name for i in script.inputs]})")
         socket = script.inputs[name]
         value = socket.default_value
-        socket.default_value = type(value)(text) if isinstance(value, (int, float, str)) else text
+        if isinstance(value, (int, float, str)):
+            socket.default_value = type(value)(text)
+        else:  # a vector or colour: "x,y,z"
+            socket.default_value = [float(v) for v in text.split(",")]
     out = nodes.new("ShaderNodeOutputMaterial")
     material.node_tree.links.new(script.outputs[0], out.inputs["Surface"])
     return material
