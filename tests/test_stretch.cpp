@@ -13,18 +13,6 @@
 namespace facetfit {
 namespace {
 
-// The analytic model with its axes turned by `angle` about the normal.
-class Rotated final : public Brdf {
- public:
-  Rotated(const Brdf& base, double angle) : base_(base), c_(std::cos(angle)), s_(std::sin(angle)) {}
-  std::optional<Rgb> eval(const Vec3& o, const Vec3& i) const override { return base_.eval(turn(o), turn(i)); }
-
- private:
-  Vec3 turn(const Vec3& v) const { return {c_ * v.x + s_ * v.y, -s_ * v.x + c_ * v.y, v.z}; }
-  const Brdf& base_;
-  double c_, s_;
-};
-
 TabulatedMicrofacet stretched_ggx(double alpha, Stretch stretch) {
   MicrofacetTables tables;
   tables.ndf = tabulate_ndf(Ndf::isotropic(NdfType::ggx, alpha));
@@ -40,7 +28,7 @@ TEST(Stretch, EqualsTheAnalyticAnisotropicGgxInEval) {
   const MicrofacetBrdf ggx(Ndf{NdfType::ggx, 0.4, 0.1}, Smith::correlated, Fresnel::one());
   for (const double rotation : {0.0, kRotation}) {
     const TabulatedMicrofacet model = stretched_ggx(0.2, {2.0, 0.5, rotation});
-    const Rotated truth(ggx, rotation);
+    const test::Rotated truth(ggx, rotation);
     std::mt19937 rng(7);
     double worst = 0.0;
     int counted = 0;
@@ -59,7 +47,7 @@ TEST(Stretch, EqualsTheAnalyticAnisotropicGgxInEval) {
 
 TEST(Stretch, PdfIsTheAnalyticVisibleNormalsAndAlbedoMatches) {
   const MicrofacetBrdf ggx(Ndf{NdfType::ggx, 0.4, 0.1}, Smith::correlated, Fresnel::one());
-  const Rotated truth(ggx, kRotation);
+  const test::Rotated truth(ggx, kRotation);
   const TabulatedMicrofacet model = stretched_ggx(0.2, {2.0, 0.5, kRotation});
   const Ndf ndf{NdfType::ggx, 0.4, 0.1};
   const Stretch turn{1.0, 1.0, kRotation};
@@ -98,38 +86,9 @@ TEST(Stretch, ChiSquareOfTheStretchedSampler) {
   for (const double phi_o : {0.0, 1.0, 2.2}) {
     SCOPED_TRACE(phi_o);
     const Vec3 o = spherical_direction(45.0 * kPi / 180.0, phi_o);
-    constexpr int kCos = 32, kPhi = 64, kSub = 8;
-    const std::size_t outside = std::size_t(kCos) * kPhi;
-    const int n = 300000;
-    std::mt19937 rng(11);
-    std::uniform_real_distribution<double> u(0.0, 1.0);
-    std::vector<double> observed(outside + 1, 0.0);
-    for (int k = 0; k < n; ++k) {
-      const auto i = model.sample_direction(o, u(rng), u(rng));
-      if (!i) {
-        observed[outside] += 1;
-        continue;
-      }
-      double phi = std::atan2(i->y, i->x);
-      if (phi < 0) phi += 2 * kPi;
-      observed[std::size_t(std::min(kCos - 1, int(i->z * kCos)) * kPhi + std::min(kPhi - 1, int(phi / (2 * kPi) * kPhi)))] += 1;
-    }
-    std::vector<double> expected(outside + 1, 0.0);
-    double total = 0.0;
-    for (int a = 0; a < kCos; ++a)
-      for (int b = 0; b < kPhi; ++b) {
-        double sum = 0.0;
-        const double dc = 1.0 / (kCos * kSub), dphi = 2 * kPi / (kPhi * kSub);
-        for (int p = 0; p < kSub; ++p)
-          for (int q = 0; q < kSub; ++q) {
-            const double c = (a * kSub + p + 0.5) * dc, s = std::sqrt(1 - c * c), phi = (b * kSub + q + 0.5) * dphi;
-            sum += model.pdf(o, Vec3(s * std::cos(phi), s * std::sin(phi), c)) * dc * dphi;
-          }
-        expected[std::size_t(a * kPhi + b)] = sum * n;
-        total += sum;
-      }
-    expected[outside] = std::max(0.0, (1.0 - total) * n);
-    const test::ChiSquareResult r = test::chi_square(observed, expected);
+    const test::ChiSquareResult r = test::chi_square_in_directions(
+        [&](double u1, double u2) { return model.sample_direction(o, u1, u2); }, [&](const Vec3& i) { return model.pdf(o, i); }, 300000, 11,
+        64);
     // Three tests: a significance of 1e-3 each, Bonferroni-corrected from 3e-3 overall.
     EXPECT_GT(r.p_value, 1e-3) << "chi2 " << r.statistic << " dof " << r.dof;
   }

@@ -16,18 +16,6 @@
 namespace facetfit {
 namespace {
 
-// A BRDF whose frame is turned by `angle` about the normal: the analytic models are axis-aligned.
-class Rotated final : public Brdf {
- public:
-  Rotated(const Brdf& base, double angle) : base_(base), c_(std::cos(angle)), s_(std::sin(angle)) {}
-  std::optional<Rgb> eval(const Vec3& o, const Vec3& i) const override { return base_.eval(turn(o), turn(i)); }
-
- private:
-  Vec3 turn(const Vec3& v) const { return {c_ * v.x + s_ * v.y, -s_ * v.x + c_ * v.y, v.z}; }  // by -angle
-  const Brdf& base_;
-  double c_, s_;
-};
-
 TEST(Utia, EncodingRoundTripsAndKeepsNegatives) {
   for (double f : {-0.5, -1e-3, 0.0, 1e-4, 0.01, 0.29, 0.2904, 0.3, 1.0, 12.5, 100.0, 400.0})
     EXPECT_NEAR(UtiaBrdf::decode(UtiaBrdf::encode(f)), f, 1e-9 * std::max(1.0, std::abs(f))) << f;
@@ -40,7 +28,7 @@ TEST(Utia, EncodingRoundTripsAndKeepsNegatives) {
 TEST(Utia, WriteReadAndLookUp) {
   test::TempDir dir;
   const MicrofacetBrdf ggx(Ndf{NdfType::ggx, 0.4, 0.2}, Smith::correlated, Fresnel::schlick(Rgb(0.9, 0.6, 0.3)));
-  const Rotated turned(ggx, 0.5);
+  const test::Rotated turned(ggx, 0.5);
   UtiaBrdf::tabulate(turned).write(dir.file("a.bin"));
   EXPECT_EQ(std::filesystem::file_size(dir.file("a.bin")), UtiaBrdf::kFileBytes);
   const UtiaBrdf read = UtiaBrdf::read(dir.file("a.bin"));
@@ -84,7 +72,7 @@ TEST_P(UtiaGroundTruth, AlphasComeBackThroughTheFile) {
   test::TempDir dir;
   const MicrofacetBrdf brdf(Ndf{c.type, c.alpha_x, c.alpha_y}, Smith::masking, Fresnel::one());
   const double angle = c.angle_degrees * kPi / 180.0;
-  UtiaBrdf::tabulate(Rotated(brdf, angle)).write(dir.file("m.bin"));
+  UtiaBrdf::tabulate(test::Rotated(brdf, angle)).write(dir.file("m.bin"));
   const Quadrature2D quad(90, 48);
   const Extraction2D e = extract_ndf_2d(backscatter_2d(UtiaBrdf::read(dir.file("m.bin")), quad), quad, {Smith::masking, 1e-10, 1000});
   ASSERT_TRUE(e.problem.empty()) << e.problem;

@@ -68,6 +68,48 @@ double dot(const double* a, const std::vector<double>& b) {
 
 }  // namespace
 
+PowerIteration power_iterate(std::vector<double>& D, const std::vector<double>& q, const std::vector<double>& area_weight,
+                             const ExtractOptions& options,
+                             const std::function<void(bool, const std::vector<double>&, std::vector<double>&)>& apply) {
+  PowerIteration out;
+  const std::size_t n = D.size();
+  // Normalizes y so that its projected area is one; returns that area (the eigenvalue estimate).
+  const auto normalize = [&](std::vector<double>& y) {
+    double s = 0.0;
+    for (std::size_t c = 0; c < n; ++c) s += area_weight[c] * y[c];
+    if (!(s > 0.0) || !std::isfinite(s)) return 0.0;
+    for (double& v : y) v /= s;
+    return s;
+  };
+  if (normalize(D) == 0.0) {
+    out.problem = "no back-scattered signal (all-zero or missing measurements)";
+    return out;
+  }
+  std::vector<double> y(n), sigma(n);
+  for (out.iterations = 1; out.iterations <= options.max_iterations; ++out.iterations) {
+    apply(options.smith == Smith::correlated, D, sigma);
+    for (std::size_t c = 0; c < n; ++c) {
+      const double s = std::max(0.0, sigma[c]);  // the spline can dip below zero between nodes: clip
+      y[c] = 4.0 * q[c] * (options.smith == Smith::separable ? s * s : s);
+    }
+    out.eigenvalue = normalize(y);
+    if (out.eigenvalue == 0.0) {
+      out.problem = "the back-scattering operator maps the distribution to zero";
+      return out;
+    }
+    double change = 0.0;
+    for (std::size_t c = 0; c < n; ++c) change += area_weight[c] * std::abs(y[c] - D[c]);
+    D.swap(y);
+    out.residual = change;
+    if (change <= options.tolerance) {
+      out.converged = true;
+      break;
+    }
+  }
+  out.iterations = std::min(out.iterations, options.max_iterations);
+  return out;
+}
+
 Extraction extract_ndf(const Backscatter& back, const Quadrature& quad, const ExtractOptions& options) {
   Extraction out;
   const ThetaGrid& grid = quad.grid();
@@ -80,54 +122,14 @@ Extraction extract_ndf(const Backscatter& back, const Quadrature& quad, const Ex
     return out;
   }
   const std::vector<double> q = kernel_factor(back, grid, options.smith);
-  const std::vector<double>& area = quad.projected_area();
-
-  // Normalizes y so that its projected area is one; returns that area (the eigenvalue estimate).
-  const auto normalize = [&](std::vector<double>& y) {
-    const double s = dot(area.data(), y);
-    if (!(s > 0.0) || !std::isfinite(s)) return 0.0;
-    for (double& v : y) v /= s;
-    return s;
-  };
-
   // Start from D proportional to f(k,k) cos^2(theta_k), the answer for sigma(k) = cos(theta_k).
   std::vector<double>& D = out.ndf.ndf;
   for (int k = 0; k < n; ++k) D[std::size_t(k)] = q[std::size_t(k)] * std::cos(grid.theta(k));
-  if (normalize(D) == 0.0) {
-    out.problem = "no back-scattered signal (all-zero or missing measurements)";
-    return out;
-  }
-
-  std::vector<double> y(static_cast<std::size_t>(n));
-  for (out.iterations = 1; out.iterations <= options.max_iterations; ++out.iterations) {
-    for (int k = 0; k < n; ++k) {
-      const std::size_t kk = std::size_t(k);
-      switch (options.smith) {
-        // The spline can dip below zero between nodes; the integrals of a peak never do, but clip anyway.
-        case Smith::masking: y[kk] = 4.0 * q[kk] * std::max(0.0, dot(quad.positive_row(k), D)); break;
-        case Smith::correlated: y[kk] = 4.0 * q[kk] * std::max(0.0, dot(quad.absolute_row(k), D)); break;
-        case Smith::separable: {
-          const double sigma = std::max(0.0, dot(quad.positive_row(k), D));
-          y[kk] = 4.0 * q[kk] * sigma * sigma;
-          break;
-        }
-      }
-    }
-    out.eigenvalue = normalize(y);
-    if (out.eigenvalue == 0.0) {
-      out.problem = "the back-scattering operator maps the distribution to zero";
-      return out;
-    }
-    double change = 0.0;
-    for (int k = 0; k < n; ++k) change += area[std::size_t(k)] * std::abs(y[std::size_t(k)] - D[std::size_t(k)]);
-    D.swap(y);
-    out.residual = change;
-    if (change <= options.tolerance) {
-      out.converged = true;
-      break;
-    }
-  }
-  out.iterations = std::min(out.iterations, options.max_iterations);
+  static_cast<PowerIteration&>(out) =
+      power_iterate(D, q, quad.projected_area(), options, [&](bool absolute, const std::vector<double>& d, std::vector<double>& sigma) {
+        for (int k = 0; k < n; ++k) sigma[std::size_t(k)] = dot(absolute ? quad.absolute_row(k) : quad.positive_row(k), d);
+      });
+  if (!out.problem.empty()) return out;
   for (int k = 0; k < n; ++k) out.ndf.sigma[std::size_t(k)] = dot(quad.positive_row(k), D);
   return out;
 }

@@ -11,6 +11,8 @@
 // two, solved by the same normalized iteration. Derivations: docs/extraction.md.
 #pragma once
 
+#include <functional>
+#include <string>
 #include <vector>
 
 #include "fit/quadrature.h"
@@ -31,14 +33,27 @@ struct ExtractOptions {
   int max_iterations = 1000;
 };
 
-struct Extraction {
-  TabulatedNdf ndf;
+// How a power iteration ended.
+struct PowerIteration {
   double eigenvalue = 0.0;  // the back-scattering estimate of F0 (luminance)
   int iterations = 0;
   double residual = 0.0;    // relative L1 change of D in the last iteration
   bool converged = false;
   std::string problem;      // empty when D is meaningful; otherwise why not
 };
+
+struct Extraction : PowerIteration {
+  TabulatedNdf ndf;
+};
+
+// The normalized power iteration of every extraction, on D over any set of cells (theta nodes, or theta
+// nodes x azimuthal bins) with q the kernel factor per cell and area_weight the cells' projected-area
+// weights: D <- 4 q sigma (masking; correlated with the |k.h| kernel) or 4 q sigma^2 (separable), renormalized
+// to unit projected area, until the projected-area L1 change is within the tolerance. apply(absolute, D,
+// sigma) computes the kernel's integral per cell. D holds the start on entry and the answer on return.
+PowerIteration power_iterate(std::vector<double>& D, const std::vector<double>& q, const std::vector<double>& area_weight,
+                             const ExtractOptions& options,
+                             const std::function<void(bool absolute, const std::vector<double>& D, std::vector<double>& sigma)>& apply);
 
 Extraction extract_ndf(const Backscatter& backscatter, const Quadrature& quadrature, const ExtractOptions& options);
 

@@ -59,43 +59,17 @@ Extraction2D extract_ndf_2d(const Backscatter2D& back, const Quadrature2D& quad,
     const std::vector<double> column = kernel_factor(back.slices[std::size_t(p)], quad.grid(), options.smith);
     for (int j = 0; j < n; ++j) q[std::size_t(j) * m + p] = column[std::size_t(j)];
   }
-  const auto normalize = [&](std::vector<double>& y) {
-    const double s = quad.projected_area(y);
-    if (!(s > 0.0) || !std::isfinite(s)) return 0.0;
-    for (double& v : y) v /= s;
-    return s;
-  };
   std::vector<double>& D = out.ndf;
+  std::vector<double> area_weight(cells);
   for (int j = 0; j < n; ++j)
-    for (int p = 0; p < m; ++p) D[std::size_t(j) * m + p] = q[std::size_t(j) * m + p] * std::cos(quad.grid().theta(j));
-  if (normalize(D) == 0.0) {
-    out.problem = "no back-scattered signal (all-zero or missing measurements)";
-    return out;
-  }
-  std::vector<double> y(cells), sigma(cells), change_weight(cells);
-  for (int j = 0; j < n; ++j)
-    for (int p = 0; p < m; ++p) change_weight[std::size_t(j) * m + p] = quad.area()[std::size_t(j)] / m;
-  for (out.iterations = 1; out.iterations <= options.max_iterations; ++out.iterations) {
-    quad.apply(options.smith == Smith::correlated, D, sigma);
-    for (std::size_t c = 0; c < cells; ++c) {
-      const double s = std::max(0.0, sigma[c]);  // the spline can dip below zero between nodes
-      y[c] = 4.0 * q[c] * (options.smith == Smith::separable ? s * s : s);
+    for (int p = 0; p < m; ++p) {
+      D[std::size_t(j) * m + p] = q[std::size_t(j) * m + p] * std::cos(quad.grid().theta(j));
+      area_weight[std::size_t(j) * m + p] = quad.area()[std::size_t(j)] / m;
     }
-    out.eigenvalue = normalize(y);
-    if (out.eigenvalue == 0.0) {
-      out.problem = "the back-scattering operator maps the distribution to zero";
-      return out;
-    }
-    double change = 0.0;
-    for (std::size_t c = 0; c < cells; ++c) change += change_weight[c] * std::abs(y[c] - D[c]);
-    D.swap(y);
-    out.residual = change;
-    if (change <= options.tolerance) {
-      out.converged = true;
-      break;
-    }
-  }
-  out.iterations = std::min(out.iterations, options.max_iterations);
+  static_cast<PowerIteration&>(out) = power_iterate(D, q, area_weight, options, [&](bool absolute, const std::vector<double>& d, std::vector<double>& sigma) {
+    quad.apply(absolute, d, sigma);
+  });
+  if (!out.problem.empty()) return out;
   quad.apply(false, D, out.sigma);
   return out;
 }

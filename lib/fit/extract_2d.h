@@ -36,15 +36,10 @@ Backscatter2D backscatter_2d(const Brdf& brdf, const Quadrature2D& quadrature);
 // azimuth, linear in phi between the file's azimuths (eval() would mix in nodes that are not back-scattering).
 Backscatter2D backscatter_2d(const UtiaBrdf& utia, const Quadrature2D& quadrature);
 
-struct Extraction2D {
+struct Extraction2D : PowerIteration {
   int phi_count = 0;
   std::vector<double> ndf;    // D(theta_j, phi_m), J x M theta-major, 1/sr; projected area 1
   std::vector<double> sigma;  // sigma(theta_j, phi_m)
-  double eigenvalue = 0.0;
-  int iterations = 0;
-  double residual = 0.0;
-  bool converged = false;
-  std::string problem;
 
   double D(int j, int m) const { return ndf[std::size_t(j) * phi_count + m]; }
 };
