@@ -126,14 +126,19 @@ def profile(binary, work, material):
         out = subprocess.run(["perf", "report", "-i", data, "--no-children", "--sort", "dso,symbol", "--stdio"],
                              check=True, capture_output=True, text=True).stdout
     except (OSError, subprocess.CalledProcessError):
-        return []
+        return [], []
     rows = []
     for line in out.splitlines():
         m = re.match(r"\s+([0-9.]+)%\s+(\S+)\s+\[[.k]\]\s+(.*)", line)
         if m:
-            symbol = re.sub(r"\(.*", "", m.group(3).strip())  # no argument lists
-            rows.append((float(m.group(1)), m.group(2), symbol[:70]))
-    return rows[:14]
+            symbol = m.group(3).strip()
+            while re.search(r"\([^()]*\)", symbol):  # no argument lists: render's lambdas keep their names
+                symbol = re.sub(r"\([^()]*\)", "", symbol)
+            rows.append((float(m.group(1)), m.group(2), re.sub(r"\s+-\s+-\s*$", "", symbol).strip()[:80]))
+    libraries = {}
+    for pct, dso, _ in rows:
+        libraries[dso] = libraries.get(dso, 0.0) + pct
+    return rows[:14], sorted(libraries.items(), key=lambda kv: -kv[1])[:5]
 
 
 def main(facetfit, mitsuba_python, dst, rgl=None):
@@ -214,8 +219,9 @@ def main(facetfit, mitsuba_python, dst, rgl=None):
             out.write("| %s | %.3f s | %.3f s | %.2f |\n" % (name, one, all_, one / all_))
         out.write("\n## Where the time goes\n\n`perf record` of one facetfit render (64 spp, whole process), self time by\n"
                   "library and symbol (unnamed addresses in libembree3 are its stripped traversal kernels).\n")
-        for label, rows_ in profiles:
-            out.write("\n%s:\n\n| self | library | symbol |\n|---|---|---|\n" % label)
+        for label, (rows_, libraries) in profiles:
+            out.write("\n%s, by library: %s.\n\n| self | library | symbol |\n|---|---|---|\n" % (
+                label, ", ".join("%s %.0f%%" % (dso, pct) for dso, pct in libraries) or "n/a"))
             if not rows_:
                 out.write("| n/a | linux-perf is not installed or not permitted | |\n")
             for pct, dso, sym in rows_:
