@@ -1,5 +1,7 @@
-"""The reference renderer against Blender Cycles on the same scene: a GGX sphere (alpha 0.2) under the
-built-in sky, 256 x 256, 64 spp, direct lighting, CPU. Run with the bpy venv's python (make bench):
+"""The reference renderer against Blender Cycles on the same scenes: a GGX sphere (alpha 0.2) under the
+built-in sky, and a GGX sphere (alpha 0.3, F = 1) in the scene of ../shared/data/realref (constant
+environment 0.3 and a directional light of irradiance 3, as in docs/render-speed.md's comparison with
+Mitsuba 3), 256 x 256, 64 spp, direct lighting, CPU. Run with the bpy venv's python (make bench):
 
     python cycles_compare.py FACETFIT_BINARY OUTPUT.md
 """
@@ -14,11 +16,17 @@ import tempfile
 import time
 
 import bpy  # Blender as a Python module (bpy wheel)
+import mathutils
 
 SIZE, SPP, ALPHA, RUNS = 256, 64, 0.2, 3
 
 
-def facetfit_times(binary, work):
+# The realref scene's light: toward (0.3, 1, 0.5) in facetfit's y-up world, irradiance 3; environment 0.3.
+SUN = (0.3, 1.0, 0.5)
+REALREF_ALPHA = 0.3
+
+
+def facetfit_times(binary, work, realref=False):
     sky = os.path.join(work, "sky.exr")
     subprocess.run([binary, "render", "-o", os.path.join(work, "warm.exr"), "--save-sky", sky, "--spp", "1",
                     "--width", "8", "--height", "8"], check=True, capture_output=True)
@@ -29,6 +37,10 @@ def facetfit_times(binary, work):
         "materials": {"m": {"type": "ggx", "alpha": ALPHA, "f0": [0.9, 0.9, 0.9], "f82": [0.9, 0.9, 0.9]}},
         "objects": [{"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "m"}],
     }
+    if realref:
+        scene["environment"] = {"constant": [0.3, 0.3, 0.3]}
+        scene["lights"] = [{"type": "directional", "direction": list(SUN), "irradiance": [3, 3, 3]}]
+        scene["materials"]["m"] = {"type": "ggx", "alpha": REALREF_ALPHA, "f0": [1, 1, 1], "f82": [1, 1, 1]}
     path = os.path.join(work, "scene.json")
     with open(path, "w") as f:
         json.dump(scene, f)
@@ -40,7 +52,7 @@ def facetfit_times(binary, work):
     return sky, times
 
 
-def cycles_times(sky, work, adaptive=False):
+def cycles_times(sky, work, adaptive=False, realref=False):
     bpy.ops.wm.read_factory_settings(use_empty=True)
     scene = bpy.context.scene
     scene.render.engine = "CYCLES"
@@ -64,8 +76,9 @@ def cycles_times(sky, work, adaptive=False):
     nodes.clear()
     glossy = nodes.new("ShaderNodeBsdfGlossy")
     glossy.distribution = "GGX"
-    glossy.inputs["Roughness"].default_value = math.sqrt(ALPHA)  # Blender's alpha = roughness^2
-    glossy.inputs["Color"].default_value = (0.9, 0.9, 0.9, 1.0)
+    alpha = REALREF_ALPHA if realref else ALPHA
+    glossy.inputs["Roughness"].default_value = math.sqrt(alpha)  # Blender's alpha = roughness^2
+    glossy.inputs["Color"].default_value = (1.0, 1.0, 1.0, 1.0) if realref else (0.9, 0.9, 0.9, 1.0)
     out = nodes.new("ShaderNodeOutputMaterial")
     mat.node_tree.links.new(glossy.outputs["BSDF"], out.inputs["Surface"])
     sphere.data.materials.append(mat)
@@ -78,9 +91,20 @@ def cycles_times(sky, work, adaptive=False):
     scene.camera = cam
     world = bpy.data.worlds.new("sky")
     world.use_nodes = True
-    env = world.node_tree.nodes.new("ShaderNodeTexEnvironment")
-    env.image = bpy.data.images.load(sky)
-    world.node_tree.links.new(env.outputs["Color"], world.node_tree.nodes["Background"].inputs["Color"])
+    if realref:
+        world.node_tree.nodes["Background"].inputs["Color"].default_value = (0.3, 0.3, 0.3, 1.0)
+        # A sun of irradiance 3 shining along -SUN: Blender's (x, -z, y) of facetfit's vector, its -Z axis along the light.
+        sun = bpy.data.lights.new("sun", "SUN")
+        sun.energy = 3.0
+        sun.angle = 0.0  # a directional light, as the reference renderer's
+        lamp = bpy.data.objects.new("sun", sun)
+        bpy.context.collection.objects.link(lamp)
+        toward = mathutils.Vector((SUN[0], -SUN[2], SUN[1])).normalized()
+        lamp.rotation_euler = (-toward).to_track_quat("-Z", "Y").to_euler()
+    else:
+        env = world.node_tree.nodes.new("ShaderNodeTexEnvironment")
+        env.image = bpy.data.images.load(sky)
+        world.node_tree.links.new(env.outputs["Color"], world.node_tree.nodes["Background"].inputs["Color"])
     scene.world = world
     times = []
     for _ in range(RUNS):
@@ -96,7 +120,10 @@ def main():
         sky, ours = facetfit_times(binary, work)
         cycles = cycles_times(sky, work)
         cycles_adaptive = cycles_times(sky, work, adaptive=True)
+        _, ours_realref = facetfit_times(binary, work, realref=True)
+        cycles_realref = cycles_times(sky, work, realref=True)
     a, b, c = statistics.median(ours), statistics.median(cycles), statistics.median(cycles_adaptive)
+    d, e = statistics.median(ours_realref), statistics.median(cycles_realref)
     text = "\n".join([
         "# Reference renderer against Cycles",
         "",
@@ -114,6 +141,16 @@ def main():
         f"| Cycles (bpy), adaptive sampling on (its default; fewer samples where it converges) | {c:.2f} | {', '.join(f'{t:.2f}' for t in cycles_adaptive)} |",
         "",
         f"Cycles with the same samples takes {b / a:.2f} x facetfit's time; with adaptive sampling {c / a:.2f} x.",
+        "",
+        f"The scene of docs/render-speed.md (../shared/data/realref: constant environment 0.3, a directional light of",
+        f"irradiance 3, GGX alpha {REALREF_ALPHA} with F = 1; Blender's sun of angle 0), same size and samples:",
+        "",
+        "| renderer | seconds (median) | runs |",
+        "|---|---|---|",
+        f"| facetfit (Embree, MIS) | {d:.2f} | {', '.join(f'{t:.2f}' for t in ours_realref)} |",
+        f"| Cycles (bpy), 64 spp everywhere | {e:.2f} | {', '.join(f'{t:.2f}' for t in cycles_realref)} |",
+        "",
+        f"Cycles takes {e / d:.2f} x facetfit's time there (Mitsuba 3's times on this scene: render-speed.md).",
         "",
     ])
     tmp = output + ".tmp"
