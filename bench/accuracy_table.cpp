@@ -94,6 +94,26 @@ void iterations_section(std::ostringstream& md) {
   md << "\n";
 }
 
+void anisotropic_section(std::ostringstream& md, const std::string& scratch) {
+  md << "## Anisotropic ground truth: the 2D extraction\n\n"
+        "Analytic NDFs with F = 1 and their axes turned (fit/extract_2d.h, tests/support/ground_truth.h): principal "
+        "alphas, angle and D (projected-area weighted relative L1 at the grid's nodes) from the back-scattering. Dense: "
+        "the analytic back-scattering at MERL's 90 theta_h bins on a 90 x 64 grid, bars 1% and 0.5 degree "
+        "(tests/test_extract_2d.cpp). UTIA: written by facetfit's UTIA writer and read back, six polar angles 15 degrees "
+        "apart, masking form, 90 x 48 grid, bar 3% for alpha >= 0.2 (tests/test_utia.cpp).\n\n"
+        "| input | NDF | smith | alpha_x, alpha_y, angle | fitted | alpha_x error | alpha_y error | angle error | D L1 |\n"
+        "|---|---|---|---|---|---|---|---|---|\n";
+  const auto row = [&](const char* input, const AnisotropicCase& c, const AnisotropicError& e) {
+    md << format("| %s | %s | %s | %.2f, %.2f, %.0f deg | %.4f, %.4f, %.2f deg | %+.2f%% | %+.2f%% | %+.3f deg | %.3f%% |\n", input,
+                 to_string(c.type), to_string(c.smith), c.alpha_x, c.alpha_y, c.angle_degrees, e.fitted.alpha_x, e.fitted.alpha_y,
+                 e.fitted.angle * 180.0 / kPi, 100 * e.alpha_x_relative, 100 * e.alpha_y_relative, e.angle_degrees, 100 * e.ndf_l1);
+  };
+  const Quadrature2D dense(90, 64), utia(90, 48);
+  for (const AnisotropicCase& c : dense_anisotropic_cases()) row("dense", c, measure_anisotropic(c, dense));
+  for (const AnisotropicCase& c : utia_anisotropic_cases()) row("UTIA", c, measure_anisotropic(c, utia, scratch));
+  md << "\n";
+}
+
 void resolution_section(std::ostringstream& md) {
   md << "## Run time against error: grid resolution\n\n"
         "GGX, height-correlated, gold Fresnel. Fit time is extraction + Fresnel pass + both alphas on a "
@@ -260,6 +280,9 @@ int main(int argc, char** argv) {
     consistency_section(md);
     iterations_section(md);
     resolution_section(md);
+    const std::string scratch = (std::filesystem::temp_directory_path() / "facetfit-accuracy-utia.bin").string();
+    anisotropic_section(md, scratch);
+    std::filesystem::remove(scratch);
     rgl_section(md, argc > 2 ? argv[2] : "");
     write_file_atomic(argv[1], md.str());
     std::printf("%s\n", argv[1]);

@@ -8,6 +8,7 @@
 #include "chi2.h"
 #include "model/analytic.h"
 #include "model/tabulated.h"
+#include "support/ground_truth.h"
 #include "test_util.h"
 
 namespace facetfit {
@@ -28,7 +29,7 @@ TEST(Stretch, EqualsTheAnalyticAnisotropicGgxInEval) {
   const MicrofacetBrdf ggx(Ndf{NdfType::ggx, 0.4, 0.1}, Smith::correlated, Fresnel::one());
   for (const double rotation : {0.0, kRotation}) {
     const TabulatedMicrofacet model = stretched_ggx(0.2, {2.0, 0.5, rotation});
-    const test::Rotated truth(ggx, rotation);
+    const RotatedBrdf truth(ggx, rotation);
     std::mt19937 rng(7);
     double worst = 0.0;
     int counted = 0;
@@ -47,7 +48,7 @@ TEST(Stretch, EqualsTheAnalyticAnisotropicGgxInEval) {
 
 TEST(Stretch, PdfIsTheAnalyticVisibleNormalsAndAlbedoMatches) {
   const MicrofacetBrdf ggx(Ndf{NdfType::ggx, 0.4, 0.1}, Smith::correlated, Fresnel::one());
-  const test::Rotated truth(ggx, kRotation);
+  const RotatedBrdf truth(ggx, kRotation);
   const TabulatedMicrofacet model = stretched_ggx(0.2, {2.0, 0.5, kRotation});
   const Ndf ndf{NdfType::ggx, 0.4, 0.1};
   const Stretch turn{1.0, 1.0, kRotation};

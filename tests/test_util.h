@@ -14,7 +14,6 @@
 #include <string>
 
 #include "core/error.h"
-#include "core/brdf.h"
 #include "core/vec.h"
 
 namespace facetfit::test {
@@ -69,18 +68,6 @@ inline std::string merl_header(std::int32_t a, std::int32_t b, std::int32_t c) {
   std::memcpy(s.data() + 8, &c, 4);
   return s;
 }
-
-// A BRDF with its frame turned by `angle` about the normal: the analytic models are axis-aligned.
-class Rotated final : public Brdf {
- public:
-  Rotated(const Brdf& base, double angle) : base_(base), c_(std::cos(angle)), s_(std::sin(angle)) {}
-  std::optional<Rgb> eval(const Vec3& o, const Vec3& i) const override { return base_.eval(turn(o), turn(i)); }
-
- private:
-  Vec3 turn(const Vec3& v) const { return {c_ * v.x + s_ * v.y, -s_ * v.x + c_ * v.y, v.z}; }  // by -angle
-  const Brdf& base_;
-  double c_, s_;
-};
 
 // A direction uniformly distributed over the upper hemisphere.
 inline Vec3 random_direction(std::mt19937& rng) {

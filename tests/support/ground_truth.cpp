@@ -43,4 +43,49 @@ GroundTruthError measure_ground_truth(const GroundTruthCase& c, const Fitter& fi
   return e;
 }
 
+std::vector<AnisotropicCase> dense_anisotropic_cases() {
+  return {{NdfType::ggx, 0.4, 0.15, 30.0, Smith::masking},       {NdfType::ggx, 0.4, 0.15, 30.0, Smith::correlated},
+          {NdfType::ggx, 0.6, 0.2, -50.0, Smith::separable},     {NdfType::beckmann, 0.3, 0.12, 70.0, Smith::masking},
+          {NdfType::beckmann, 0.5, 0.25, 10.0, Smith::correlated}};
+}
+
+std::vector<AnisotropicCase> utia_anisotropic_cases() {
+  return {{NdfType::ggx, 0.5, 0.25, 30.0},      {NdfType::ggx, 0.8, 0.3, -60.0}, {NdfType::ggx, 0.3, 0.2, 45.0},
+          {NdfType::beckmann, 0.5, 0.25, 30.0}, {NdfType::beckmann, 0.3, 0.2, -20.0}};
+}
+
+AnisotropicError measure_anisotropic(const AnisotropicCase& c, const Quadrature2D& quad, const std::string& utia_path) {
+  const Ndf ndf{c.type, c.alpha_x, c.alpha_y};
+  const MicrofacetBrdf brdf(ndf, c.smith, Fresnel::one());
+  const double angle = c.angle_degrees * kPi / 180.0;
+  const RotatedBrdf turned(brdf, angle);
+  Backscatter2D back;
+  if (utia_path.empty()) {
+    back = backscatter_2d(turned, quad);
+  } else {
+    UtiaBrdf::tabulate(turned).write(utia_path);
+    back = backscatter_2d(UtiaBrdf::read(utia_path), quad);
+  }
+  const Extraction2D x = extract_ndf_2d(back, quad, {c.smith, 1e-10, 1000});
+  AnisotropicError e;
+  e.problem = x.problem;
+  e.iterations = x.iterations;
+  e.eigenvalue = x.eigenvalue;
+  if (!x.problem.empty()) return e;
+  e.fitted = c.type == NdfType::ggx ? alpha_ggx_2d(x.ndf, quad) : alpha_beckmann_2d(x.ndf, quad);
+  e.alpha_x_relative = e.fitted.alpha_x / c.alpha_x - 1.0;
+  e.alpha_y_relative = e.fitted.alpha_y / c.alpha_y - 1.0;
+  e.angle_degrees = e.fitted.angle * 180.0 / kPi - c.angle_degrees;
+  double diff = 0.0, norm = 0.0;
+  for (int j = 0; j < quad.size(); ++j)
+    for (int m = 0; m < quad.phi_count(); ++m) {
+      const double truth = ndf.D(spherical_direction(quad.grid().theta(j), quad.phi(m) - angle));
+      const double w = quad.area()[std::size_t(j)] / quad.phi_count();
+      diff += w * std::abs(x.D(j, m) - truth);
+      norm += w * truth;
+    }
+  e.ndf_l1 = norm > 0.0 ? diff / norm : 0.0;
+  return e;
+}
+
 }  // namespace facetfit

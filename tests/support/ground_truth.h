@@ -3,9 +3,13 @@
 // docs/accuracy.md (bench/accuracy_table.cpp) share it through the facetfit_testing library.
 #pragma once
 
+#include <cmath>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "core/brdf.h"
+#include "fit/extract_2d.h"
 #include "fit/fit.h"
 #include "model/fresnel.h"
 #include "model/ndf.h"
@@ -35,5 +39,44 @@ std::vector<GroundTruthCase> standard_ground_truth_cases();
 // Tabulates the case into a MERL table (through `merl_path` on disk when not empty, exercising the
 // writer and reader) and fits it with `fitter`.
 GroundTruthError measure_ground_truth(const GroundTruthCase& c, const Fitter& fitter, const std::string& merl_path = "");
+
+// A BRDF with its frame turned by `angle` about the normal: the analytic models are axis-aligned.
+class RotatedBrdf final : public Brdf {
+ public:
+  RotatedBrdf(const Brdf& base, double angle) : base_(base), c_(std::cos(angle)), s_(std::sin(angle)) {}
+  std::optional<Rgb> eval(const Vec3& o, const Vec3& i) const override { return base_.eval(turn(o), turn(i)); }
+
+ private:
+  Vec3 turn(const Vec3& v) const { return {c_ * v.x + s_ * v.y, -s_ * v.x + c_ * v.y, v.z}; }  // by -angle
+  const Brdf& base_;
+  double c_, s_;
+};
+
+// Anisotropic ground truth: an analytic NDF with F = 1 and axes turned by `angle_degrees`, its
+// back-scattering extracted in 2D (fit/extract_2d.h), principal alphas and angle compared.
+struct AnisotropicCase {
+  NdfType type = NdfType::ggx;
+  double alpha_x = 0.4, alpha_y = 0.15, angle_degrees = 0.0;
+  Smith smith = Smith::masking;
+};
+
+struct AnisotropicError {
+  AnisotropicAlpha fitted;
+  double alpha_x_relative = 0.0, alpha_y_relative = 0.0;  // fitted / true - 1
+  double angle_degrees = 0.0;                              // fitted - true
+  double ndf_l1 = 0.0;  // projected-area weighted relative L1 of D at the grid's nodes (dense input only)
+  double eigenvalue = 0.0;
+  int iterations = 0;
+  std::string problem;
+};
+
+// The cases of the tests and of docs/accuracy.md: dense analytic back-scattering (every Smith model,
+// GGX and Beckmann, rotated), and through UTIA files (alpha >= 0.2, the bar).
+std::vector<AnisotropicCase> dense_anisotropic_cases();
+std::vector<AnisotropicCase> utia_anisotropic_cases();
+
+// Through the analytic back-scattering at MERL's theta_h bins, or, with `utia_path`, through a UTIA file
+// written by facetfit's writer and read back (six polar angles).
+AnisotropicError measure_anisotropic(const AnisotropicCase& c, const Quadrature2D& quadrature, const std::string& utia_path = "");
 
 }  // namespace facetfit
