@@ -63,19 +63,6 @@ Quadrature2D::Quadrature2D(int resolution, int phi_count) : base_(resolution), p
   const int n = size(), m = phi_count, f = frequencies();
   const double bin = 2.0 * kPi / m;
   const std::vector<Quadrature::Node>& nodes = base_.nodes();
-  const auto spread = [this](double* row, const Quadrature::Node& node, double value) {
-    const ThetaGrid::Stencil st = grid().stencil(node.interval, node.t);
-    for (int q = 0; q < 4; ++q) row[st.index[q]] += st.weight[q] * value;
-  };
-
-  abs_slope_.assign(std::size_t(n), 0.0);
-  sq_slope_.assign(std::size_t(n), 0.0);
-  for (const Quadrature::Node& node : nodes) {
-    const double s = std::sin(node.theta), c = std::cos(node.theta);
-    // dw = sin(theta) d(theta) d(phi), slope radius tan(theta); the azimuthal factors are per bin.
-    spread(abs_slope_.data(), node, s * s * node.weight);
-    if (node.interval < resolution - 1) spread(sq_slope_.data(), node, s * s * s / c * node.weight);
-  }
 
   {
     std::lock_guard<std::mutex> lock(planner_mutex());
@@ -167,27 +154,18 @@ void Quadrature2D::apply(bool absolute, const std::vector<double>& D, std::vecto
   for (std::size_t t = 0; t < sigma.size(); ++t) sigma[t] = real.real()[t] / m;  // FFTW's transforms are unnormalized
 }
 
-double Quadrature2D::projected_area(const std::vector<double>& D) const {
-  const int m = phi_count_;
-  double s = 0.0;
-  for (int j = 0; j < size(); ++j) {
-    double row = 0.0;
-    for (int q = 0; q < m; ++q) row += D[std::size_t(j) * m + q];
-    s += area()[std::size_t(j)] * row / m;
-  }
-  return s;
-}
-
 namespace {
 
-// sum_jm theta_weight(j) azimuth_weight(m) D(j, m), azimuth_weight(m) the integral over bin m of the
-// azimuthal factor, from its antiderivative.
+// sum_jm theta_weight(j) azimuth_weight(m) D(j, m) / phi_integral: the isotropic moment's weights hold the
+// azimuthal factor's integral over the circle (phi_integral), here replaced by its integral over bin m, from
+// its antiderivative.
 template <class Antiderivative>
-double slope_moment(const std::vector<double>& theta_weight, const std::vector<double>& D, int m, double psi,
+double slope_moment(const std::vector<double>& theta_weight, double phi_integral, const std::vector<double>& D, int m, double psi,
                     const Antiderivative& integral) {
   const double bin = 2.0 * kPi / m;
   std::vector<double> azimuth(std::size_t(m), 0.0);
-  for (int q = 0; q < m; ++q) azimuth[std::size_t(q)] = integral((q + 0.5) * bin - psi) - integral((q - 0.5) * bin - psi);
+  for (int q = 0; q < m; ++q)
+    azimuth[std::size_t(q)] = (integral((q + 0.5) * bin - psi) - integral((q - 0.5) * bin - psi)) / phi_integral;
   double s = 0.0;
   for (std::size_t j = 0; j < theta_weight.size(); ++j)
     for (int q = 0; q < m; ++q) s += theta_weight[j] * azimuth[std::size_t(q)] * D[j * std::size_t(m) + std::size_t(q)];
@@ -197,15 +175,15 @@ double slope_moment(const std::vector<double>& theta_weight, const std::vector<d
 }  // namespace
 
 double Quadrature2D::abs_slope_moment(const std::vector<double>& D, double psi) const {
-  return slope_moment(abs_slope_, D, phi_count_, psi, abs_cos_antiderivative);
+  return slope_moment(base_.abs_slope_moment(), 4.0, D, phi_count_, psi, abs_cos_antiderivative);  // |cos| over the circle: 4
 }
 
 double Quadrature2D::sq_slope_moment(const std::vector<double>& D, double psi) const {
-  return slope_moment(sq_slope_, D, phi_count_, psi, [](double x) { return 0.5 * x + 0.25 * std::sin(2.0 * x); });
+  return slope_moment(base_.sq_slope_moment(), kPi, D, phi_count_, psi, [](double x) { return 0.5 * x + 0.25 * std::sin(2.0 * x); });
 }
 
 std::size_t Quadrature2D::bytes() const {
-  return sizeof(double) * (positive_.size() + absolute_.size() + abs_slope_.size() + sq_slope_.size()) +
+  return sizeof(double) * (positive_.size() + absolute_.size()) +
          sizeof(double) * std::size_t(size()) * std::size_t(size()) * 2;  // the isotropic base's rows
 }
 

@@ -41,10 +41,10 @@ class Quadrature2D {
   // Projected area: sum_jm area(j) D(j, m) / M = integral of D cos(theta) dw (area() is the isotropic
   // weight, which holds 2 pi for the azimuth).
   const std::vector<double>& area() const { return base_.projected_area(); }
-  double projected_area(const std::vector<double>& D) const;
 
   // E|x~ cos(psi) + y~ sin(psi)| (first) and E[(x~ cos(psi) + y~ sin(psi))^2] (second; the last theta
-  // interval left out, as in the isotropic moments) of the slopes of D: the roughness along psi.
+  // interval left out, as in the isotropic moments) of the slopes of D: the roughness along psi. The theta
+  // weights are the isotropic moments' (fit/quadrature.h), their azimuthal factor taken bin by bin.
   double abs_slope_moment(const std::vector<double>& D, double psi) const;
   double sq_slope_moment(const std::vector<double>& D, double psi) const;
 
@@ -55,7 +55,6 @@ class Quadrature2D {
   Quadrature base_;
   int phi_count_;
   std::vector<double> positive_, absolute_;
-  std::vector<double> abs_slope_, sq_slope_;  // per theta node: the theta part of the moments
   struct Plans;
   std::unique_ptr<Plans> plans_;
 };
