@@ -15,22 +15,22 @@
 
 namespace facetfit {
 
-struct Stretch {
-  double x = 1.0, y = 1.0;
-  double rotation = 0.0;  // radians: the azimuth of the x axis
+class Stretch {
+ public:
+  // Slopes scaled by (x, y) along axes whose x axis lies at azimuth `rotation` (radians).
+  Stretch(double along_x = 1.0, double along_y = 1.0, double rotation = 0.0)
+      : x(along_x), y(along_y), rotation_(rotation), cos_(std::cos(rotation)), sin_(std::sin(rotation)) {}
+
+  double x, y;
+  double rotation() const { return rotation_; }
 
   // An isotropic lobe does not change under rotation alone.
   bool identity() const { return x == 1.0 && y == 1.0; }
 
-  // Into and out of the frame whose x axis is the stretch's.
-  Vec3 to_frame(const Vec3& v) const {
-    const double c = std::cos(rotation), s = std::sin(rotation);
-    return {c * v.x + s * v.y, -s * v.x + c * v.y, v.z};
-  }
-  Vec3 from_frame(const Vec3& v) const {
-    const double c = std::cos(rotation), s = std::sin(rotation);
-    return {c * v.x - s * v.y, s * v.x + c * v.y, v.z};
-  }
+  // Into and out of the frame whose x axis is the stretch's (the rotation's sine and cosine are kept:
+  // the tabulated model turns every direction it evaluates).
+  Vec3 to_frame(const Vec3& v) const { return {cos_ * v.x + sin_ * v.y, -sin_ * v.x + cos_ * v.y, v.z}; }
+  Vec3 from_frame(const Vec3& v) const { return {cos_ * v.x - sin_ * v.y, sin_ * v.x + cos_ * v.y, v.z}; }
   // A direction as the measured lobe sees it (masking, the view of visible normals); frame coordinates.
   Vec3 direction(const Vec3& w) const { return glm::normalize(Vec3(x * w.x, y * w.y, w.z)); }
   // A normal of the stretched lobe as a normal of the measured one, and back; frame coordinates.
@@ -41,6 +41,9 @@ struct Stretch {
     const double r = cos_measured / cos_h;
     return r * r * r / (x * y);
   }
+
+ private:
+  double rotation_, cos_, sin_;
 };
 
 }  // namespace facetfit

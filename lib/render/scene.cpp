@@ -115,17 +115,17 @@ MaterialDesc parse_material(const std::string& name, const json& j, const std::s
   if (j.contains("stretch") || j.contains("rotation") || j.contains("tangent")) {
     if (m.type != "lut") fail(path, "material " + name + ": \"stretch\", \"rotation\" and \"tangent\" are for lut materials");
     if (j.contains("tangent")) m.tangent = direction(j["tangent"], "material " + name + ": tangent", path);
+    double sx = 1.0, sy = 1.0;
     if (j.contains("stretch")) {
       const json& st = j["stretch"];
       if (!st.is_array() || st.size() != 2 || !st[0].is_number() || !st[1].is_number())
         fail(path, "material " + name + ": stretch must be [x, y]");
-      m.stretch.x = st[0].get<double>(), m.stretch.y = st[1].get<double>();
-      if (!(m.stretch.x >= 0.01 && m.stretch.x <= 100.0 && m.stretch.y >= 0.01 && m.stretch.y <= 100.0))
-        fail(path, "material " + name + ": stretch must be in [0.01, 100]");
+      sx = st[0].get<double>(), sy = st[1].get<double>();
+      if (!(sx >= 0.01 && sx <= 100.0 && sy >= 0.01 && sy <= 100.0)) fail(path, "material " + name + ": stretch must be in [0.01, 100]");
     }
     const double degrees = get<double>(j, "rotation", 0.0, path);
     if (!(std::abs(degrees) <= 360.0)) fail(path, "material " + name + ": rotation must be in [-360, 360] degrees");
-    m.stretch.rotation = degrees * kPi / 180.0;
+    m.stretch = Stretch(sx, sy, degrees * kPi / 180.0);
   }
   return m;
 }
