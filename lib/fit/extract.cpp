@@ -1,5 +1,6 @@
 #include "fit/extract.h"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -23,14 +24,13 @@ std::vector<double> kernel_factor(const Backscatter& back, const ThetaGrid& grid
   // Beckmann written as UTIA files the principal alphas come back within 1.9% down to alpha 0.2 this way,
   // against 7% through the values (tests/test_utia.cpp). Dense samples (MERL's 90) keep the values in u.
   std::vector<double> us(m), qs(m), slope(m);
-  double peak = 0.0;
-  for (std::size_t t = 0; t < m; ++t) peak = std::max(peak, back.value[t] * (times_cos ? std::cos(back.theta[t]) : 1.0));
+  for (std::size_t t = 0; t < m; ++t) qs[t] = back.value[t] * (times_cos ? std::cos(back.theta[t]) : 1.0);
+  const double peak = *std::max_element(qs.begin(), qs.end());
   if (!(peak > 0.0)) return std::vector<double>(std::size_t(grid.size()), 0.0);  // no signal: the caller says so
   const bool logarithmic = m < 16;
   const auto coordinate = [logarithmic](double theta) { return logarithmic ? theta : ThetaGrid::u_of_theta(theta); };
   for (std::size_t t = 0; t < m; ++t) {
     us[t] = coordinate(back.theta[t]);
-    qs[t] = back.value[t] * (times_cos ? std::cos(back.theta[t]) : 1.0);
     if (logarithmic) qs[t] = std::log(std::max(qs[t], 1e-12 * peak));
   }
   for (std::size_t t = 0; t < m; ++t) {
