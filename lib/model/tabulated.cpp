@@ -55,32 +55,42 @@ TabulatedMicrofacet::TabulatedMicrofacet(MicrofacetTables tables)
     : TabulatedMicrofacet(tables, VisibleNormalTables::build(tables.ndf)) {}
 
 TabulatedMicrofacet::TabulatedMicrofacet(MicrofacetTables tables, VisibleNormalTables sampling, Stretch stretch)
-    : tables_(std::move(tables)), sampling_(std::move(sampling)), stretch_(stretch) {
-  for (int j = 0; j < tables_.ndf.grid.size(); ++j) cos_nodes_.push_back(std::cos(tables_.ndf.grid.theta(j)));
-  parts_ = ProposalParts(tables_.fresnel.value[0], tables_.body, tables_.coat);
+    : stretch_(stretch) {
+  auto shared = std::make_shared<Shared>();
+  shared->tables = std::move(tables);
+  shared->sampling = std::move(sampling);
+  for (int j = 0; j < shared->tables.ndf.grid.size(); ++j) shared->cos_nodes.push_back(std::cos(shared->tables.ndf.grid.theta(j)));
+  shared->parts = ProposalParts(shared->tables.fresnel.value[0], shared->tables.body, shared->tables.coat);
+  shared_ = std::move(shared);
+}
+
+TabulatedMicrofacet TabulatedMicrofacet::stretched(const Stretch& stretch) const {
+  TabulatedMicrofacet copy = *this;
+  copy.stretch_ = stretch;
+  return copy;
 }
 
 double TabulatedMicrofacet::D(const Vec3& h) const {
   if (h.z <= 0.0) return 0.0;
-  if (stretch_.identity()) return tables_.ndf.D(std::acos(std::min(h.z, 1.0)));
+  if (stretch_.identity()) return shared_->tables.ndf.D(std::acos(std::min(h.z, 1.0)));
   // D_s(h) = P(slopes / s) / (s_x s_y cos^4) with P = D cos^4 of the measured normal.
   const Vec3 m = stretch_.measured_normal(stretch_.to_frame(h));
   const double r = m.z / h.z;
-  return tables_.ndf.D(std::acos(std::min(m.z, 1.0))) * r * r * r * r / (stretch_.x * stretch_.y);
+  return shared_->tables.ndf.D(std::acos(std::min(m.z, 1.0))) * r * r * r * r / (stretch_.x * stretch_.y);
 }
 
 double TabulatedMicrofacet::g1(const Vec3& w) const {
-  if (stretch_.identity() || w.z <= 0.0) return tables_.ndf.g1(w.z);
-  return tables_.ndf.g1(stretch_.direction(stretch_.to_frame(w)).z);  // Lambda_s(w) = Lambda(w')
+  if (stretch_.identity() || w.z <= 0.0) return shared_->tables.ndf.g1(w.z);
+  return shared_->tables.ndf.g1(stretch_.direction(stretch_.to_frame(w)).z);  // Lambda_s(w) = Lambda(w')
 }
 
-Rgb TabulatedMicrofacet::fresnel(double cos_d) const { return tables_.fresnel.eval(std::acos(clamp(cos_d, 0.0, 1.0))); }
+Rgb TabulatedMicrofacet::fresnel(double cos_d) const { return shared_->tables.fresnel.eval(std::acos(clamp(cos_d, 0.0, 1.0))); }
 
 std::optional<Rgb> TabulatedMicrofacet::eval(const Vec3& o, const Vec3& i) const {
   if (i.z <= 0.0 || o.z <= 0.0) return Rgb(0.0);
   const Vec3 h = glm::normalize(i + o);
-  const double g2 = smith_g2_from_g1(tables_.smith, g1(i), g1(o));
-  return tables_.body * kInvPi + fresnel(glm::dot(i, h)) * (D(h) * g2 / (4.0 * i.z * o.z)) + Rgb(tables_.coat.eval(o, i));
+  const double g2 = smith_g2_from_g1(shared_->tables.smith, g1(i), g1(o));
+  return shared_->tables.body * kInvPi + fresnel(glm::dot(i, h)) * (D(h) * g2 / (4.0 * i.z * o.z)) + Rgb(shared_->tables.coat.eval(o, i));
 }
 
 namespace {
@@ -138,13 +148,13 @@ double TabulatedMicrofacet::visible_normal_pdf(const Vec3& o, const Vec3& h) con
 
 double TabulatedMicrofacet::measured_visible_normal_pdf(const Vec3& o, const Vec3& h) const {
   const double oh = glm::dot(o, h);
-  if (o.z <= 0.0 || h.z <= 0.0 || oh <= 0.0 || sampling_.empty()) return 0.0;
-  const ThetaGrid& grid = tables_.ndf.grid;
+  if (o.z <= 0.0 || h.z <= 0.0 || oh <= 0.0 || shared_->sampling.empty()) return 0.0;
+  const ThetaGrid& grid = shared_->tables.ndf.grid;
   const GridPosition view = locate(grid, o.z), normal = locate(grid, h.z);
-  const double band = cos_nodes_[std::size_t(normal.j)] - cos_nodes_[std::size_t(normal.j) + 1];
+  const double band = shared_->cos_nodes[std::size_t(normal.j)] - shared_->cos_nodes[std::size_t(normal.j) + 1];
   if (!(band > 0.0)) return 0.0;
   // The two view slices around o, mixed linearly in u (sample() picks one with these weights).
-  const double mass = (1.0 - view.t) * sampling_.mass(view.j, normal.j) + view.t * sampling_.mass(view.j + 1, normal.j);
+  const double mass = (1.0 - view.t) * shared_->sampling.mass(view.j, normal.j) + view.t * shared_->sampling.mass(view.j + 1, normal.j);
   // Azimuth: exactly max(0, o.h) over its phi integral at this theta_h.
   const double sin_o = std::sqrt(std::max(0.0, 1.0 - o.z * o.z)), sin_h = std::sqrt(std::max(0.0, 1.0 - h.z * h.z));
   const double phi_total = positive_phi_integral(sin_o * sin_h, o.z * h.z);
@@ -153,8 +163,8 @@ double TabulatedMicrofacet::measured_visible_normal_pdf(const Vec3& o, const Vec
 }
 
 double TabulatedMicrofacet::pdf(const Vec3& o, const Vec3& i) const {
-  if (i.z <= 0.0 || o.z <= 0.0 || sampling_.empty()) return 0.0;
-  return parts_.pdf(o, i, lobe_pdf(o, i));
+  if (i.z <= 0.0 || o.z <= 0.0 || shared_->sampling.empty()) return 0.0;
+  return shared_->parts.pdf(o, i, lobe_pdf(o, i));
 }
 
 double TabulatedMicrofacet::lobe_pdf(const Vec3& o, const Vec3& i) const {
@@ -175,8 +185,8 @@ std::optional<TabulatedMicrofacet::Sample> TabulatedMicrofacet::sample(const Vec
 }
 
 std::optional<Vec3> TabulatedMicrofacet::sample_direction(const Vec3& o, double u1, double u2) const {
-  if (o.z <= 0.0 || sampling_.empty()) return std::nullopt;
-  return parts_.sample(o, u1, u2, [&](double a, double b) { return lobe_direction(o, a, b); });
+  if (o.z <= 0.0 || shared_->sampling.empty()) return std::nullopt;
+  return shared_->parts.sample(o, u1, u2, [&](double a, double b) { return lobe_direction(o, a, b); });
 }
 
 std::optional<Vec3> TabulatedMicrofacet::lobe_direction(const Vec3& o, double u1, double u2) const {
@@ -193,7 +203,7 @@ std::optional<Vec3> TabulatedMicrofacet::lobe_direction(const Vec3& o, double u1
 }
 
 Vec3 TabulatedMicrofacet::measured_visible_normal(const Vec3& o, double u1, double u2) const {
-  const ThetaGrid& grid = tables_.ndf.grid;
+  const ThetaGrid& grid = shared_->tables.ndf.grid;
   const int r = grid.resolution;
   // Pick one of the two view slices around o with the weights of the mixture, reusing u1.
   const GridPosition view = locate(grid, o.z);
@@ -206,10 +216,10 @@ Vec3 TabulatedMicrofacet::measured_visible_normal(const Vec3& o, double u1, doub
   }
   u1 = clamp(u1, 0.0, 1.0 - 1e-16);
   // The interval of theta_h: the last node whose CDF is <= u1 (zero-mass intervals are never chosen).
-  const double* cdf = sampling_.cdf.data() + std::size_t(slice) * (r + 1);
+  const double* cdf = shared_->sampling.cdf.data() + std::size_t(slice) * (r + 1);
   double frac;
   const int j = sample_cdf(cdf, r, u1, &frac);
-  const double cos_h = cos_nodes_[std::size_t(j)] - frac * (cos_nodes_[std::size_t(j)] - cos_nodes_[std::size_t(j) + 1]);
+  const double cos_h = shared_->cos_nodes[std::size_t(j)] - frac * (shared_->cos_nodes[std::size_t(j)] - shared_->cos_nodes[std::size_t(j) + 1]);
   const double sin_h = std::sqrt(std::max(0.0, 1.0 - cos_h * cos_h));
   const double sin_o = std::sqrt(std::max(0.0, 1.0 - o.z * o.z));
   const double phi = sample_phi(sin_o * sin_h, o.z * cos_h, u2) + (sin_o > 0.0 ? std::atan2(o.y, o.x) : 0.0);

@@ -9,6 +9,7 @@
 // for the body the cosine; for the coat its GGX visible normals. pdf() is the mixture's.
 #pragma once
 
+#include <memory>
 #include <optional>
 #include <vector>
 
@@ -79,20 +80,28 @@ class TabulatedMicrofacet final : public Brdf, public Proposal {
   double lobe_pdf(const Vec3& o, const Vec3& i) const;
   // The probabilities of the three parts (they sum to 1): luminance of the body albedo, of F(0) for
   // the lobe and the coat's f0, the last two at least 0.1 so that a dark lobe is still found.
-  double lobe_weight() const { return parts_.lobe; }
-  double body_weight() const { return parts_.body; }
-  double coat_weight() const { return parts_.coat_weight(); }
+  double lobe_weight() const { return shared_->parts.lobe; }
+  double body_weight() const { return shared_->parts.body; }
+  double coat_weight() const { return shared_->parts.coat_weight(); }
 
-  const MicrofacetTables& tables() const { return tables_; }
-  const VisibleNormalTables& sampling() const { return sampling_; }
+  const MicrofacetTables& tables() const { return shared_->tables; }
+  const VisibleNormalTables& sampling() const { return shared_->sampling; }
   const Stretch& stretch() const { return stretch_; }
-  bool can_sample() const override { return !sampling_.empty(); }
+  bool can_sample() const override { return !shared_->sampling.empty(); }
+
+  // The same lobe under another stretch: shares the tables, so it is cheap enough to make per shading
+  // point (a roughness texture, render/texture.h).
+  TabulatedMicrofacet stretched(const Stretch& stretch) const;
 
  private:
-  MicrofacetTables tables_;
-  VisibleNormalTables sampling_;
-  std::vector<double> cos_nodes_;  // cos(theta_j)
-  ProposalParts parts_;
+  // What a stretch does not change, immutable and shared between copies.
+  struct Shared {
+    MicrofacetTables tables;
+    VisibleNormalTables sampling;
+    std::vector<double> cos_nodes;  // cos(theta_j)
+    ProposalParts parts;
+  };
+  std::shared_ptr<const Shared> shared_;
   Stretch stretch_;
 
   std::optional<Vec3> lobe_direction(const Vec3& o, double u1, double u2) const;
