@@ -68,26 +68,14 @@ std::vector<float> read_all(const std::string& path, OIIO::ImageSpec& spec) {
   if (spec.deep) fail(path, "deep images are not supported");
   if (spec.depth != 1) fail(path, "volume images are not supported");
   if (spec.width < 1 || spec.height < 1 || spec.nchannels < 1) fail(path, "empty image");
-  std::vector<float> all(std::size_t(spec.width) * std::size_t(spec.height) * std::size_t(spec.nchannels));
-  if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, all.data()))
-    fail(path, "cannot read pixels: " + in->geterror());
-  return all;
+  return read_pixels(*in, path);
 }
 
 // Channels by name, never by position: EXR stores them sorted by name (A, B, G, R).
 Image read_image(const std::string& path) {
   OIIO::ImageSpec spec;
   const std::vector<float> all = read_all(path, spec);
-  int channel[3];
-  const char* names[3] = {"R", "G", "B"};
-  for (int c = 0; c < 3; ++c) {
-    channel[c] = spec.channelindex(names[c]);
-    if (channel[c] < 0) {
-      std::string present;
-      for (const std::string& n : spec.channelnames) present += (present.empty() ? "" : ", ") + n;
-      fail(path, std::string("no ") + names[c] + " channel (channels: " + present + ")");
-    }
-  }
+  const std::array<int, 3> channel = rgb_channels(spec, path, OneChannel::refused);
   const int a = spec.channelindex("A");
   Image image;
   image.width = spec.width;
@@ -100,10 +88,10 @@ Image read_image(const std::string& path) {
   if (a >= 0) image.alpha.resize(n);
   for (std::size_t p = 0; p < n; ++p) {
     for (int c = 0; c < 3; ++c) {
-      const float v = all[p * nch + std::size_t(channel[c])];
+      const float v = all[p * nch + std::size_t(channel[std::size_t(c)])];
       // A NaN or infinite pixel has no colour difference: refused, not averaged into a score.
       if (!std::isfinite(v))
-        fail(path, std::string("non-finite ") + names[c] + " value at pixel (" + std::to_string(p % std::size_t(spec.width)) + ", " +
+        fail(path, std::string("non-finite ") + "RGB"[c] + " value at pixel (" + std::to_string(p % std::size_t(spec.width)) + ", " +
                        std::to_string(p / std::size_t(spec.width)) + ")");
       image.rgb[3 * p + c] = v;
     }

@@ -155,6 +155,28 @@ std::unique_ptr<OIIO::ImageInput> open_image(const std::string& path, const std:
   return in;
 }
 
+std::array<int, 3> rgb_channels(const OIIO::ImageSpec& spec, const std::string& path, OneChannel one_channel) {
+  std::array<int, 3> channel{};
+  if (spec.nchannels == 1 && one_channel == OneChannel::grey) return channel;
+  const char* names[3] = {"R", "G", "B"};
+  for (int c = 0; c < 3; ++c) {
+    channel[std::size_t(c)] = spec.channelindex(names[c]);
+    if (channel[std::size_t(c)] < 0) {
+      std::string present;
+      for (const std::string& n : spec.channelnames) present += (present.empty() ? "" : ", ") + n;
+      fail(path, std::string("no ") + names[c] + " channel (channels: " + present + ")");
+    }
+  }
+  return channel;
+}
+
+std::vector<float> read_pixels(OIIO::ImageInput& in, const std::string& path) {
+  const OIIO::ImageSpec& spec = in.spec();
+  std::vector<float> all(std::size_t(spec.width) * std::size_t(spec.height) * std::size_t(spec.nchannels));
+  if (!in.read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, all.data())) fail(path, "cannot read pixels: " + first_line(in.geterror()));
+  return all;
+}
+
 void write_image_atomic(const std::string& path, const OIIO::ImageSpec& spec, const void* pixels) {
   AtomicFile out(path);
   auto image = OIIO::ImageOutput::create(out.temp_path());

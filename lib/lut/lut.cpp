@@ -314,18 +314,10 @@ Lut read_lut(const std::string& path) {
     fail(path, "image is " + std::to_string(spec.width) + " x " + std::to_string(spec.height) + ", expected " +
                    std::to_string(layout.width) + " x " + std::to_string(layout.height) + " for resolution " +
                    std::to_string(m.resolution));
-  // EXR stores channels sorted by name: find R, G, B by name, not by position.
-  int channel[3];
-  const char* names[3] = {"R", "G", "B"};
-  for (int c = 0; c < 3; ++c) {
-    channel[c] = spec.channelindex(names[c]);
-    if (channel[c] < 0) fail(path, std::string("no channel ") + names[c]);
-  }
-  std::vector<float> pixels(std::size_t(spec.width) * spec.height * spec.nchannels);
-  if (!image->read_image(0, 0, 0, spec.nchannels, TypeDesc::FLOAT, pixels.data()))
-    fail(path, "cannot read pixels: " + image->geterror());
+  const std::array<int, 3> channel = rgb_channels(spec, path, OneChannel::refused);
+  const std::vector<float> pixels = read_pixels(*image, path);
   const auto get = [&](int row, int x, int c) {
-    const float v = pixels[(std::size_t(row) * spec.width + x) * spec.nchannels + channel[c]];
+    const float v = pixels[(std::size_t(row) * spec.width + x) * spec.nchannels + channel[std::size_t(c)]];
     if (!std::isfinite(v)) fail(path, "non-finite value in row " + std::to_string(row) + ", column " + std::to_string(x));
     return double(v);
   };

@@ -3,6 +3,7 @@
 #include <OpenImageIO/imageio.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "core/error.h"
@@ -55,17 +56,11 @@ Environment Environment::load(const std::string& path, std::uint64_t max_bytes) 
                    std::to_string(spec.nchannels) + " channels; at most 65536 x 32768, at least 2 x 1, 1 to 64 channels");
   check_memory(path, "a " + std::to_string(spec.width) + " x " + std::to_string(spec.height) + " environment map",
                bytes_to_load(spec.width, spec.height, spec.nchannels), max_bytes);
-  int channel[3];
-  const char* names[3] = {"R", "G", "B"};
-  for (int c = 0; c < 3; ++c) {
-    channel[c] = spec.channelindex(names[c]);
-    if (channel[c] < 0) channel[c] = std::min(c, spec.nchannels - 1);  // grey maps
-  }
-  std::vector<float> all(std::size_t(spec.width) * spec.height * spec.nchannels);
-  if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, all.data())) fail(path, "cannot read: " + in->geterror());
+  const std::array<int, 3> channel = rgb_channels(spec, path, OneChannel::grey);
+  const std::vector<float> all = read_pixels(*in, path);
   std::vector<float> rgb(std::size_t(spec.width) * spec.height * 3);
   for (std::size_t p = 0; p < std::size_t(spec.width) * spec.height; ++p)
-    for (int c = 0; c < 3; ++c) rgb[p * 3 + c] = all[p * spec.nchannels + channel[c]];
+    for (int c = 0; c < 3; ++c) rgb[p * 3 + c] = all[p * spec.nchannels + channel[std::size_t(c)]];
   return from_pixels(spec.width, spec.height, std::move(rgb));
 }
 
