@@ -3,10 +3,14 @@
 
 #include <cmath>
 
+#include <functional>
+
+#include "io/image_file.h"
 #include "lut/lut.h"
 #include "model/analytic.h"
 #include "model/tabulated.h"
 #include "render/renderer.h"
+#include "render/texture.h"
 #include "test_util.h"
 
 namespace facetfit {
@@ -283,6 +287,78 @@ TEST(Render, StretchedLutMaterials) {
               parse_scene_text(R"({"materials": {"m": {"type": "ggx", "alpha": 0.2, "stretch": [2, 1]}},
                                    "objects": [{"type": "sphere", "material": "m"}]})", "t.json", ".");
             }).find("are for lut materials"), std::string::npos);
+}
+
+TEST(Render, StretchTextureDrivesTheStretchPerPoint) {
+  // A uniform texture (2, 0.5) times a stretch (1.5, 1) is the stretch (3, 0.5) everywhere: the same image,
+  // sample for sample. A texture that varies changes the image where it departs from that value.
+  test::TempDir dir;
+  const Fitter fitter{FitOptions::paper()};
+  write_lut(dir.file("gold.exr"),
+            make_lut(fitter.fit(load_table("builtin:gold-ggx-0.15")), fitter.quadrature(), "builtin:gold-ggx-0.15", "x", 0.02, true));
+  const auto write_texture = [&](const std::string& name, int w, int h, const std::function<Rgb(int, int)>& value) {
+    std::vector<float> px;
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        const Rgb v = value(x, y);
+        px.insert(px.end(), {float(v.r), float(v.g), float(v.b)});
+      }
+    write_image_atomic(dir.file(name), OIIO::ImageSpec(w, h, 3, OIIO::TypeDesc::FLOAT), px.data());
+  };
+  write_texture("uniform.exr", 4, 2, [](int, int) { return Rgb(2.0, 0.5, 7.0); });
+  // The bottom row as the top: v is periodic, so the top pole reads both.
+  write_texture("bands.exr", 16, 8, [](int, int y) { return y < 4 || y == 7 ? Rgb(2.0, 0.5, 0.0) : Rgb(0.5, 2.0, 0.0); });
+  const auto scene = [&](const std::string& material, const std::string& object) {
+    return parse_scene_text(R"({"camera": {"width": 32, "height": 32}, "render": {"spp": 8},
+      "environment": {"builtin": "sky"},
+      "materials": {"m": {"type": "lut", "file": "gold.exr", "rotation": 30, "tangent": [0, 1, 0])" + material + R"(}},
+      "objects": [)" + object + R"(]})", "s.json", dir.path().string());
+  };
+  const std::string sphere = R"({"type": "sphere", "material": "m"})";
+  const std::string plane = R"({"type": "plane", "point": [0, 0, 0], "normal": [0, 0.6, 4], "size": 2, "material": "m"})";
+  for (const std::string& object : {sphere, plane}) {
+    const RenderedImage fixed = render(scene(R"(, "stretch": [3, 0.5])", object));
+    const RenderedImage textured = render(scene(R"(, "stretch": [1.5, 1], "stretch_texture": "uniform.exr")", object));
+    EXPECT_EQ(fixed.rgba, textured.rgba) << object;
+    // Bands: the upper half of the texture (v > 1/2: the upper hemisphere, or half the plane) is (2, 0.5),
+    // most of the lower (0.5, 2).
+    const RenderedImage bands = render(scene(R"(, "stretch": [1.5, 1], "stretch_texture": "bands.exr")", object));
+    EXPECT_NE(fixed.rgba, bands.rgba) << object;
+  }
+  // On the sphere the upper rows see the upper texture band: identical to the uniform stretch where the
+  // whole bilinear footprint lies in that band (the top rows of the sphere, well above its equator).
+  const RenderedImage fixed = render(scene(R"(, "stretch": [3, 0.5])", sphere));
+  const RenderedImage bands = render(scene(R"(, "stretch": [1.5, 1], "stretch_texture": "bands.exr")", sphere));
+  int same = 0, covered = 0;
+  for (int y = 0; y < 10; ++y)
+    for (int x = 0; x < 32; ++x) {
+      const std::size_t k = (std::size_t(y) * 32 + std::size_t(x)) * 4;
+      if (fixed.rgba[k + 3] < 1.0f) continue;
+      ++covered;
+      same += fixed.rgba[k] == bands.rgba[k] && fixed.rgba[k + 1] == bands.rgba[k + 1];
+    }
+  EXPECT_GT(covered, 20);
+  EXPECT_EQ(same, covered);
+  EXPECT_NE(test::error_of([&] { render(scene(R"(, "stretch_texture": "missing.exr")", sphere)); }).find("missing.exr"), std::string::npos);
+  EXPECT_NE(test::error_of([&] { scene(R"(, "stretch_texture": "uniform.exr")", R"({"type": "mesh", "file": "x.obj", "material": "m"})"); })
+                .find("a mesh has no texture coordinates"),
+            std::string::npos);
+}
+
+TEST(Texture, BilinearBetweenPixelCentresWithVFromTheBottomAndBothAxesPeriodic) {
+  // 4 x 2: row 0 (top) 0, 1, 2, 3 in red; row 1 (bottom) 10, 11, 12, 13.
+  const Texture t(4, 2, {0, 0, 0, 1, 0, 0, 2, 0, 0, 3, 0, 0, 10, 0, 0, 11, 0, 0, 12, 0, 0, 13, 0, 0});
+  EXPECT_DOUBLE_EQ(t.lookup({0.125, 0.25}).r, 10.0);  // centre of the bottom-left pixel
+  EXPECT_DOUBLE_EQ(t.lookup({0.375, 0.75}).r, 1.0);   // centre of the top row's second pixel
+  EXPECT_DOUBLE_EQ(t.lookup({0.25, 0.75}).r, 0.5);    // between two centres
+  EXPECT_DOUBLE_EQ(t.lookup({0.0, 0.75}).r, 1.5);     // across the u seam: (3 + 0) / 2
+  EXPECT_DOUBLE_EQ(t.lookup({0.125, 0.5}).r, 5.0);    // halfway between the rows
+  EXPECT_DOUBLE_EQ(t.lookup({1.125, -0.75}).r, 10.0); // periodic
+  // The sphere's coordinates: the top pole v = 1, the bottom 0, the point facing +z (the default camera) u = 0.
+  EXPECT_NEAR(sphere_texture_coordinates({0, 1, 0}).v, 1.0, 1e-12);
+  EXPECT_NEAR(sphere_texture_coordinates({0, -1, 0}).v, 0.0, 1e-12);
+  EXPECT_NEAR(sphere_texture_coordinates({1, 0, 0}).v, 0.5, 1e-12);
+  EXPECT_NEAR(sphere_texture_coordinates({1, 0, 0}).u, 0.25, 1e-12);
 }
 
 }  // namespace

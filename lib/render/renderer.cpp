@@ -15,7 +15,9 @@
 #include "core/memory_budget.h"
 #include "io/image_file.h"
 #include "io/input.h"
+#include "model/tabulated.h"
 #include "render/environment.h"
+#include "render/texture.h"
 
 namespace facetfit {
 
@@ -114,12 +116,26 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
   // Only what the scene uses is loaded.
   std::vector<std::shared_ptr<const ShadingModel>> materials;
   std::vector<std::optional<Vec3>> tangents;  // per material: the world direction its tangent follows
+  // Per material with a stretch_texture: the texture, and the tabulated lobe it stretches per point.
+  struct StretchTexture {
+    Texture texture;
+    const TabulatedMicrofacet* lobe;
+    Stretch stretch;
+  };
+  std::vector<std::optional<StretchTexture>> stretch_textures;
   std::map<std::string, int> material_index;
   for (const ObjectDesc& o : desc.objects) {
     if (material_index.count(o.material)) continue;
     material_index[o.material] = int(materials.size());
-    materials.push_back(load_material(desc, desc.materials.at(o.material)));
-    tangents.push_back(desc.materials.at(o.material).tangent);
+    const MaterialDesc& m = desc.materials.at(o.material);
+    materials.push_back(load_material(desc, m));
+    tangents.push_back(m.tangent);
+    stretch_textures.emplace_back();
+    if (!m.stretch_texture.empty()) {
+      const auto* lobe = dynamic_cast<const TabulatedMicrofacet*>(&materials.back()->brdf());
+      if (!lobe) fail(m.file, "a stretch_texture needs a tabulated lobe");
+      stretch_textures.back() = StretchTexture{Texture::load(resolve(desc, m.stretch_texture), budget - image_bytes), lobe, m.stretch};
+    }
   }
   std::optional<Environment> env;
   switch (desc.environment.kind) {
@@ -237,7 +253,26 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
     const std::optional<Vec3>& tangent = tangents[std::size_t(geo.material)];
     const Frame frame = tangent ? Frame(n, *tangent) : Frame(n);
     const Vec3 o = frame.to_local(-dir);
-    const ShadingModel& model = *materials[std::size_t(geo.material)];
+    // A stretch_texture reshapes the lobe here: a copy sharing its tables, owned by this call (the
+    // shading model refers to it without owning it).
+    std::optional<TabulatedMicrofacet> textured_lobe;
+    std::optional<ShadingModel> textured;
+    if (const auto& st = stretch_textures[std::size_t(geo.material)]) {
+      const ObjectDesc& object = *geo.object;
+      TextureCoordinates at;
+      if (object.kind == ObjectDesc::Kind::sphere) {
+        at = sphere_texture_coordinates(glm::normalize(p - object.center));
+      } else {  // plane: its square's own axes
+        const Frame square(object.normal);
+        at = {glm::dot(p - object.point, square.t) / object.size + 0.5, glm::dot(p - object.point, square.b) / object.size + 0.5};
+      }
+      const Rgb scale = st->texture.lookup(at);
+      const auto stretch = [](double a, double b) { return clamp(a * b, 0.01, 100.0); };
+      textured_lobe.emplace(st->lobe->stretched(Stretch(stretch(st->stretch.x, scale.r), stretch(st->stretch.y, scale.g), st->stretch.rotation())));
+      const std::shared_ptr<const TabulatedMicrofacet> unowned(std::shared_ptr<void>(), &*textured_lobe);
+      textured.emplace(unowned, unowned);
+    }
+    const ShadingModel& model = textured ? *textured : *materials[std::size_t(geo.material)];
     const Vec3 origin = p + eps * n;
     const auto visible_if_unblocked = [&](const Vec3& d, double tfar, const Rgb& value) {
       rays.push_back(shadow_ray(origin, d, tfar));

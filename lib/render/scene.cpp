@@ -112,8 +112,11 @@ MaterialDesc parse_material(const std::string& name, const json& j, const std::s
   if (!smith) fail(path, "material " + name + ": smith must be masking, correlated or separable");
   m.smith = *smith;
   if (j.contains("albedo")) m.albedo = nonnegative(j["albedo"], "material " + name + ": albedo", path);
-  if (j.contains("stretch") || j.contains("rotation") || j.contains("tangent")) {
-    if (m.type != "lut") fail(path, "material " + name + ": \"stretch\", \"rotation\" and \"tangent\" are for lut materials");
+  if (j.contains("stretch") || j.contains("rotation") || j.contains("tangent") || j.contains("stretch_texture")) {
+    if (m.type != "lut")
+      fail(path, "material " + name + ": \"stretch\", \"rotation\", \"tangent\" and \"stretch_texture\" are for lut materials");
+    m.stretch_texture = get<std::string>(j, "stretch_texture", "", path);
+    if (j.contains("stretch_texture") && m.stretch_texture.empty()) fail(path, "material " + name + ": stretch_texture must name an image");
     if (j.contains("tangent")) m.tangent = direction(j["tangent"], "material " + name + ": tangent", path);
     double sx = 1.0, sy = 1.0;
     if (j.contains("stretch")) {
@@ -242,6 +245,8 @@ SceneDesc parse_scene_text(const std::string& text, const std::string& path, con
     }
     d.material = get<std::string>(o, "material", "", path);
     if (!s.materials.count(d.material)) fail(path, "object references undefined material \"" + d.material + "\"");
+    if (d.kind == ObjectDesc::Kind::mesh && !s.materials.at(d.material).stretch_texture.empty())
+      fail(path, "a mesh has no texture coordinates: material \"" + d.material + "\" has a stretch_texture (spheres and planes have)");
     s.objects.push_back(d);
   }
   if (s.objects.empty()) fail(path, "no objects");
@@ -365,7 +370,7 @@ std::shared_ptr<const ShadingModel> load_material(const SceneDesc& scene, const 
   }
   if (m.type == "lut") {
     std::shared_ptr<const TabulatedMicrofacet> model = sampled_lut_model(resolve(scene, m.file));
-    if (!m.stretch.identity()) model = std::make_shared<TabulatedMicrofacet>(model->tables(), model->sampling(), m.stretch);
+    if (!m.stretch.identity()) model = std::make_shared<TabulatedMicrofacet>(model->stretched(m.stretch));
     return std::make_shared<ShadingModel>(model, model);
   }
   // ggx | beckmann | lsq (the LUT's classical baseline: Lambert + GGX + Schlick); nothing else renders as them

@@ -54,6 +54,9 @@ struct MaterialDesc {
   // whose projection on the surface is the tangent (else any tangent: fine for an isotropic lobe).
   Stretch stretch;
   std::optional<Vec3> tangent;
+  // lut: an image whose R and G multiply the stretch's x and y per shading point (render/texture.h: its
+  // coordinates, and how it is read), for spheres and planes.
+  std::string stretch_texture;
 };
 
 struct ObjectDesc {
