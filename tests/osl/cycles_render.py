@@ -7,8 +7,11 @@
         The reference renderer's default view (docs/scene-format.md) of a unit sphere shaded by SHADER
         under the lat-long map ENV.exr, direct lighting, box pixel filter, transparent film.
 
-NAME=VALUE set the shader's parameters (ints, floats, strings, or vectors as x,y,z, as the parameter's type). Output: float
-RGBA OpenEXR, scene-linear, no view transform.
+NAME=VALUE set the shader's parameters (ints, floats, strings, or vectors as x,y,z, as the parameter's type).
+stretch_texture=IMAGE (sphere only) drives roughness_scale_x and roughness_scale_y by the image's R and G times
+their given values, through Blender's Image Texture node (sphere projection of the generated coordinates,
+linear interpolation, repeat), as an artist would connect a roughness texture. Output: float RGBA OpenEXR,
+scene-linear, no view transform.
 """
 import glob
 import math
@@ -68,6 +71,28 @@ def script_material(shader, params):
     return material
 
 
+def connect_stretch_texture(material, image):
+    """The image's R and G times the script node's roughness_scale_x and _y, into those inputs."""
+    tree = material.node_tree
+    script = next(n for n in tree.nodes if n.type == "SCRIPT")
+    coords = tree.nodes.new("ShaderNodeTexCoord")
+    texture = tree.nodes.new("ShaderNodeTexImage")
+    texture.image = bpy.data.images.load(os.path.abspath(image))
+    texture.image.colorspace_settings.name = "Non-Color"
+    texture.projection = "SPHERE"
+    texture.interpolation = "Linear"
+    texture.extension = "REPEAT"
+    tree.links.new(coords.outputs["Generated"], texture.inputs["Vector"])
+    separate = tree.nodes.new("ShaderNodeSeparateColor")
+    tree.links.new(texture.outputs["Color"], separate.inputs["Color"])
+    for channel, name in (("Red", "roughness_scale_x"), ("Green", "roughness_scale_y")):
+        scale = tree.nodes.new("ShaderNodeMath")
+        scale.operation = "MULTIPLY"
+        tree.links.new(separate.outputs[channel], scale.inputs[0])
+        scale.inputs[1].default_value = script.inputs[name].default_value
+        tree.links.new(scale.outputs["Value"], script.inputs[name])
+
+
 def render(scene, out):
     scene.render.filepath = out
     bpy.ops.render.render(write_still=True)
@@ -92,7 +117,11 @@ def sphere(shader, out, size, spp, environment, params):
     scene = new_scene(size, spp)
     bpy.ops.mesh.primitive_uv_sphere_add(segments=256, ring_count=128, radius=1.0)
     bpy.ops.object.shade_smooth()
-    bpy.context.active_object.data.materials.append(script_material(shader, params))
+    stretch_texture = params.pop("stretch_texture", None)
+    material = script_material(shader, params)
+    if stretch_texture:
+        connect_stretch_texture(material, stretch_texture)
+    bpy.context.active_object.data.materials.append(material)
     # Blender is z-up: facetfit's (x, y, z) is Blender's (x, z, -y) read backwards, i.e. Blender (x, y, z)
     # = facetfit (x, -z, y). The camera at facetfit (0, 0.6, 4) looking at the origin.
     bpy.ops.object.camera_add(location=(0, -4, 0.6))
