@@ -13,10 +13,12 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <random>
 #include <regex>
+#include <sstream>
 
 #include "color/image_diff.h"
 #include "model/theta_grid.h"
@@ -598,27 +600,32 @@ TEST_F(OslSphere, StretchedPreviewMatchesReference) {
                "facetfit_material", 512, "lut=" + lut + " roughness_scale_x=3.0 roughness_scale_y=0.5 rotation=30.0 tangent=0,0,1");
 }
 
+// A roughness texture for the spheres: from sharper to much rougher around the sphere and between the
+// axes, R = exp(0.9 sin(2 pi u + 1) sin(pi v)), G = exp(-0.7 cos(2 pi u) sin^2(pi v)); 1 along its top and
+// bottom rows, which the repeat extension blends at the poles.
+std::string write_roughness_texture(const TempDir& dir) {
+  constexpr int kWidth = 64, kHeight = 32;
+  std::vector<float> px;
+  for (int y = 0; y < kHeight; ++y)
+    for (int x = 0; x < kWidth; ++x) {
+      const double u = (x + 0.5) / kWidth, v = 1.0 - (y + 0.5) / kHeight, band = std::sin(kPi * v);
+      px.insert(px.end(), {float(std::exp(0.9 * std::sin(2.0 * kPi * u + 1.0) * band)),
+                           float(std::exp(-0.7 * std::cos(2.0 * kPi * u) * band * band)), 0.0f});
+    }
+  const std::string path = dir.file("roughness.exr");
+  write_image_atomic(path, OIIO::ImageSpec(kWidth, kHeight, 3, OIIO::TypeDesc::FLOAT), px.data());
+  return path;
+}
+
 // A roughness texture: the stretch per shading point from an image, through Blender's Image Texture node
 // into the shaders' roughness_scale parameters, against the reference renderer's stretch_texture (its
-// coordinates are Blender's sphere projection: render/texture.h). The texture turns the lobe from
-// sharper to much rougher around the sphere and between the axes; it is 1 along its top and bottom rows,
-// which the repeat extension blends at the poles. The test sees the mapping: with the reference's texture
-// mirrored in u, or turned a quarter, the same renders differ by a mean Delta E of 3.6 and 5.3 (0.5 as it is).
+// coordinates are Blender's sphere projection: render/texture.h). The test sees the mapping: with the
+// reference's texture mirrored in u, or turned a quarter, the same renders differ by a mean Delta E of
+// 3.6 and 5.3 (0.5 as it is).
 TEST_F(OslSphere, TextureDrivenStretchMatchesReference) {
   constexpr int kPasses = 8, kSamples = 64;
   const std::string lut = bake("gold-ggx-0.15");
-  const std::string texture = work_->file("roughness.exr");
-  {
-    constexpr int kWidth = 64, kHeight = 32;
-    std::vector<float> px;
-    for (int y = 0; y < kHeight; ++y)
-      for (int x = 0; x < kWidth; ++x) {
-        const double u = (x + 0.5) / kWidth, v = 1.0 - (y + 0.5) / kHeight, band = std::sin(kPi * v);
-        px.insert(px.end(), {float(std::exp(0.9 * std::sin(2.0 * kPi * u + 1.0) * band)),
-                             float(std::exp(-0.7 * std::cos(2.0 * kPi * u) * band * band)), 0.0f});
-      }
-    write_image_atomic(texture, OIIO::ImageSpec(kWidth, kHeight, 3, OIIO::TypeDesc::FLOAT), px.data());
-  }
+  const std::string texture = write_roughness_texture(*work_);
   const nlohmann::json reference = {{"type", "lut"},     {"file", lut},         {"stretch", {2.0, 1.0}},
                                     {"rotation", 30.0},  {"tangent", {0, 1, 0}}, {"stretch_texture", texture}};
   const std::string stretch = " roughness_scale_x=2.0 roughness_scale_y=1.0 rotation=30.0 tangent=0,0,1 stretch_texture=" + texture;
@@ -626,6 +633,37 @@ TEST_F(OslSphere, TextureDrivenStretchMatchesReference) {
                kPasses, "lut=" + lut + " environment_map=" + work_->file("sky.exr") + " samples=" + std::to_string(kSamples) + stretch);
   check_sphere("gold-ggx-0.15-textured", "material, stretch (2, 1) times a texture, at 30 degrees", reference, 4096, "facetfit_material",
                512, "lut=" + lut + stretch);
+}
+
+// The artist's control on a real measurement (the paper's figure of an edited measured material): one
+// RGL material's LUT at several stretches and under the roughness texture, each through the preview
+// shader against the reference renderer.
+TEST_F(OslSphere, StretchSeriesOfAMeasuredMaterialMatchesReference) {
+  const std::filesystem::path source = test::rgl_dir() / "ilm_l3_37_metallic_rgb.bsdf";
+  if (!std::filesystem::exists(source)) GTEST_SKIP() << source << " is absent (the RGL database of ../shared/data): no measured series";
+  constexpr int kPasses = 8, kSamples = 64;
+  const RunResult r = facetfit("bake " + source.string() + " -o " + work_->path().string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::string lut = work_->file("ilm_l3_37_metallic_rgb.exr");
+  const std::string texture = write_roughness_texture(*work_);
+  struct Case {
+    std::string name;
+    double x, y, degrees;
+    bool textured;
+  };
+  for (const Case& c : {Case{"sharper", 0.5, 0.5, 0.0, false}, Case{"rougher", 2.0, 2.0, 0.0, false},
+                        Case{"anisotropic", 4.0, 0.5, 45.0, false}, Case{"textured", 1.0, 1.0, 0.0, true}}) {
+    nlohmann::json reference = {{"type", "lut"}, {"file", lut}, {"stretch", {c.x, c.y}}, {"rotation", c.degrees}, {"tangent", {0, 1, 0}}};
+    std::string params = "lut=" + lut + " environment_map=" + work_->file("sky.exr") + " samples=" + std::to_string(kSamples) +
+                         " roughness_scale_x=" + std::to_string(c.x) + " roughness_scale_y=" + std::to_string(c.y) +
+                         " rotation=" + std::to_string(c.degrees) + " tangent=0,0,1";
+    if (c.textured) reference["stretch_texture"] = texture, params += " stretch_texture=" + texture;
+    std::ostringstream what;
+    what << "preview, " << (c.textured ? "the roughness texture" : "stretch (" + std::to_string(c.x).substr(0, 3) + ", " +
+                                                                     std::to_string(c.y).substr(0, 3) + ")")
+         << (c.degrees != 0.0 ? " at " + std::to_string(int(c.degrees)) + " degrees" : "");
+    check_sphere("ilm_l3_37_metallic-" + c.name, what.str(), reference, 4096, "facetfit_preview", kPasses, params);
+  }
 }
 
 // The material shader hands the fitted body, alpha, F82-tint Fresnel and coat to Cycles' own closures;
