@@ -1,9 +1,11 @@
-// facetfit convert INPUT -o OUT.binary : any input in MERL layout.
+// facetfit convert INPUT -o OUT.binary|OUT.bin : any input in MERL layout, or sampled at UTIA's nodes.
 #include <cstdio>
+#include <filesystem>
 
 #include "commands.h"
 #include "core/error.h"
 #include "io/input.h"
+#include "io/utia.h"
 #include "model/builtin.h"
 
 namespace facetfit::cli {
@@ -11,12 +13,19 @@ namespace facetfit::cli {
 void add_convert_command(CLI::App& app, Context& ctx) {
   auto input = std::make_shared<std::string>();
   auto output = std::make_shared<std::string>();
-  CLI::App* cmd = app.add_subcommand("convert", "Write any input as a MERL .binary table");
+  CLI::App* cmd = app.add_subcommand("convert", "Write any input as a MERL .binary table or a UTIA .bin file");
   cmd->add_option("input", *input, "Input material (file or builtin:NAME)")->required();
-  cmd->add_option("-o,--output", *output, "Output .binary file")->required();
+  cmd->add_option("-o,--output", *output, "Output file: .binary (MERL) or .bin (UTIA, sampled at its nodes)")->required();
   cmd->callback([input, output, &ctx] {
     try {
-      load_table(*input).write(*output);
+      const std::string extension = std::filesystem::path(*output).extension().string();
+      if (extension == ".bin") {
+        UtiaBrdf::tabulate(*load_brdf(*input)).write(*output);
+      } else if (extension == ".binary") {
+        load_table(*input).write(*output);
+      } else {
+        fail(*output, "unsupported output format '" + extension + "' (supported: .binary, .bin)");
+      }
       std::printf("%s\n", output->c_str());
     } catch (const Error& e) {
       report_error(e.what());

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "io/merl.h"
+#include "io/utia.h"
 #include "test_util.h"
 
 namespace facetfit {
@@ -121,6 +122,23 @@ TEST(Cli, ConvertThenFitTheFile) {
   const RunResult r = facetfit("fit " + path + " --json --smith correlated --resolution 90");
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NEAR(nlohmann::json::parse(r.out)["alpha_ggx"].get<double>(), 0.15, 0.15 * 0.005);
+}
+
+// UTIA files: convert writes them (any input sampled at the file's nodes), fit and folder expansion take
+// them (as their azimuthal mean; tests/test_accuracy.cpp checks what comes back), bad outputs get a line.
+TEST(Cli, ConvertToUtiaThenFitTheFile) {
+  TempDir dir;
+  const std::string path = dir.file("silver.bin");
+  ASSERT_EQ(facetfit("convert builtin:silver-ggx-0.60 -o " + path).status, 0);
+  EXPECT_EQ(std::filesystem::file_size(path), UtiaBrdf::kFileBytes);
+  const RunResult r = facetfit("fit " + dir.path().string() + " --json");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(lines(r.out), 1);
+  // The 15-degree grid limits it (tests/test_accuracy.cpp): -0.7% here.
+  EXPECT_NEAR(nlohmann::json::parse(r.out)["alpha_ggx"].get<double>(), 0.60, 0.60 * 0.03);
+  const RunResult bad = facetfit("convert builtin:silver-ggx-0.60 -o " + dir.file("x.png"));
+  EXPECT_EQ(bad.status, 1);
+  EXPECT_NE(bad.err.find("x.png: unsupported output format '.png' (supported: .binary, .bin)"), std::string::npos) << bad.err;
 }
 
 TEST(Cli, FolderInputFitsEveryTableInIt) {

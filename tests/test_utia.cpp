@@ -6,6 +6,8 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <memory>
+#include <random>
 
 #include "core/error.h"
 #include "fit/extract_2d.h"
@@ -76,6 +78,27 @@ TEST_P(UtiaGroundTruth, AlphasComeBackThroughTheFile) {
 
 INSTANTIATE_TEST_SUITE_P(Utia, UtiaGroundTruth,
                          ::testing::ValuesIn(utia_anisotropic_cases()));
+
+TEST(Utia, AzimuthalMeanIsTheMeanOverTurnsByTheFilesStep) {
+  const MicrofacetBrdf aniso(Ndf{NdfType::ggx, 0.4, 0.15}, Smith::correlated, Fresnel::schlick(Rgb(0.9, 0.6, 0.3)));
+  const UtiaBrdf file = UtiaBrdf::tabulate(RotatedBrdf(aniso, 0.4));
+  const UtiaBrdf mean = file.azimuthal_mean();
+  std::mt19937 rng(3);
+  for (int k = 0; k < 100; ++k) {
+    const Vec3 o = test::random_direction(rng), i = test::random_direction(rng);
+    Rgb want(0.0);
+    for (int t = 0; t < UtiaBrdf::kPhi; ++t) {
+      const double a = t * UtiaBrdf::kPhiStep * kPi / 180.0, c = std::cos(a), s = std::sin(a);
+      const auto turn = [&](const Vec3& w) { return Vec3(c * w.x - s * w.y, s * w.x + c * w.y, w.z); };
+      want += *file.eval(turn(o), turn(i)) / double(UtiaBrdf::kPhi);
+    }
+    const Rgb got = *mean.eval(o, i);
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(got[c], want[c], 1e-9 * std::max(1.0, std::abs(want[c])));
+    // Isotropic: a turn of both directions changes nothing.
+    const Vec3 o2(-o.y, o.x, o.z), i2(-i.y, i.x, i.z);
+    EXPECT_NEAR(mean.eval(o2, i2)->g, got.g, 1e-9 * std::max(1.0, got.g));
+  }
+}
 
 }  // namespace
 }  // namespace facetfit

@@ -15,6 +15,13 @@ namespace facetfit {
 
 Backscatter backscatter_of(const MerlTable& table) {
   Backscatter back;
+  if (!table.source_backscatter().empty()) {  // measured off the table's bins (io/merl.h)
+    for (const MerlTable::BackscatterNode& node : table.source_backscatter()) {
+      back.theta.push_back(node.theta);
+      back.value.push_back(std::max(0.0, luminance(node.value)));  // below zero: noise on a zero measurement
+    }
+    return back;
+  }
   for (int i = 0; i < MerlTable::kThetaH; ++i) {
     Rgb mean(0.0);
     bool complete = true;

@@ -7,6 +7,7 @@
 
 #include "core/error.h"
 #include "io/rgl.h"
+#include "io/utia.h"
 #include "model/builtin.h"
 
 namespace facetfit {
@@ -15,7 +16,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-bool is_supported_file(const fs::path& p) { return p.extension() == ".binary" || p.extension() == ".bsdf"; }
+bool is_supported_file(const fs::path& p) { return p.extension() == ".binary" || p.extension() == ".bsdf" || p.extension() == ".bin"; }
 
 }  // namespace
 
@@ -34,20 +35,37 @@ std::optional<MerlTable::BinPoint> parse_bin_point(const std::string& name) {
 
 const char* to_string(MerlTable::BinPoint at) { return at == MerlTable::BinPoint::start ? "start" : "center"; }
 
-MerlTable load_table(const std::string& source, MerlTable::BinPoint merl_bins) {
+std::shared_ptr<const Brdf> load_brdf(const std::string& source, MerlTable::BinPoint merl_bins) {
   if (is_builtin(source)) {
     const std::string name = source.substr(std::string(kBuiltinPrefix).size());
     const auto material = find_builtin(name);
     if (!material) fail(source, "no such built-in material (facetfit list-builtins shows them)");
-    return MerlTable::tabulate(*material->brdf);
+    return material->brdf;
   }
   const fs::path path(source);
-  if (path.extension() == ".binary") return MerlTable::read(source, merl_bins);
-  if (path.extension() == ".bsdf") return MerlTable::tabulate(RglBsdf::read(source));
+  if (path.extension() == ".binary") return std::make_shared<MerlTable>(MerlTable::read(source, merl_bins));
+  if (path.extension() == ".bsdf") return std::make_shared<RglBsdf>(RglBsdf::read(source));
+  if (path.extension() == ".bin") return std::make_shared<UtiaBrdf>(UtiaBrdf::read(source));
   std::error_code ec;
   if (fs::is_directory(path, ec)) fail(source, "is a folder with no supported material file");
   if (!fs::exists(path, ec)) fail(source, "cannot open: no such file");
-  fail(source, "unsupported format '" + path.extension().string() + "' (supported: .binary, .bsdf, builtin:NAME)");
+  fail(source, "unsupported format '" + path.extension().string() + "' (supported: .binary, .bsdf, .bin, builtin:NAME)");
+}
+
+MerlTable load_table(const std::string& source, MerlTable::BinPoint merl_bins) {
+  const std::shared_ptr<const Brdf> brdf = load_brdf(source, merl_bins);
+  if (const auto* table = dynamic_cast<const MerlTable*>(brdf.get())) return *table;
+  // UTIA: anisotropic, tabulated as its azimuthal mean (the isotropic fits see that; fit/extract_2d.h
+  // fits the file itself).
+  if (const auto* utia = dynamic_cast<const UtiaBrdf*>(brdf.get())) {
+    const UtiaBrdf mean = utia->azimuthal_mean();
+    MerlTable table = MerlTable::tabulate(mean);
+    std::vector<MerlTable::BackscatterNode> back;
+    for (int t = 0; t < UtiaBrdf::kTheta; ++t) back.push_back({t * UtiaBrdf::kThetaStep * kPi / 180.0, mean.node(t, 0, t, 0)});
+    table.set_source_backscatter(std::move(back));
+    return table;
+  }
+  return MerlTable::tabulate(*brdf);
 }
 
 std::vector<std::string> expand_inputs(const std::vector<std::string>& args) {

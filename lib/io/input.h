@@ -1,10 +1,12 @@
 // Material inputs named on a command line, whatever their format, as MERL-layout tables.
 //
-// Sources: a MERL `.binary` file, an RGL `.bsdf` file or `builtin:NAME` (the last two tabulated into
-// MERL layout on load). Folders expand to the
+// Sources: a MERL `.binary` file, an RGL `.bsdf` file, a UTIA `.bin` file (anisotropic: tabulated as its
+// azimuthal mean, UtiaBrdf::azimuthal_mean) or `builtin:NAME` (all but MERL tabulated into MERL layout
+// on load). Folders expand to the
 // supported files they hold, sorted by name.
 #pragma once
 
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -18,6 +20,10 @@ constexpr const char* kBuiltinPrefix = "builtin:";
 // Loads one source. Throws Error("<source>: <problem>"). `merl_bins`: which point of its bins a MERL
 // file's values stand for (io/merl.h).
 MerlTable load_table(const std::string& source, MerlTable::BinPoint merl_bins = MerlTable::BinPoint::start);
+
+// One source as it is, at its own resolution: the MERL table, the RGL file (symmetric slices), the UTIA
+// file or the analytic built-in. Throws Error("<source>: <problem>").
+std::shared_ptr<const Brdf> load_brdf(const std::string& source, MerlTable::BinPoint merl_bins = MerlTable::BinPoint::start);
 
 // "start" or "center"; nullopt otherwise.
 std::optional<MerlTable::BinPoint> parse_bin_point(const std::string& name);

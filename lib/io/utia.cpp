@@ -96,6 +96,22 @@ UtiaBrdf UtiaBrdf::tabulate(const Brdf& brdf) {
   return UtiaBrdf(std::move(f));
 }
 
+UtiaBrdf UtiaBrdf::azimuthal_mean() const {
+  auto f = std::make_shared<std::vector<double>>(3 * kPerPlane, 0.0);
+  for (int c = 0; c < 3; ++c) {
+    const double* in = f_->data() + std::size_t(c) * kPerPlane;
+    double* out = f->data() + std::size_t(c) * kPerPlane;
+    for (int ti = 0; ti < kTheta; ++ti)
+      for (int tv = 0; tv < kTheta; ++tv)
+        for (int delta = 0; delta < kPhi; ++delta) {
+          double sum = 0.0;
+          for (int k = 0; k < kPhi; ++k) sum += in[index(ti, k, tv, (k + delta) % kPhi)];
+          for (int pi = 0; pi < kPhi; ++pi) out[index(ti, pi, tv, (pi + delta) % kPhi)] = sum / kPhi;
+        }
+  }
+  return UtiaBrdf(std::move(f));
+}
+
 void UtiaBrdf::write(const std::string& path) const {
   AtomicFile out(path);
   std::vector<double> encoded(f_->size());

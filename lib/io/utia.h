@@ -34,6 +34,12 @@ class UtiaBrdf final : public Brdf {
   static UtiaBrdf read(const std::string& path);
   // Samples any BRDF at the nodes (what the writer writes).
   static UtiaBrdf tabulate(const Brdf& brdf);
+  // The file's mean over turns of both directions about the normal by multiples of its azimuth step, as
+  // a file of its own (isotropic): node (ti, pi, tv, pv) becomes the mean over k of node (ti, pi + k,
+  // tv, pv + k), which depends on pv - pi alone. The interpolation being linear in the nodes, its eval()
+  // is the mean of eval() over those 48 turns, at the cost of one: what an isotropic fit sees of an
+  // anisotropic material.
+  UtiaBrdf azimuthal_mean() const;
   // Writes the file through a temporary; throws Error naming the file.
   void write(const std::string& path) const;
 

@@ -12,6 +12,7 @@
 #include "fit/fit.h"
 #include "io/input.h"
 #include "io/rgl.h"
+#include "io/utia.h"
 #include "lut/lut.h"
 #include "lut/record.h"
 #include "model/analytic.h"
@@ -112,12 +113,13 @@ MaterialDesc parse_material(const std::string& name, const json& j, const std::s
   if (!smith) fail(path, "material " + name + ": smith must be masking, correlated or separable");
   m.smith = *smith;
   if (j.contains("albedo")) m.albedo = nonnegative(j["albedo"], "material " + name + ": albedo", path);
-  if (j.contains("stretch") || j.contains("rotation") || j.contains("tangent") || j.contains("stretch_texture")) {
-    if (m.type != "lut")
-      fail(path, "material " + name + ": \"stretch\", \"rotation\", \"tangent\" and \"stretch_texture\" are for lut materials");
+  if (j.contains("tangent") && m.type != "lut" && m.type != "measured")
+    fail(path, "material " + name + ": \"tangent\" is for lut and measured materials (an anisotropic measurement turns with it)");
+  if (j.contains("tangent")) m.tangent = direction(j["tangent"], "material " + name + ": tangent", path);
+  if (j.contains("stretch") || j.contains("rotation") || j.contains("stretch_texture")) {
+    if (m.type != "lut") fail(path, "material " + name + ": \"stretch\", \"rotation\" and \"stretch_texture\" are for lut materials");
     m.stretch_texture = get<std::string>(j, "stretch_texture", "", path);
     if (j.contains("stretch_texture") && m.stretch_texture.empty()) fail(path, "material " + name + ": stretch_texture must name an image");
-    if (j.contains("tangent")) m.tangent = direction(j["tangent"], "material " + name + ": tangent", path);
     double sx = 1.0, sy = 1.0;
     if (j.contains("stretch")) {
       const json& st = j["stretch"];
@@ -349,9 +351,10 @@ std::shared_ptr<const ShadingModel> load_material(const SceneDesc& scene, const 
     // already made it), or else the paper's fit alone (a proposal needs the lobe's shape, not the
     // refinement's accuracy).
     const std::string source = resolve(scene, m.file);
-    const bool rgl = std::filesystem::path(source).extension() == ".bsdf";
+    const std::string extension = std::filesystem::path(source).extension().string();
+    const bool rgl = extension == ".bsdf", utia = extension == ".bin";
     std::shared_ptr<const MerlTable> table;
-    if (!rgl || m.proposal.empty()) table = std::make_shared<MerlTable>(load_table(source));
+    if (!(rgl || utia) || m.proposal.empty()) table = std::make_shared<MerlTable>(load_table(source));
     std::shared_ptr<const TabulatedMicrofacet> proposal;
     if (!m.proposal.empty()) {
       proposal = sampled_lut_model(resolve(scene, m.proposal));
@@ -366,6 +369,8 @@ std::shared_ptr<const ShadingModel> load_material(const SceneDesc& scene, const 
       brdf->set_slices(*parse_slices(m.slices));
       return std::make_shared<ShadingModel>(brdf, proposal);
     }
+    // UTIA files too, anisotropic as they are (the table and the proposal's fit see their azimuthal mean).
+    if (utia) return std::make_shared<ShadingModel>(std::make_shared<UtiaBrdf>(UtiaBrdf::read(source)), proposal);
     return std::make_shared<ShadingModel>(table, proposal);
   }
   if (m.type == "lut") {
