@@ -29,6 +29,9 @@ void print_row(const std::string& source, const FitResult& r, double seconds) {
   std::printf("%-28s  %9.4f  %9.4f  %5.3f %5.3f %5.3f  %5.3f %5.3f %5.3f  %5d  %8.1e  %7.1f\n", source.c_str(), r.alpha_ggx,
               r.alpha_beckmann, r.f0.r, r.f0.g, r.f0.b, r.f82.r, r.f82.g, r.f82.b, r.extraction.iterations,
               r.extraction.residual, seconds * 1e3);
+  if (const auto& a = r.anisotropic)
+    std::printf("%-28s  anisotropic: ggx %.4f x %.4f, beckmann %.4f x %.4f, x axis at %.1f degrees (the row above: the azimuthal mean)\n", "",
+                a->ggx.alpha_x, a->ggx.alpha_y, a->beckmann.alpha_x, a->beckmann.alpha_y, a->ggx.angle * 180.0 / kPi);
 }
 
 void run_fit(const FitArgs& args, Context& ctx) {

@@ -80,7 +80,8 @@ TEST(MerlBins, GroundTruthWrittenEitherWayComesBack) {
 // A UTIA file goes through the isotropic pipeline as its azimuthal mean (io/input.h), its back-scattering
 // taken at the file's own six polar angles: an isotropic GGX comes back with its alpha within the UTIA bar
 // of the 2D path, 3% (-1.1% here; read from the table instead, between the file's 15-degree nodes and
-// extrapolated past 75 degrees, it came out -3.3%), an anisotropic one with an alpha between its two.
+// extrapolated past 75 degrees, it came out -3.3%), an anisotropic one with an alpha between its two and,
+// beside it, its anisotropic fit.
 TEST(Utia, LoadsAsItsAzimuthalMeanForTheIsotropicFit) {
   test::TempDir dir;
   const MicrofacetBrdf iso(Ndf::isotropic(NdfType::ggx, 0.3), Smith::masking, Fresnel::schlick(Rgb(0.9, 0.6, 0.3)));
@@ -99,6 +100,16 @@ TEST(Utia, LoadsAsItsAzimuthalMeanForTheIsotropicFit) {
   std::cout << "anisotropic GGX (0.45, 0.2) through UTIA: isotropic alpha " << b.alpha_ggx << "\n";
   EXPECT_GT(b.alpha_ggx, 0.2);
   EXPECT_LT(b.alpha_ggx, 0.45);
+  // Beside it, the 2D extraction of the file's own back-scattering (fit/extract_2d.h): its principal
+  // alphas and angle, within the UTIA bar (3%); an isotropic file gets equal alphas.
+  ASSERT_TRUE(a.anisotropic && b.anisotropic);
+  std::cout << "anisotropic fit: " << b.anisotropic->ggx.alpha_x << " x " << b.anisotropic->ggx.alpha_y << " at "
+            << b.anisotropic->ggx.angle * 180.0 / kPi << " degrees; isotropic file " << a.anisotropic->ggx.alpha_x << " x "
+            << a.anisotropic->ggx.alpha_y << "\n";
+  EXPECT_NEAR(b.anisotropic->ggx.alpha_x, 0.45, 0.03 * 0.45);
+  EXPECT_NEAR(b.anisotropic->ggx.alpha_y, 0.2, 0.03 * 0.2);
+  EXPECT_NEAR(b.anisotropic->ggx.angle, 0.6, 2.0 * kPi / 180.0);
+  EXPECT_NEAR(a.anisotropic->ggx.alpha_x, a.anisotropic->ggx.alpha_y, 1e-3 * a.anisotropic->ggx.alpha_x);
   EXPECT_NE(test::error_of([&] { load_table(dir.file("nothing.bin")); }).find("nothing.bin"), std::string::npos);
 }
 

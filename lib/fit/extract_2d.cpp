@@ -21,16 +21,16 @@ Backscatter2D backscatter_2d(const Brdf& brdf, const Quadrature2D& quad) {
   return b;
 }
 
-Backscatter2D backscatter_2d(const UtiaBrdf& utia, const Quadrature2D& quad) {
+Backscatter2D backscatter_2d(const BackscatterLattice& lattice, const Quadrature2D& quad) {
   Backscatter2D b;
   for (int m = 0; m < quad.phi_count(); ++m) {
-    double x = quad.phi(m) * 180.0 / kPi / UtiaBrdf::kPhiStep;
-    const int lo = std::min(int(x), UtiaBrdf::kPhi - 1), hi = (lo + 1) % UtiaBrdf::kPhi;
+    const double x = quad.phi(m) / (2.0 * kPi) * lattice.azimuths;
+    const int lo = std::min(int(x), lattice.azimuths - 1), hi = (lo + 1) % lattice.azimuths;
     const double t = x - lo;
     Backscatter slice;
-    for (int p = 0; p < UtiaBrdf::kTheta; ++p) {
-      const Rgb f = utia.node(p, lo, p, lo) * (1.0 - t) + utia.node(p, hi, p, hi) * t;
-      slice.theta.push_back(p * UtiaBrdf::kThetaStep * kPi / 180.0);
+    for (std::size_t p = 0; p < lattice.theta.size(); ++p) {
+      const Rgb f = lattice.at(int(p), lo) * (1.0 - t) + lattice.at(int(p), hi) * t;
+      slice.theta.push_back(lattice.theta[p]);
       slice.value.push_back(std::max(0.0, luminance(f)));
     }
     b.slices.push_back(std::move(slice));

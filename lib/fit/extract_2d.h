@@ -20,7 +20,7 @@
 #include "core/brdf.h"
 #include "fit/extract.h"
 #include "fit/quadrature_2d.h"
-#include "io/utia.h"
+#include "io/backscatter_lattice.h"
 
 namespace facetfit {
 
@@ -32,9 +32,9 @@ struct Backscatter2D {
 
 // f(k, k) of a BRDF (e.g. an analytic anisotropic model) at MERL's theta_h bins and the quadrature's azimuths.
 Backscatter2D backscatter_2d(const Brdf& brdf, const Quadrature2D& quadrature);
-// f(k, k) of a UTIA file: its diagonal nodes (theta_i = theta_v, phi_i = phi_v), six polar angles per
-// azimuth, linear in phi between the file's azimuths (eval() would mix in nodes that are not back-scattering).
-Backscatter2D backscatter_2d(const UtiaBrdf& utia, const Quadrature2D& quadrature);
+// f(k, k) measured at a lattice's nodes (a UTIA file's diagonal: UtiaBrdf::backscatter), linear in phi
+// between its azimuths (the file's eval() would mix in nodes that are not back-scattering).
+Backscatter2D backscatter_2d(const BackscatterLattice& lattice, const Quadrature2D& quadrature);
 
 struct Extraction2D : PowerIteration {
   int phi_count = 0;

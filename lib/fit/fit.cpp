@@ -4,6 +4,7 @@
 
 #include <array>
 #include <cmath>
+#include <cstdio>
 
 #include "core/error.h"
 #include "fit/plausibility.h"
@@ -15,10 +16,10 @@ namespace facetfit {
 
 Backscatter backscatter_of(const MerlTable& table) {
   Backscatter back;
-  if (!table.source_backscatter().empty()) {  // measured off the table's bins (io/merl.h)
-    for (const MerlTable::BackscatterNode& node : table.source_backscatter()) {
-      back.theta.push_back(node.theta);
-      back.value.push_back(std::max(0.0, luminance(node.value)));  // below zero: noise on a zero measurement
+  if (const BackscatterLattice& lattice = table.source_backscatter(); !lattice.empty()) {  // measured off the bins
+    for (std::size_t p = 0; p < lattice.theta.size(); ++p) {
+      back.theta.push_back(lattice.theta[p]);
+      back.value.push_back(std::max(0.0, luminance(lattice.azimuthal_mean(int(p)))));  // below zero: noise on a zero measurement
     }
     return back;
   }
@@ -165,6 +166,26 @@ FitResult Fitter::fit(const MerlTable& table) const {
       !finite(result.f82) || !finite(result.body()))
     result.problem = "the fit produced non-finite parameters";
   if (result.ok()) result.warnings = plausibility_warnings(table, result);
+  if (result.ok() && table.source_backscatter().azimuths > 1) {
+    // The same power iteration with the azimuth kept, on the source's own azimuths (6 ms at 90 x 48).
+    const BackscatterLattice& lattice = table.source_backscatter();
+    const Quadrature2D quadrature(options_.resolution, lattice.azimuths);
+    const Extraction2D e = extract_ndf_2d(backscatter_2d(lattice, quadrature), quadrature,
+                                          {options_.smith, options_.tolerance, options_.max_iterations});
+    if (e.problem.empty()) {
+      const AnisotropicFit a{alpha_ggx_2d(e.ndf, quadrature), alpha_beckmann_2d(e.ndf, quadrature), e.iterations, e.residual};
+      result.anisotropic = a;
+      // Anisotropic beyond what the 15-degree grid resolves (a 10% ratio): say what an isotropic LUT loses.
+      if (a.ggx.alpha_x > 1.1 * a.ggx.alpha_y) {
+        char text[200];
+        std::snprintf(text, sizeof text, "anisotropic (GGX %.3f x %.3f, x axis at %.0f degrees): the isotropic fits are of its azimuthal mean",
+                      a.ggx.alpha_x, a.ggx.alpha_y, a.ggx.angle * 180.0 / kPi);
+        result.warnings.push_back(text);
+      }
+    } else {
+      result.warnings.push_back("no anisotropic fit: " + e.problem);
+    }
+  }
   return result;
 }
 

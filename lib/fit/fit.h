@@ -11,6 +11,7 @@
 #include <string>
 
 #include "fit/extract.h"
+#include "fit/extract_2d.h"
 #include "fit/fresnel_fit.h"
 #include "fit/parametric_fit.h"
 #include "fit/quadrature.h"
@@ -42,6 +43,14 @@ struct FitOptions {
 const char* to_string(FitOptions::Refine r);
 std::optional<FitOptions::Refine> parse_refine(const std::string& name);
 
+// The 2D extraction (fit/extract_2d.h) of a source that measured back-scattering along azimuths (a
+// UTIA file): its principal roughness in each family.
+struct AnisotropicFit {
+  AnisotropicAlpha ggx, beckmann;
+  int iterations = 0;
+  double residual = 0.0;
+};
+
 struct FitResult {
   Extraction extraction;  // the power iteration: ndf, sigma, eigenvalue, iterations, residual
   LobeFit lobe;           // body + tabulated lobe: the extraction's, refined unless Refine::none
@@ -58,6 +67,9 @@ struct FitResult {
   bool refined = false;             // Refine::full: body, parametric fits and errors are measured
   std::string problem;  // empty for a meaningful fit; otherwise why it is not one
   std::vector<std::string> warnings;  // implausible values in the measurement or the fit (fit/plausibility.h)
+  // With a source that holds back-scattering along azimuths (MerlTable::source_backscatter); the rest of
+  // the result is the isotropic fit of the table (for UTIA, the azimuthal mean).
+  std::optional<AnisotropicFit> anisotropic;
 
   bool ok() const { return problem.empty(); }
   const TabulatedNdf& ndf() const { return lobe.ndf; }

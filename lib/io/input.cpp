@@ -58,11 +58,8 @@ MerlTable load_table(const std::string& source, MerlTable::BinPoint merl_bins) {
   // UTIA: anisotropic, tabulated as its azimuthal mean (the isotropic fits see that; fit/extract_2d.h
   // fits the file itself).
   if (const auto* utia = dynamic_cast<const UtiaBrdf*>(brdf.get())) {
-    const UtiaBrdf mean = utia->azimuthal_mean();
-    MerlTable table = MerlTable::tabulate(mean);
-    std::vector<MerlTable::BackscatterNode> back;
-    for (int t = 0; t < UtiaBrdf::kTheta; ++t) back.push_back({t * UtiaBrdf::kThetaStep * kPi / 180.0, mean.node(t, 0, t, 0)});
-    table.set_source_backscatter(std::move(back));
+    MerlTable table = MerlTable::tabulate(utia->azimuthal_mean());
+    table.set_source_backscatter(utia->backscatter());
     return table;
   }
   return MerlTable::tabulate(*brdf);

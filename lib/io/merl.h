@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "core/brdf.h"
+#include "io/backscatter_lattice.h"
 
 namespace facetfit {
 
@@ -72,16 +73,11 @@ class MerlTable final : public Brdf {
   void set(int i, int j, int k, const Rgb& v);
   void set_missing(int i, int j, int k);
 
-  // Back-scattering f(k, k) measured by the source at its own polar angles, when those are not the
-  // table's bins: a UTIA file holds six, 15 degrees apart, between which the table only interpolates
-  // (and past 75 degrees extrapolates). The fit then takes these instead of the table's theta_d = 0 bins.
-  // Empty for every other source.
-  struct BackscatterNode {
-    double theta = 0.0;
-    Rgb value{0.0};
-  };
-  const std::vector<BackscatterNode>& source_backscatter() const { return source_backscatter_; }
-  void set_source_backscatter(std::vector<BackscatterNode> nodes) { source_backscatter_ = std::move(nodes); }
+  // Back-scattering measured by the source at nodes of its own (io/backscatter_lattice.h: a UTIA file),
+  // which the fits take instead of the table's theta_d = 0 bins, resampled between those nodes. Empty
+  // for every other source.
+  const BackscatterLattice& source_backscatter() const { return source_backscatter_; }
+  void set_source_backscatter(BackscatterLattice lattice) { source_backscatter_ = std::move(lattice); }
 
  private:
   std::optional<Rgb> eval_nearest(double x_h, double x_d, double x_p) const;
@@ -108,7 +104,7 @@ class MerlTable final : public Brdf {
   explicit MerlTable(Uninitialized);
 
   std::vector<float, UninitializedAllocator<float>> data_;  // 3 * kBins, channel-planar as in the file
-  std::vector<BackscatterNode> source_backscatter_;
+  BackscatterLattice source_backscatter_;
   Lookup lookup_ = Lookup::linear;
 };
 

@@ -96,6 +96,16 @@ UtiaBrdf UtiaBrdf::tabulate(const Brdf& brdf) {
   return UtiaBrdf(std::move(f));
 }
 
+BackscatterLattice UtiaBrdf::backscatter() const {
+  BackscatterLattice b;
+  b.azimuths = kPhi;
+  for (int p = 0; p < kTheta; ++p) {
+    b.theta.push_back(p * kThetaStep * kPi / 180.0);
+    for (int k = 0; k < kPhi; ++k) b.value.push_back(node(p, k, p, k));
+  }
+  return b;
+}
+
 UtiaBrdf UtiaBrdf::azimuthal_mean() const {
   auto f = std::make_shared<std::vector<double>>(3 * kPerPlane, 0.0);
   for (int c = 0; c < 3; ++c) {

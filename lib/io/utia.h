@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "core/brdf.h"
+#include "io/backscatter_lattice.h"
 
 namespace facetfit {
 
@@ -34,6 +35,8 @@ class UtiaBrdf final : public Brdf {
   static UtiaBrdf read(const std::string& path);
   // Samples any BRDF at the nodes (what the writer writes).
   static UtiaBrdf tabulate(const Brdf& brdf);
+  // f(k, k) at the diagonal nodes (theta_i = theta_v, phi_i = phi_v): six polar angles, 48 azimuths.
+  BackscatterLattice backscatter() const;
   // The file's mean over turns of both directions about the normal by multiples of its azimuth step, as
   // a file of its own (isotropic): node (ti, pi, tv, pv) becomes the mean over k of node (ti, pi + k,
   // tv, pv + k), which depends on pv - pi alone. The interpolation being linear in the nodes, its eval()

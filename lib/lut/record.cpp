@@ -41,6 +41,14 @@ nlohmann::json fit_record(const std::string& source, const FitResult& fit, doubl
     for (const auto& [name, p] : {std::pair<const char*, const ParametricFit*>{"ggx", &fit.ggx}, {"beckmann", &fit.beckmann}, {"lsq", &fit.lsq}})
       j[name] = parametric_json(p->alpha, p->body, p->f0, p->f82, p->coat, p->error);
     j["warnings"] = fit.warnings;
+    j["anisotropic"] = nullptr;
+    if (const auto& a = fit.anisotropic) {
+      const auto principal = [](const AnisotropicAlpha& p) {
+        return nlohmann::json{{"alpha_x", p.alpha_x}, {"alpha_y", p.alpha_y}, {"angle_degrees", p.angle * 180.0 / kPi}};
+      };
+      j["anisotropic"] = {{"ggx", principal(a->ggx)}, {"beckmann", principal(a->beckmann)}, {"iterations", a->iterations},
+                          {"residual", a->residual}};
+    }
   } else {
     for (const char* k : {"alpha_ggx", "alpha_beckmann", "f0", "f82"}) j[k] = nullptr;
   }

@@ -17,8 +17,9 @@ std::string json_text(const nlohmann::json& j, int indent = -1);
 nlohmann::json read_json_file(const std::string& path);
 
 // Keys: source, alpha_ggx, alpha_beckmann, f0, f82 (of the tabulated representation), refine, body,
-// coat, error, error_extraction, ggx / beckmann / lsq (parametric_json), warnings, iterations, residual,
-// seconds. A meaningless fit has null parameters (JSON has no NaN).
+// coat, error, error_extraction, ggx / beckmann / lsq (parametric_json), warnings, anisotropic (null, or
+// for a UTIA source {ggx, beckmann: {alpha_x, alpha_y, angle_degrees}, iterations, residual}), iterations,
+// residual, seconds. A meaningless fit has null parameters (JSON has no NaN).
 nlohmann::json fit_record(const std::string& source, const FitResult& fit, double seconds);
 
 // A coat as {alpha, f0}, null when absent; a parametric fit as {alpha, body, f0, f82, coat, error}.

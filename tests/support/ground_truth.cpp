@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "fit/roughness.h"
+#include "io/utia.h"
 #include "model/analytic.h"
 
 namespace facetfit {
@@ -64,7 +65,7 @@ AnisotropicError measure_anisotropic(const AnisotropicCase& c, const Quadrature2
     back = backscatter_2d(turned, quad);
   } else {
     UtiaBrdf::tabulate(turned).write(utia_path);
-    back = backscatter_2d(UtiaBrdf::read(utia_path), quad);
+    back = backscatter_2d(UtiaBrdf::read(utia_path).backscatter(), quad);
   }
   const Extraction2D x = extract_ndf_2d(back, quad, {c.smith, 1e-10, 1000});
   AnisotropicError e;
