@@ -15,6 +15,7 @@
 #include "io/input.h"
 #include "io/merl.h"
 #include "io/sha256.h"
+#include "io/utia.h"
 #include "lut/bake.h"
 #include "lut/lut.h"
 #include "model/analytic.h"
@@ -145,6 +146,29 @@ void BM_TabulateAnalytic(benchmark::State& state) {
   for (auto _ : state) benchmark::DoNotOptimize(MerlTable::tabulate(brdf));
 }
 BENCHMARK(BM_TabulateAnalytic)->Unit(benchmark::kMillisecond);
+
+// A UTIA file (anisotropic GGX written by facetfit's writer) to the fit's table: read, azimuthal mean,
+// tabulation in MERL layout (io/input.h); then the default fit of it, which adds the 2D extraction.
+const std::string& utia_file() {
+  static const std::string path = [] {
+    const std::string p = (std::filesystem::temp_directory_path() / "facetfit-bench-anisotropic.bin").string();
+    UtiaBrdf::tabulate(MicrofacetBrdf(Ndf{NdfType::ggx, 0.45, 0.2}, Smith::correlated, Fresnel::schlick(Rgb(0.9, 0.6, 0.3)))).write(p);
+    return p;
+  }();
+  return path;
+}
+void BM_LoadUtia(benchmark::State& state) {
+  for (auto _ : state) benchmark::DoNotOptimize(load_table(utia_file()));
+}
+BENCHMARK(BM_LoadUtia)->Unit(benchmark::kMillisecond);
+void BM_FitUtia(benchmark::State& state) {
+  const MerlTable table = load_table(utia_file());
+  FitOptions options;
+  options.refine = state.range(0) ? FitOptions::Refine::full : FitOptions::Refine::none;
+  const Fitter fitter(options);
+  for (auto _ : state) benchmark::DoNotOptimize(fitter.fit(table));
+}
+BENCHMARK(BM_FitUtia)->ArgName("refine")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 
 // A MERL file on disk for the bake benchmarks, written once.
 const std::string& gold_file() {

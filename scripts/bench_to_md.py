@@ -16,6 +16,8 @@ NOTES = {
     "BM_Quadrature": "quadrature weights of one resolution (once per batch, shared by every material)",
     "BM_RefineAlpha": "optional least-squares refinement of one alpha (`--refine`)",
     "BM_TabulateAnalytic": "tabulate an analytic BRDF into MERL layout (tests, `convert builtin:`)",
+    "BM_LoadUtia": "a UTIA file (anisotropic GGX) to the fits' table: read, azimuthal mean, tabulation in MERL layout (against BM_TabulateAnalytic)",
+    "BM_FitUtia": "the fit of that table, the paper's method (refine:0) and the default (refine:1), each with the 2D extraction of the file's back-scattering",
     "BM_Bake": "bake one MERL file with the default fit: SHA-256, read, fit, sampling tables, EXR, sidecar (hash overlapped with the read)",
     "BM_Sha256File": "SHA-256 of the 35 MB MERL file (OpenSSL; provenance in the LUT, bake cache key)",
     "BM_VisibleNormalTables": "the sampling tables of one material",
