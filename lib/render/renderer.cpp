@@ -71,6 +71,14 @@ struct Geometry {
   int material;
 };
 
+// Texture coordinates of point p on a sphere (render/texture.h) or a plane (its square's axes, as its
+// geometry is built below: 0 to 1 across it). Meshes carry none (the scene refuses textures on them).
+TextureCoordinates texture_coordinates(const ObjectDesc& object, const Vec3& p) {
+  if (object.kind == ObjectDesc::Kind::sphere) return sphere_texture_coordinates(glm::normalize(p - object.center));
+  const Frame square(object.normal);
+  return {glm::dot(p - object.point, square.t) / object.size + 0.5, glm::dot(p - object.point, square.b) / object.size + 0.5};
+}
+
 }  // namespace
 
 void read_obj(const std::string& path, std::vector<float>& positions, std::vector<unsigned>& indices) {
@@ -258,15 +266,7 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
     std::optional<TabulatedMicrofacet> textured_lobe;
     std::optional<ShadingModel> textured;
     if (const auto& st = stretch_textures[std::size_t(geo.material)]) {
-      const ObjectDesc& object = *geo.object;
-      TextureCoordinates at;
-      if (object.kind == ObjectDesc::Kind::sphere) {
-        at = sphere_texture_coordinates(glm::normalize(p - object.center));
-      } else {  // plane: its square's own axes
-        const Frame square(object.normal);
-        at = {glm::dot(p - object.point, square.t) / object.size + 0.5, glm::dot(p - object.point, square.b) / object.size + 0.5};
-      }
-      const Rgb scale = st->texture.lookup(at);
+      const Rgb scale = st->texture.lookup(texture_coordinates(*geo.object, p));
       const auto stretch = [](double a, double b) { return clamp(a * b, 0.01, 100.0); };
       textured_lobe.emplace(st->lobe->stretched(Stretch(stretch(st->stretch.x, scale.r), stretch(st->stretch.y, scale.g), st->stretch.rotation())));
       const std::shared_ptr<const TabulatedMicrofacet> unowned(std::shared_ptr<void>(), &*textured_lobe);
