@@ -342,6 +342,9 @@ TEST(Render, StretchTextureDrivesTheStretchPerPoint) {
   EXPECT_GT(covered, 20);
   EXPECT_EQ(same, covered);
   EXPECT_NE(test::error_of([&] { render(scene(R"(, "stretch_texture": "missing.exr")", sphere)); }).find("missing.exr"), std::string::npos);
+  write_texture("nan.exr", 2, 2, [](int x, int y) { return x == 1 && y == 1 ? Rgb(1.0, std::nan(""), 1.0) : Rgb(1.0); });
+  EXPECT_NE(test::error_of([&] { render(scene(R"(, "stretch_texture": "nan.exr")", sphere)); }).find("nan.exr: non-finite G value at pixel (1, 1)"),
+            std::string::npos);
   EXPECT_NE(test::error_of([&] { scene(R"(, "stretch_texture": "uniform.exr")", R"({"type": "mesh", "file": "x.obj", "material": "m"})"); })
                 .find("a mesh has no texture coordinates"),
             std::string::npos);

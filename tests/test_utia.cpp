@@ -60,6 +60,12 @@ TEST(Utia, BadFilesGetOneLine) {
   std::memcpy(&bytes[800], &nan, sizeof nan);
   test::write_bytes(dir.file("nan.bin"), bytes);
   EXPECT_NE(test::error_of([&] { UtiaBrdf::read(dir.file("nan.bin")); }).find("byte offset 800"), std::string::npos);
+  // Finite in the file, infinite once decoded (x^2.4 overflows): refused the same way.
+  std::string huge(UtiaBrdf::kFileBytes, '\0');
+  const double big = 1e200;
+  std::memcpy(&huge[1600], &big, sizeof big);
+  test::write_bytes(dir.file("huge.bin"), huge);
+  EXPECT_NE(test::error_of([&] { UtiaBrdf::read(dir.file("huge.bin")); }).find("byte offset 1600 is not a finite number"), std::string::npos);
   EXPECT_NE(test::error_of([&] { UtiaBrdf::read("/dev/zero"); }).find("not a regular file"), std::string::npos);
 }
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
@@ -172,9 +173,30 @@ std::array<int, 3> rgb_channels(const OIIO::ImageSpec& spec, const std::string& 
 
 std::vector<float> read_pixels(OIIO::ImageInput& in, const std::string& path) {
   const OIIO::ImageSpec& spec = in.spec();
+  // read_image reads every slice of a volume and the samples of a deep image: not into this buffer.
+  if (spec.deep) fail(path, "deep images are not supported");
+  if (spec.depth != 1) fail(path, "volume images are not supported");
+  if (spec.width < 1 || spec.height < 1 || spec.nchannels < 1) fail(path, "empty image");
   std::vector<float> all(std::size_t(spec.width) * std::size_t(spec.height) * std::size_t(spec.nchannels));
   if (!in.read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, all.data())) fail(path, "cannot read pixels: " + first_line(in.geterror()));
   return all;
+}
+
+std::vector<float> read_rgb(OIIO::ImageInput& in, const std::string& path, OneChannel one_channel) {
+  const OIIO::ImageSpec& spec = in.spec();
+  const std::array<int, 3> channel = rgb_channels(spec, path, one_channel);
+  const std::vector<float> all = read_pixels(in, path);
+  const std::size_t pixels = std::size_t(spec.width) * std::size_t(spec.height), n = std::size_t(spec.nchannels);
+  std::vector<float> rgb(pixels * 3);
+  for (std::size_t p = 0; p < pixels; ++p)
+    for (std::size_t c = 0; c < 3; ++c) {
+      const float v = all[p * n + std::size_t(channel[c])];
+      if (!std::isfinite(v))
+        fail(path, std::string("non-finite ") + "RGB"[c] + " value at pixel (" + std::to_string(p % std::size_t(spec.width)) + ", " +
+                       std::to_string(p / std::size_t(spec.width)) + ")");
+      rgb[p * 3 + c] = v;
+    }
+  return rgb;
 }
 
 void write_image_atomic(const std::string& path, const OIIO::ImageSpec& spec, const void* pixels) {

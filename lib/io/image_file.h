@@ -22,8 +22,11 @@ enum class OneChannel { grey, refused };
 std::array<int, 3> rgb_channels(const OIIO::ImageSpec& spec, const std::string& path, OneChannel one_channel);
 
 // Every channel of an open image's first subimage as floats, interleaved, row 0 at the top. Throws
-// Error("<path>: cannot read pixels: ...").
+// Error("<path>: ...") for a deep, volume or empty image and for a failed read.
 std::vector<float> read_pixels(OIIO::ImageInput& in, const std::string& path);
+
+// Its R, G and B (rgb_channels) as interleaved floats; a NaN or infinite value is refused, naming the pixel.
+std::vector<float> read_rgb(OIIO::ImageInput& in, const std::string& path, OneChannel one_channel);
 
 // Writes `pixels` (spec.format, interleaved as spec says) to `path` through an AtomicFile; the format
 // follows the extension. Throws Error("<path>: cannot write: ...").

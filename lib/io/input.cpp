@@ -53,8 +53,9 @@ std::shared_ptr<const Brdf> load_brdf(const std::string& source, MerlTable::BinP
 }
 
 MerlTable load_table(const std::string& source, MerlTable::BinPoint merl_bins) {
+  // A MERL file is read as it is (not through load_brdf, whose shared copy would double the 17 MB).
+  if (!is_builtin(source) && fs::path(source).extension() == ".binary") return MerlTable::read(source, merl_bins);
   const std::shared_ptr<const Brdf> brdf = load_brdf(source, merl_bins);
-  if (const auto* table = dynamic_cast<const MerlTable*>(brdf.get())) return *table;
   // UTIA: anisotropic, tabulated as its azimuthal mean (the isotropic fits see that; fit/extract_2d.h
   // fits the file itself).
   if (const auto* utia = dynamic_cast<const UtiaBrdf*>(brdf.get())) {

@@ -75,7 +75,8 @@ class MerlTable final : public Brdf {
 
   // Back-scattering measured by the source at nodes of its own (io/backscatter_lattice.h: a UTIA file),
   // which the fits take instead of the table's theta_d = 0 bins, resampled between those nodes. Empty
-  // for every other source.
+  // for every other source. It describes the source, not the bins: set() and channel() leave it as it
+  // is, a table resampled or written as MERL (centres_to_edges, write) does not carry it.
   const BackscatterLattice& source_backscatter() const { return source_backscatter_; }
   void set_source_backscatter(BackscatterLattice lattice) { source_backscatter_ = std::move(lattice); }
 

@@ -74,10 +74,10 @@ UtiaBrdf UtiaBrdf::read(const std::string& path) {
   auto f = std::make_shared<std::vector<double>>(3 * kPerPlane);
   if (!in.read(reinterpret_cast<char*>(f->data()), std::streamsize(kFileBytes))) fail(path, "cannot read: short read");
   for (std::size_t k = 0; k < f->size(); ++k) {
-    const double x = (*f)[k];
-    if (!std::isfinite(x))
-      fail(path, "value at byte offset " + std::to_string(k * sizeof(double)) + " is not a finite number");
-    (*f)[k] = decode(x);
+    const double x = (*f)[k], v = decode(x);
+    if (!std::isfinite(v))  // a NaN, an infinity, or a finite value whose decoding overflows
+      fail(path, "value at byte offset " + std::to_string(k * sizeof(double)) + " is not a finite number (" + std::to_string(x) + ")");
+    (*f)[k] = v;
   }
   return UtiaBrdf(std::move(f));
 }

@@ -17,6 +17,9 @@ namespace facetfit {
 
 class Stretch {
  public:
+  // What a scene or a texture may ask along either axis: roughness from 1/100 to 100 times the measured.
+  static constexpr double kMin = 0.01, kMax = 100.0;
+
   // Slopes scaled by (x, y) along axes whose x axis lies at azimuth `rotation` (radians).
   Stretch(double along_x = 1.0, double along_y = 1.0, double rotation = 0.0)
       : x(along_x), y(along_y), rotation_(rotation), cos_(std::cos(rotation)), sin_(std::sin(rotation)) {}

@@ -3,7 +3,6 @@
 #include <OpenImageIO/imageio.h>
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 
 #include "core/error.h"
@@ -56,11 +55,7 @@ Environment Environment::load(const std::string& path, std::uint64_t max_bytes) 
                    std::to_string(spec.nchannels) + " channels; at most 65536 x 32768, at least 2 x 1, 1 to 64 channels");
   check_memory(path, "a " + std::to_string(spec.width) + " x " + std::to_string(spec.height) + " environment map",
                bytes_to_load(spec.width, spec.height, spec.nchannels), max_bytes);
-  const std::array<int, 3> channel = rgb_channels(spec, path, OneChannel::grey);
-  const std::vector<float> all = read_pixels(*in, path);
-  std::vector<float> rgb(std::size_t(spec.width) * spec.height * 3);
-  for (std::size_t p = 0; p < std::size_t(spec.width) * spec.height; ++p)
-    for (int c = 0; c < 3; ++c) rgb[p * 3 + c] = all[p * spec.nchannels + channel[std::size_t(c)]];
+  std::vector<float> rgb = read_rgb(*in, path, OneChannel::grey);
   return from_pixels(spec.width, spec.height, std::move(rgb));
 }
 

@@ -131,6 +131,7 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
     Stretch stretch;
   };
   std::vector<std::optional<StretchTexture>> stretch_textures;
+  std::uint64_t left = budget - image_bytes;  // for the textures and the environment map together
   std::map<std::string, int> material_index;
   for (const ObjectDesc& o : desc.objects) {
     if (material_index.count(o.material)) continue;
@@ -142,7 +143,8 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
     if (!m.stretch_texture.empty()) {
       const auto* lobe = dynamic_cast<const TabulatedMicrofacet*>(&materials.back()->brdf());
       if (!lobe) fail(m.file, "a stretch_texture needs a tabulated lobe");
-      stretch_textures.back() = StretchTexture{Texture::load(resolve(desc, m.stretch_texture), budget - image_bytes), lobe, m.stretch};
+      stretch_textures.back() = StretchTexture{Texture::load(resolve(desc, m.stretch_texture), left), lobe, m.stretch};
+      left -= stretch_textures.back()->texture.bytes();
     }
   }
   std::optional<Environment> env;
@@ -151,7 +153,7 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
     case EnvironmentDesc::Kind::builtin_sky: env = Environment::sky(); break;
     case EnvironmentDesc::Kind::constant: env = Environment::constant(desc.environment.constant * desc.environment.scale); break;
     case EnvironmentDesc::Kind::file: {
-      Environment loaded = Environment::load(resolve(desc, desc.environment.file), budget - image_bytes);
+      Environment loaded = Environment::load(resolve(desc, desc.environment.file), left);
       if (desc.environment.scale != 1.0) {
         std::vector<float> px = loaded.pixels();
         for (float& v : px) v *= float(desc.environment.scale);
@@ -267,7 +269,7 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
     std::optional<ShadingModel> textured;
     if (const auto& st = stretch_textures[std::size_t(geo.material)]) {
       const Rgb scale = st->texture.lookup(texture_coordinates(*geo.object, p));
-      const auto stretch = [](double a, double b) { return clamp(a * b, 0.01, 100.0); };
+      const auto stretch = [](double a, double b) { return clamp(a * b, Stretch::kMin, Stretch::kMax); };
       textured_lobe.emplace(st->lobe->stretched(Stretch(stretch(st->stretch.x, scale.r), stretch(st->stretch.y, scale.g), st->stretch.rotation())));
       const std::shared_ptr<const TabulatedMicrofacet> unowned(std::shared_ptr<void>(), &*textured_lobe);
       textured.emplace(unowned, unowned);

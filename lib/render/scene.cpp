@@ -126,7 +126,8 @@ MaterialDesc parse_material(const std::string& name, const json& j, const std::s
       if (!st.is_array() || st.size() != 2 || !st[0].is_number() || !st[1].is_number())
         fail(path, "material " + name + ": stretch must be [x, y]");
       sx = st[0].get<double>(), sy = st[1].get<double>();
-      if (!(sx >= 0.01 && sx <= 100.0 && sy >= 0.01 && sy <= 100.0)) fail(path, "material " + name + ": stretch must be in [0.01, 100]");
+      if (!(sx >= Stretch::kMin && sx <= Stretch::kMax && sy >= Stretch::kMin && sy <= Stretch::kMax))
+        fail(path, "material " + name + ": stretch must be in [0.01, 100]");
     }
     const double degrees = get<double>(j, "rotation", 0.0, path);
     if (!(std::abs(degrees) <= 360.0)) fail(path, "material " + name + ": rotation must be in [-360, 360] degrees");

@@ -1,7 +1,6 @@
 #include "render/texture.h"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 
 #include "core/error.h"
@@ -10,7 +9,10 @@
 
 namespace facetfit {
 
-Texture::Texture(int width, int height, std::vector<float> rgb) : width_(width), height_(height), rgb_(std::move(rgb)) {}
+Texture::Texture(int width, int height, std::vector<float> rgb) : width_(width), height_(height), rgb_(std::move(rgb)) {
+  if (width < 1 || height < 1 || rgb_.size() != std::size_t(width) * std::size_t(height) * 3)
+    throw Error("texture: " + std::to_string(rgb_.size()) + " values for " + std::to_string(width) + " x " + std::to_string(height) + " RGB pixels");
+}
 
 Texture Texture::load(const std::string& path, std::uint64_t max_bytes) {
   auto in = open_image(path, "cannot open texture");
@@ -22,17 +24,7 @@ Texture Texture::load(const std::string& path, std::uint64_t max_bytes) {
   const std::uint64_t pixels = std::uint64_t(spec.width) * std::uint64_t(spec.height);
   check_memory(path, "a " + std::to_string(spec.width) + " x " + std::to_string(spec.height) + " texture",
                pixels * (std::uint64_t(spec.nchannels) + 3u) * sizeof(float), max_bytes);
-  const std::array<int, 3> channel = rgb_channels(spec, path, OneChannel::grey);
-  const std::vector<float> all = read_pixels(*in, path);
-  std::vector<float> rgb(std::size_t(pixels) * 3);
-  for (std::size_t p = 0; p < std::size_t(pixels); ++p)
-    for (std::size_t c = 0; c < 3; ++c) {
-      const float v = all[p * std::size_t(spec.nchannels) + std::size_t(channel[c])];
-      if (!std::isfinite(v))
-        fail(path, std::string("non-finite ") + "RGB"[c] + " value at pixel (" + std::to_string(p % std::size_t(spec.width)) + ", " +
-                       std::to_string(p / std::size_t(spec.width)) + ")");
-      rgb[p * 3 + c] = v;
-    }
+  std::vector<float> rgb = read_rgb(*in, path, OneChannel::grey);
   return Texture(spec.width, spec.height, std::move(rgb));
 }
 

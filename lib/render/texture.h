@@ -27,6 +27,7 @@ class Texture {
 
   Rgb lookup(TextureCoordinates at) const;
   int width() const { return width_; }
+  std::uint64_t bytes() const { return rgb_.size() * sizeof(float); }
   int height() const { return height_; }
 
  private:
