@@ -375,6 +375,59 @@ TEST(Render, MeasuredUtiaFilesRenderAnisotropicAlongTheirTangent) {
   EXPECT_GT(turned_aniso, 4.0 * turned_iso);  // 0.087 against 0.012 when written
 }
 
+// The plane's texture axes as docs/scene-format.md states them: facing +y, u along +x and v along -z. Seen
+// from above (image right +x, image top -z), a texture split in two halves renders each half of the image as
+// the uniform stretch of that half does.
+TEST(Render, PlaneTextureAxesAreAsDocumented) {
+  test::TempDir dir;
+  const Fitter fitter{FitOptions::paper()};
+  write_lut(dir.file("gold.exr"),
+            make_lut(fitter.fit(load_table("builtin:gold-ggx-0.15")), fitter.quadrature(), "builtin:gold-ggx-0.15", "x", 0.02, true));
+  constexpr int kTexels = 64;
+  const auto write_halves = [&](const std::string& name, bool along_u) {
+    std::vector<float> px;
+    for (int y = 0; y < kTexels; ++y)
+      for (int x = 0; x < kTexels; ++x) {
+        // u >= 1/2 (right columns), or v >= 1/2 (top rows): the rough half.
+        const bool rough = along_u ? x >= kTexels / 2 : y < kTexels / 2;
+        const float s = rough ? 4.0f : 0.25f;
+        px.insert(px.end(), {s, s, 0.0f});
+      }
+    write_image_atomic(dir.file(name), OIIO::ImageSpec(kTexels, kTexels, 3, OIIO::TypeDesc::FLOAT), px.data());
+  };
+  write_halves("u.exr", true);
+  write_halves("v.exr", false);
+  constexpr int kSize = 32;
+  const auto image = [&](const std::string& material) {
+    return render(parse_scene_text(R"({"camera": {"position": [0, 4, 0], "look_at": [0, 0, 0], "up": [0, 0, -1], "width": 32, "height": 32},
+      "render": {"spp": 4}, "environment": {"builtin": "sky"},
+      "materials": {"m": {"type": "lut", "file": "gold.exr")" + material + R"(}},
+      "objects": [{"type": "plane", "point": [0, 0, 0], "normal": [0, 1, 0], "size": 2, "material": "m"}]})",
+                                   "s.json", dir.path().string()));
+  };
+  const RenderedImage sharp = image(R"(, "stretch": [0.25, 0.25])"), rough = image(R"(, "stretch": [4, 4])");
+  // Pixel (x, y) sees the plane at world x or -z = (2 (p + 0.5) / 32 - 1) tan(15 deg) 4: compare the pixels
+  // well inside one half (0.1 to 0.9 from the middle line), away from the texture's seams.
+  const auto world = [](int p) { return (2.0 * (p + 0.5) / kSize - 1.0) * std::tan(15.0 * kPi / 180.0) * 4.0; };
+  for (const bool along_u : {true, false}) {
+    const RenderedImage textured = image(R"(, "stretch_texture": ")" + std::string(along_u ? "u.exr" : "v.exr") + "\"");
+    int checked = 0;
+    for (int y = 0; y < kSize; ++y)
+      for (int x = 0; x < kSize; ++x) {
+        // Column x sees world x = world(x), along which u grows; row y sees world z = world(y), against which v grows.
+        const double from_middle = along_u ? world(x) : -world(y);  // > 0: the rough half
+        if (std::abs(from_middle) < 0.1 || std::abs(from_middle) > 0.9) continue;
+        const RenderedImage& want = from_middle > 0.0 ? rough : sharp;
+        const std::size_t k = (std::size_t(y) * kSize + std::size_t(x)) * 4;
+        for (int c = 0; c < 3; ++c)
+          EXPECT_NEAR(textured.rgba[k + std::size_t(c)], want.rgba[k + std::size_t(c)], 1e-5 * (1.0 + want.rgba[k + std::size_t(c)]))
+              << (along_u ? "u" : "v") << " at pixel " << x << ", " << y;
+        ++checked;
+      }
+    EXPECT_GT(checked, 300);
+  }
+}
+
 TEST(Texture, BilinearBetweenPixelCentresWithVFromTheBottomAndBothAxesPeriodic) {
   // 4 x 2: row 0 (top) 0, 1, 2, 3 in red; row 1 (bottom) 10, 11, 12, 13.
   const Texture t(4, 2, {0, 0, 0, 1, 0, 0, 2, 0, 0, 3, 0, 0, 10, 0, 0, 11, 0, 0, 12, 0, 0, 13, 0, 0});
