@@ -52,18 +52,22 @@ std::shared_ptr<const Brdf> load_brdf(const std::string& source, MerlTable::BinP
   fail(source, "unsupported format '" + path.extension().string() + "' (supported: .binary, .bsdf, .bin, builtin:NAME)");
 }
 
-MerlTable load_table(const std::string& source, MerlTable::BinPoint merl_bins) {
-  // A MERL file is read as it is (not through load_brdf, whose shared copy would double the 17 MB).
-  if (!is_builtin(source) && fs::path(source).extension() == ".binary") return MerlTable::read(source, merl_bins);
-  const std::shared_ptr<const Brdf> brdf = load_brdf(source, merl_bins);
+MerlTable table_of(const Brdf& source) {
+  if (const auto* table = dynamic_cast<const MerlTable*>(&source)) return *table;
   // UTIA: anisotropic, tabulated as its azimuthal mean (the isotropic fits see that; fit/extract_2d.h
   // fits the file itself).
-  if (const auto* utia = dynamic_cast<const UtiaBrdf*>(brdf.get())) {
+  if (const auto* utia = dynamic_cast<const UtiaBrdf*>(&source)) {
     MerlTable table = MerlTable::tabulate(utia->azimuthal_mean());
     table.set_source_backscatter(utia->backscatter());
     return table;
   }
-  return MerlTable::tabulate(*brdf);
+  return MerlTable::tabulate(source);
+}
+
+MerlTable load_table(const std::string& source, MerlTable::BinPoint merl_bins) {
+  // A MERL file is read as it is (not through load_brdf, whose shared copy would double the 17 MB).
+  if (!is_builtin(source) && fs::path(source).extension() == ".binary") return MerlTable::read(source, merl_bins);
+  return table_of(*load_brdf(source, merl_bins));
 }
 
 std::vector<std::string> expand_inputs(const std::vector<std::string>& args) {

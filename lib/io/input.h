@@ -25,6 +25,11 @@ MerlTable load_table(const std::string& source, MerlTable::BinPoint merl_bins = 
 // file or the analytic built-in. Throws Error("<source>: <problem>").
 std::shared_ptr<const Brdf> load_brdf(const std::string& source, MerlTable::BinPoint merl_bins = MerlTable::BinPoint::start);
 
+// The MERL-layout table the fits see of a loaded source: a MERL table as it is, a UTIA file as its
+// azimuthal mean with its own back-scattering (MerlTable::source_backscatter), anything else tabulated.
+// load_table(source) is table_of(*load_brdf(source)), without the copy for MERL files.
+MerlTable table_of(const Brdf& source);
+
 // "start" or "center"; nullopt otherwise.
 std::optional<MerlTable::BinPoint> parse_bin_point(const std::string& name);
 const char* to_string(MerlTable::BinPoint at);

@@ -352,10 +352,13 @@ std::shared_ptr<const ShadingModel> load_material(const SceneDesc& scene, const 
     // already made it), or else the paper's fit alone (a proposal needs the lobe's shape, not the
     // refinement's accuracy).
     const std::string source = resolve(scene, m.file);
-    const std::string extension = std::filesystem::path(source).extension().string();
-    const bool rgl = extension == ".bsdf", utia = extension == ".bin";
-    std::shared_ptr<const MerlTable> table;
-    if (!(rgl || utia) || m.proposal.empty()) table = std::make_shared<MerlTable>(load_table(source));
+    // Read once: what is rendered (the file itself for RGL and UTIA, else its table) and what the fit
+    // proposing directions sees (the table).
+    const std::shared_ptr<const Brdf> measurement = load_brdf(source);
+    const auto* rgl = dynamic_cast<const RglBsdf*>(measurement.get());
+    const bool utia = dynamic_cast<const UtiaBrdf*>(measurement.get()) != nullptr;
+    std::shared_ptr<const MerlTable> table = std::dynamic_pointer_cast<const MerlTable>(measurement);
+    if (!table && (!(rgl || utia) || m.proposal.empty())) table = std::make_shared<MerlTable>(table_of(*measurement));
     std::shared_ptr<const TabulatedMicrofacet> proposal;
     if (!m.proposal.empty()) {
       proposal = sampled_lut_model(resolve(scene, m.proposal));
@@ -366,12 +369,12 @@ std::shared_ptr<const ShadingModel> load_material(const SceneDesc& scene, const 
     // RGL files render through their own evaluation (the renderer's o is the viewer's side), not the
     // MERL-layout table: with view slices this is Mitsuba's `measured` (tests/test_mitsuba.cpp).
     if (rgl) {
-      auto brdf = std::make_shared<RglBsdf>(RglBsdf::read(source));
+      auto brdf = std::make_shared<RglBsdf>(*rgl);  // a copy shares the file's tables; the slices are its own
       brdf->set_slices(*parse_slices(m.slices));
       return std::make_shared<ShadingModel>(brdf, proposal);
     }
     // UTIA files too, anisotropic as they are (the table and the proposal's fit see their azimuthal mean).
-    if (utia) return std::make_shared<ShadingModel>(std::make_shared<UtiaBrdf>(UtiaBrdf::read(source)), proposal);
+    if (utia) return std::make_shared<ShadingModel>(measurement, proposal);
     return std::make_shared<ShadingModel>(table, proposal);
   }
   if (m.type == "lut") {
