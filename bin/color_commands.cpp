@@ -72,7 +72,6 @@ std::vector<float> read_all(const std::string& path, OIIO::ImageSpec& spec) {
 Image read_image(const std::string& path) {
   OIIO::ImageSpec spec;
   const std::vector<float> all = read_all(path, spec);
-  const std::array<int, 3> channel = rgb_channels(spec, path, OneChannel::refused);
   const int a = spec.channelindex("A");
   Image image;
   image.width = spec.width;
@@ -80,19 +79,12 @@ Image read_image(const std::string& path) {
   // OIIO reports 8- and 16-bit PNG, JPEG and the like as "sRGB": their values are already display
   // code values and skip the display transform. Everything else (EXR: "Linear") is scene-linear.
   image.display_referred = spec.get_string_attribute("oiio:ColorSpace") == "sRGB";
-  const std::size_t n = image.pixels(), nch = std::size_t(spec.nchannels);
-  image.rgb.resize(3 * n);
-  if (a >= 0) image.alpha.resize(n);
-  for (std::size_t p = 0; p < n; ++p) {
-    for (int c = 0; c < 3; ++c) {
-      const float v = all[p * nch + std::size_t(channel[std::size_t(c)])];
-      // A NaN or infinite pixel has no colour difference: refused, not averaged into a score.
-      if (!std::isfinite(v))
-        fail(path, std::string("non-finite ") + "RGB"[c] + " value at pixel (" + std::to_string(p % std::size_t(spec.width)) + ", " +
-                       std::to_string(p / std::size_t(spec.width)) + ")");
-      image.rgb[3 * p + c] = v;
-    }
-    if (a >= 0) image.alpha[p] = all[p * nch + std::size_t(a)];
+  // A NaN or infinite pixel has no colour difference: refused, not averaged into a score.
+  image.rgb = rgb_of(all, spec, path, OneChannel::refused);
+  if (a >= 0) {
+    const std::size_t n = image.pixels(), nch = std::size_t(spec.nchannels);
+    image.alpha.resize(n);
+    for (std::size_t p = 0; p < n; ++p) image.alpha[p] = all[p * nch + std::size_t(a)];
   }
   return image;
 }

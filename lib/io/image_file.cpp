@@ -182,10 +182,8 @@ std::vector<float> read_pixels(OIIO::ImageInput& in, const std::string& path) {
   return all;
 }
 
-std::vector<float> read_rgb(OIIO::ImageInput& in, const std::string& path, OneChannel one_channel) {
-  const OIIO::ImageSpec& spec = in.spec();
+std::vector<float> rgb_of(const std::vector<float>& all, const OIIO::ImageSpec& spec, const std::string& path, OneChannel one_channel) {
   const std::array<int, 3> channel = rgb_channels(spec, path, one_channel);
-  const std::vector<float> all = read_pixels(in, path);
   const std::size_t pixels = std::size_t(spec.width) * std::size_t(spec.height), n = std::size_t(spec.nchannels);
   std::vector<float> rgb(pixels * 3);
   for (std::size_t p = 0; p < pixels; ++p)
@@ -197,6 +195,10 @@ std::vector<float> read_rgb(OIIO::ImageInput& in, const std::string& path, OneCh
       rgb[p * 3 + c] = v;
     }
   return rgb;
+}
+
+std::vector<float> read_rgb(OIIO::ImageInput& in, const std::string& path, OneChannel one_channel) {
+  return rgb_of(read_pixels(in, path), in.spec(), path, one_channel);
 }
 
 void write_image_atomic(const std::string& path, const OIIO::ImageSpec& spec, const void* pixels) {

@@ -25,7 +25,10 @@ std::array<int, 3> rgb_channels(const OIIO::ImageSpec& spec, const std::string& 
 // Error("<path>: ...") for a deep, volume or empty image and for a failed read.
 std::vector<float> read_pixels(OIIO::ImageInput& in, const std::string& path);
 
-// Its R, G and B (rgb_channels) as interleaved floats; a NaN or infinite value is refused, naming the pixel.
+// The R, G and B (rgb_channels) of `pixels`, read_pixels of an image with `spec`, as interleaved floats; a
+// NaN or infinite value is refused, naming the pixel.
+std::vector<float> rgb_of(const std::vector<float>& pixels, const OIIO::ImageSpec& spec, const std::string& path, OneChannel one_channel);
+// rgb_of(read_pixels(in, path), ...).
 std::vector<float> read_rgb(OIIO::ImageInput& in, const std::string& path, OneChannel one_channel);
 
 // Writes `pixels` (spec.format, interleaved as spec says) to `path` through an AtomicFile; the format

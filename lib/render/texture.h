@@ -27,8 +27,8 @@ class Texture {
 
   Rgb lookup(TextureCoordinates at) const;
   int width() const { return width_; }
-  std::uint64_t bytes() const { return rgb_.size() * sizeof(float); }
   int height() const { return height_; }
+  std::uint64_t bytes() const { return rgb_.size() * sizeof(float); }
 
  private:
   int width_ = 0, height_ = 0;
