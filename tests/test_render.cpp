@@ -2,11 +2,12 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-
 #include <functional>
 #include <iostream>
 
+#include "fit/fit.h"
 #include "io/image_file.h"
+#include "io/input.h"
 #include "io/utia.h"
 #include "lut/lut.h"
 #include "model/analytic.h"
@@ -17,6 +18,23 @@
 
 namespace facetfit {
 namespace {
+
+// The paper's fit of the built-in gold GGX 0.15, baked with sampling tables.
+void write_gold_lut(const std::string& path) {
+  const Fitter fitter{FitOptions::paper()};
+  write_lut(path, make_lut(fitter.fit(load_table("builtin:gold-ggx-0.15")), fitter.quadrature(), "builtin:gold-ggx-0.15", "x", 0.02, true));
+}
+
+// A float RGB image of `width` x `height` with value(x, y) at pixel (x, y), row 0 at the top.
+void write_texture(const std::string& path, int width, int height, const std::function<Rgb(int, int)>& value) {
+  std::vector<float> px;
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) {
+      const Rgb v = value(x, y);
+      px.insert(px.end(), {float(v.r), float(v.g), float(v.b)});
+    }
+  write_image_atomic(path, OIIO::ImageSpec(width, height, 3, OIIO::TypeDesc::FLOAT), px.data());
+}
 
 // A sphere of `m` filling most of a small image, under a uniform environment of radiance 1.
 SceneDesc furnace(const MaterialDesc& m, int spp = 64) {
@@ -247,9 +265,7 @@ TEST(Render, MeasuredMaterialSampledByAGivenLutRendersTheSameImage) {
   // A measured material sampled by a bake's LUT (the report hands its bake over rather than fitting
   // again) still renders the measurement: the same bar against the analytic model.
   test::TempDir dir;
-  const Fitter fitter{FitOptions::paper()};
-  write_lut(dir.file("gold.exr"),
-            make_lut(fitter.fit(load_table("builtin:gold-ggx-0.15")), fitter.quadrature(), "builtin:gold-ggx-0.15", "x", 0.02, true));
+  write_gold_lut(dir.file("gold.exr"));
   MaterialDesc measured;
   measured.type = "measured";
   measured.file = "builtin:gold-ggx-0.15";
@@ -267,9 +283,7 @@ TEST(Render, StretchedLutMaterials) {
   // anisotropic GGX): the identity renders the LUT as it is, a stretch changes the image, and bad values
   // get one line.
   test::TempDir dir;
-  const Fitter fitter{FitOptions::paper()};
-  write_lut(dir.file("gold.exr"),
-            make_lut(fitter.fit(load_table("builtin:gold-ggx-0.15")), fitter.quadrature(), "builtin:gold-ggx-0.15", "x", 0.02, true));
+  write_gold_lut(dir.file("gold.exr"));
   const auto scene = [&](const std::string& extra) {
     SceneDesc s = parse_scene_text(R"({"camera": {"width": 32, "height": 32}, "render": {"spp": 8},
       "environment": {"builtin": "sky"},
@@ -295,21 +309,10 @@ TEST(Render, StretchTextureDrivesTheStretchPerPoint) {
   // A uniform texture (2, 0.5) times a stretch (1.5, 1) is the stretch (3, 0.5) everywhere: the same image,
   // sample for sample. A texture that varies changes the image where it departs from that value.
   test::TempDir dir;
-  const Fitter fitter{FitOptions::paper()};
-  write_lut(dir.file("gold.exr"),
-            make_lut(fitter.fit(load_table("builtin:gold-ggx-0.15")), fitter.quadrature(), "builtin:gold-ggx-0.15", "x", 0.02, true));
-  const auto write_texture = [&](const std::string& name, int w, int h, const std::function<Rgb(int, int)>& value) {
-    std::vector<float> px;
-    for (int y = 0; y < h; ++y)
-      for (int x = 0; x < w; ++x) {
-        const Rgb v = value(x, y);
-        px.insert(px.end(), {float(v.r), float(v.g), float(v.b)});
-      }
-    write_image_atomic(dir.file(name), OIIO::ImageSpec(w, h, 3, OIIO::TypeDesc::FLOAT), px.data());
-  };
-  write_texture("uniform.exr", 4, 2, [](int, int) { return Rgb(2.0, 0.5, 7.0); });
+  write_gold_lut(dir.file("gold.exr"));
+  write_texture(dir.file("uniform.exr"), 4, 2, [](int, int) { return Rgb(2.0, 0.5, 7.0); });
   // The bottom row as the top: v is periodic, so the top pole reads both.
-  write_texture("bands.exr", 16, 8, [](int, int y) { return y < 4 || y == 7 ? Rgb(2.0, 0.5, 0.0) : Rgb(0.5, 2.0, 0.0); });
+  write_texture(dir.file("bands.exr"), 16, 8, [](int, int y) { return y < 4 || y == 7 ? Rgb(2.0, 0.5, 0.0) : Rgb(0.5, 2.0, 0.0); });
   const auto scene = [&](const std::string& material, const std::string& object) {
     return parse_scene_text(R"({"camera": {"width": 32, "height": 32}, "render": {"spp": 8},
       "environment": {"builtin": "sky"},
@@ -342,7 +345,7 @@ TEST(Render, StretchTextureDrivesTheStretchPerPoint) {
   EXPECT_GT(covered, 20);
   EXPECT_EQ(same, covered);
   EXPECT_NE(test::error_of([&] { render(scene(R"(, "stretch_texture": "missing.exr")", sphere)); }).find("missing.exr"), std::string::npos);
-  write_texture("nan.exr", 2, 2, [](int x, int y) { return x == 1 && y == 1 ? Rgb(1.0, std::nan(""), 1.0) : Rgb(1.0); });
+  write_texture(dir.file("nan.exr"), 2, 2, [](int x, int y) { return x == 1 && y == 1 ? Rgb(1.0, std::nan(""), 1.0) : Rgb(1.0); });
   EXPECT_NE(test::error_of([&] { render(scene(R"(, "stretch_texture": "nan.exr")", sphere)); }).find("nan.exr: non-finite G value at pixel (1, 1)"),
             std::string::npos);
   EXPECT_NE(test::error_of([&] { scene(R"(, "stretch_texture": "uniform.exr")", R"({"type": "mesh", "file": "x.obj", "material": "m"})"); })
@@ -380,20 +383,14 @@ TEST(Render, MeasuredUtiaFilesRenderAnisotropicAlongTheirTangent) {
 // the uniform stretch of that half does.
 TEST(Render, PlaneTextureAxesAreAsDocumented) {
   test::TempDir dir;
-  const Fitter fitter{FitOptions::paper()};
-  write_lut(dir.file("gold.exr"),
-            make_lut(fitter.fit(load_table("builtin:gold-ggx-0.15")), fitter.quadrature(), "builtin:gold-ggx-0.15", "x", 0.02, true));
+  write_gold_lut(dir.file("gold.exr"));
   constexpr int kTexels = 64;
   const auto write_halves = [&](const std::string& name, bool along_u) {
-    std::vector<float> px;
-    for (int y = 0; y < kTexels; ++y)
-      for (int x = 0; x < kTexels; ++x) {
-        // u >= 1/2 (right columns), or v >= 1/2 (top rows): the rough half.
-        const bool rough = along_u ? x >= kTexels / 2 : y < kTexels / 2;
-        const float s = rough ? 4.0f : 0.25f;
-        px.insert(px.end(), {s, s, 0.0f});
-      }
-    write_image_atomic(dir.file(name), OIIO::ImageSpec(kTexels, kTexels, 3, OIIO::TypeDesc::FLOAT), px.data());
+    write_texture(dir.file(name), kTexels, kTexels, [&](int x, int y) {
+      // u >= 1/2 (right columns), or v >= 1/2 (top rows): the rough half.
+      const bool rough = along_u ? x >= kTexels / 2 : y < kTexels / 2;
+      return rough ? Rgb(4.0, 4.0, 0.0) : Rgb(0.25, 0.25, 0.0);
+    });
   };
   write_halves("u.exr", true);
   write_halves("v.exr", false);

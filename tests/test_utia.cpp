@@ -94,9 +94,8 @@ TEST(Utia, AzimuthalMeanIsTheMeanOverTurnsByTheFilesStep) {
     const Vec3 o = test::random_direction(rng), i = test::random_direction(rng);
     Rgb want(0.0);
     for (int t = 0; t < UtiaBrdf::kPhi; ++t) {
-      const double a = t * UtiaBrdf::kPhiStep * kPi / 180.0, c = std::cos(a), s = std::sin(a);
-      const auto turn = [&](const Vec3& w) { return Vec3(c * w.x - s * w.y, s * w.x + c * w.y, w.z); };
-      want += *file.eval(turn(o), turn(i)) / double(UtiaBrdf::kPhi);
+      // Both directions turned by t steps (RotatedBrdf turns them by minus its angle).
+      want += *RotatedBrdf(file, -t * UtiaBrdf::kPhiStep * kPi / 180.0).eval(o, i) / double(UtiaBrdf::kPhi);
     }
     const Rgb got = *mean.eval(o, i);
     for (int c = 0; c < 3; ++c) EXPECT_NEAR(got[c], want[c], 1e-9 * std::max(1.0, std::abs(want[c])));
