@@ -112,7 +112,7 @@ void anisotropic_section(std::ostringstream& md, const std::string& scratch) {
   };
   const Quadrature2D dense(90, 64), utia(90, 48);
   for (const AnisotropicCase& c : dense_anisotropic_cases()) row("dense", c, measure_anisotropic(c, dense));
-  for (const AnisotropicCase& c : utia_anisotropic_cases()) row("UTIA", c, measure_anisotropic(c, utia, scratch));
+  for (const AnisotropicCase& c : utia_anisotropic_cases()) row("UTIA", c, measure_anisotropic(c, utia, AnisotropicInput::utia, scratch));
   md << "\n";
 }
 

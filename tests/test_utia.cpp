@@ -75,7 +75,7 @@ class UtiaGroundTruth : public ::testing::TestWithParam<AnisotropicCase> {};
 TEST_P(UtiaGroundTruth, AlphasComeBackThroughTheFile) {
   test::TempDir dir;
   const Quadrature2D quad(90, 48);
-  const AnisotropicError e = measure_anisotropic(GetParam(), quad, dir.file("m.bin"));
+  const AnisotropicError e = measure_anisotropic(GetParam(), quad, AnisotropicInput::utia, dir.file("m.bin"));
   ASSERT_TRUE(e.problem.empty()) << e.problem;
   EXPECT_LT(std::abs(e.alpha_x_relative), 0.03);
   EXPECT_LT(std::abs(e.alpha_y_relative), 0.03);

@@ -299,25 +299,42 @@ struct GaussRule {
   GaussRule() { gauss_legendre(5, x, w); }
 };
 
-// Linear blend of two theta_i slices, as Mitsuba's conditioned Marginal2D interpolates every table
-// (density and CDFs alike) between the bracketing parameter values; clamped outside them.
+// Position of a parameter value among its nodes: nodes k and k + 1 and the weight of k + 1, clamped
+// outside them (a single node: weight 0).
+Segment node_segment(const std::vector<double>& nodes, double v) {
+  if (nodes.size() == 1) return {0, 0.0};
+  const auto it = std::upper_bound(nodes.begin(), nodes.end(), v);
+  const std::size_t above = static_cast<std::size_t>(it - nodes.begin());
+  const std::size_t k = std::min(above == 0 ? 0 : above - 1, nodes.size() - 2);
+  return {k, clamp((v - nodes[k]) / (nodes[k + 1] - nodes[k]), 0.0, 1.0)};
+}
+
+// Bilinear blend of the slices at the parameters (phi_i, theta_i), as Mitsuba's conditioned Marginal2D
+// interpolates every table (density and CDFs alike) between the bracketing parameter values; slices are
+// stored phi_i-major. Up to four slices; one or two for the isotropic files of the database.
 struct SliceBlend {
-  std::size_t s0 = 0, s1 = 0;
-  double w1 = 0.0;
+  std::array<std::size_t, 4> slice{};
+  std::array<double, 4> weight{};
+  int n = 0;
 
   double operator()(const double* table, std::size_t slice_size, std::size_t index) const {
-    const double a = table[s0 * slice_size + index];
-    return w1 == 0.0 ? a : a + w1 * (table[s1 * slice_size + index] - a);
+    double v = 0.0;
+    for (int k = 0; k < n; ++k) v += weight[std::size_t(k)] * table[slice[std::size_t(k)] * slice_size + index];
+    return v;
   }
 };
 
-SliceBlend blend_for(const std::vector<double>& nodes, double theta) {
-  if (nodes.size() == 1) return {};
-  const auto it = std::upper_bound(nodes.begin(), nodes.end(), theta);
-  const std::size_t above = static_cast<std::size_t>(it - nodes.begin());
-  const std::size_t k = std::min(above == 0 ? 0 : above - 1, nodes.size() - 2);
-  const double t = clamp((theta - nodes[k]) / (nodes[k + 1] - nodes[k]), 0.0, 1.0);
-  return {k, k + 1, t};
+SliceBlend blend_for(const std::vector<double>& phi_nodes, double phi, const std::vector<double>& theta_nodes, double theta) {
+  const Segment p = node_segment(phi_nodes, phi), t = node_segment(theta_nodes, theta);
+  SliceBlend b;
+  for (int a = 0; a < 2; ++a)
+    for (int c = 0; c < 2; ++c) {
+      const double w = (a ? p.t : 1.0 - p.t) * (c ? t.t : 1.0 - t.t);
+      if (w == 0.0) continue;
+      b.slice[std::size_t(b.n)] = (p.k + std::size_t(a)) * theta_nodes.size() + t.k + std::size_t(c);
+      b.weight[std::size_t(b.n++)] = w;
+    }
+  return b;
 }
 
 // Builds the CDFs of one slice of bilinear density (in units of grid patches) and normalizes all
@@ -348,6 +365,13 @@ struct RglBsdf::Tables {
   std::string description;
   bool jacobian = true;
   std::vector<double> theta_i;  // incident elevations of the slices, strictly increasing
+  std::vector<double> phi_i;    // incident azimuths of the slices, strictly increasing
+  // Mitsuba's reading of phi_i: more than two entries make the file anisotropic, its half-vector
+  // azimuth absolute rather than measured from the slice direction's plane. phi_i spanning 2 pi / r
+  // declares a symmetry: r = 2 a half turn about the normal, r = 4 mirrors about both axes; both
+  // directions are carried into the span (by that turn or those mirrors) before the lookup.
+  bool isotropic = true;
+  int reduction = 1;
 
   Grid ndf;    // D over (u_theta, u_phi) of the half vector
   Grid sigma;  // projected microfacet area over (u_theta, u_phi) of i
@@ -405,12 +429,23 @@ RglBsdf RglBsdf::read(const std::string& path) {
   const FieldSet in(path, bytes, parse_header(path, bytes));
   auto t = std::make_shared<Tables>();
 
-  // Anisotropy first: such files are otherwise well formed, and deserve the specific message.
   const Field& phi_i = in.get("phi_i", kFloat32, 1);
   in.check(phi_i.count >= 1, "field 'phi_i' is empty");
-  in.check(phi_i.count == 1, "anisotropic RGL files are not supported yet (phi_i has " + std::to_string(phi_i.count) +
-                                 " entries; isotropic files have 1)");
-  in.floats("phi_i", phi_i);
+  t->phi_i = in.floats("phi_i", phi_i);
+  for (std::size_t k = 0; k < t->phi_i.size(); ++k) {
+    const double v = t->phi_i[k];
+    in.check(std::abs(v) <= kPi + 1e-4, "field 'phi_i' has " + std::to_string(v) + " at element " + std::to_string(k) +
+                                            ", outside [-pi, pi]");
+    in.check(k == 0 || v > t->phi_i[k - 1], "field 'phi_i' is not strictly increasing at element " + std::to_string(k));
+  }
+  t->isotropic = t->phi_i.size() <= 2;
+  if (!t->isotropic) {
+    const double span = t->phi_i.back() - t->phi_i.front();
+    t->reduction = int(std::lround(2.0 * kPi / span));
+    in.check(t->reduction == 1 || t->reduction == 2 || t->reduction == 4,
+             "field 'phi_i' spans " + std::to_string(span) + " radians; an anisotropic file spans 2 pi, pi or pi/2");
+  }
+  const std::uint64_t n_phi = phi_i.count;
 
   const Field& desc = in.get("description", kUInt8, 1);
   t->description.assign(reinterpret_cast<const char*>(in.data(desc)), desc.count);
@@ -444,28 +479,29 @@ RglBsdf RglBsdf::read(const std::string& path) {
   read_grid("sigma", t->sigma, true);  // eval divides by it
 
   const Field& vndf = in.get("vndf", kFloat32, 4);
-  in.check(vndf.shape[0] == 1 && vndf.shape[1] == n_theta && vndf.shape[2] >= 2 && vndf.shape[3] >= 2,
-           "field 'vndf' has shape " + dims(vndf) + ", expected 1 x " + std::to_string(n_theta) +
-               " (theta_i) x rows x columns, at least 2 x 2");
+  const std::string params = std::to_string(n_phi) + " (phi_i) x " + std::to_string(n_theta) + " (theta_i)";
+  in.check(vndf.shape[0] == n_phi && vndf.shape[1] == n_theta && vndf.shape[2] >= 2 && vndf.shape[3] >= 2,
+           "field 'vndf' has shape " + dims(vndf) + ", expected " + params + " x rows x columns, at least 2 x 2");
   t->vy = static_cast<std::size_t>(vndf.shape[2]);
   t->vx = static_cast<std::size_t>(vndf.shape[3]);
   t->vndf_pdf = in.floats("vndf", vndf);
   for (std::size_t k = 0; k < t->vndf_pdf.size(); ++k)
     if (t->vndf_pdf[k] < 0.0) fail(path, "field 'vndf' has a negative density at element " + std::to_string(k));
   t->vndf_cond.resize(t->vndf_pdf.size());
-  t->vndf_marg.resize(static_cast<std::size_t>(n_theta) * t->vy);
-  for (std::size_t s = 0; s < n_theta; ++s) {
+  const std::size_t slices = static_cast<std::size_t>(n_phi * n_theta);
+  t->vndf_marg.resize(slices * t->vy);
+  for (std::size_t s = 0; s < slices; ++s) {
     const std::size_t slice = t->vx * t->vy;
     const double total = build_warp_slice(t->vndf_pdf.data() + s * slice, t->vndf_cond.data() + s * slice,
                                           t->vndf_marg.data() + s * t->vy, t->vx, t->vy);
     in.check(total > 0.0 && std::isfinite(total),
-             "field 'vndf' slice " + std::to_string(s) + " (theta_i " + std::to_string(t->theta_i[s]) + ") has no mass");
+             "field 'vndf' slice " + std::to_string(s) + " (phi_i " + std::to_string(t->phi_i[s / n_theta]) + ", theta_i " +
+                 std::to_string(t->theta_i[s % n_theta]) + ") has no mass");
   }
 
   const Field& rgb = in.get("rgb", kFloat32, 5);
-  in.check(rgb.shape[0] == 1 && rgb.shape[1] == n_theta && rgb.shape[2] == 3 && rgb.shape[3] >= 2 && rgb.shape[4] >= 2,
-           "field 'rgb' has shape " + dims(rgb) + ", expected 1 x " + std::to_string(n_theta) +
-               " (theta_i) x 3 x rows x columns, at least 2 x 2");
+  in.check(rgb.shape[0] == n_phi && rgb.shape[1] == n_theta && rgb.shape[2] == 3 && rgb.shape[3] >= 2 && rgb.shape[4] >= 2,
+           "field 'rgb' has shape " + dims(rgb) + ", expected " + params + " x 3 x rows x columns, at least 2 x 2");
   t->ry = static_cast<std::size_t>(rgb.shape[3]);
   t->rx = static_cast<std::size_t>(rgb.shape[4]);
   t->rgb = in.floats("rgb", rgb);  // negative values (noise, out-of-gamut colour) are kept
@@ -474,9 +510,9 @@ RglBsdf RglBsdf::read(const std::string& path) {
   // RGB table is inconsistent.
   if (in.has("luminance")) {
     const Field& lum = in.get("luminance", kFloat32, 4);
-    in.check(lum.shape[0] == 1 && lum.shape[1] == n_theta && lum.shape[2] == rgb.shape[3] && lum.shape[3] == rgb.shape[4],
-             "field 'luminance' has shape " + dims(lum) + ", expected 1 x " + std::to_string(n_theta) + " x " +
-                 std::to_string(rgb.shape[3]) + " x " + std::to_string(rgb.shape[4]) + " to match 'rgb'");
+    in.check(lum.shape[0] == n_phi && lum.shape[1] == n_theta && lum.shape[2] == rgb.shape[3] && lum.shape[3] == rgb.shape[4],
+             "field 'luminance' has shape " + dims(lum) + ", expected " + params + " x " + std::to_string(rgb.shape[3]) +
+                 " x " + std::to_string(rgb.shape[4]) + " to match 'rgb'");
   }
 
   const Field& jac = in.get("jacobian", kUInt8, 1);
@@ -517,6 +553,22 @@ double RglBsdf::measured_sigma(double theta) const {
 }
 
 const std::vector<double>& RglBsdf::slice_elevations() const { return t_->theta_i; }
+bool RglBsdf::anisotropic() const { return !t_->isotropic; }
+
+BackscatterLattice RglBsdf::backscatter(int thetas, int azimuths) const {
+  BackscatterLattice lattice;
+  lattice.azimuths = azimuths;
+  for (int p = 0; p < thetas; ++p) {
+    // Nodes at the middle of equal steps below 89.5 degrees: the table has no slice at the horizon.
+    const double theta = (double(p) + 0.5) / double(thetas) * (89.5 * kPi / 180.0);
+    lattice.theta.push_back(theta);
+    for (int k = 0; k < azimuths; ++k) {
+      const Vec3 d = spherical_direction(theta, 2.0 * kPi * double(k) / double(azimuths));
+      lattice.value.push_back(*eval(d, d));  // both one-sided estimates coincide at k = k
+    }
+  }
+  return lattice;
+}
 
 RglBsdf::Consistency RglBsdf::self_consistency() const {
   const Tables& t = *t_;
@@ -548,17 +600,20 @@ RglBsdf::Consistency RglBsdf::self_consistency() const {
   // The VNDF of slice theta_i over (u_theta, u_phi) of the half vector m, phi measured from the
   // slice's plane: D(m) max(0, i.m) / sigma(i) d(omega)/d(u) with d(omega) = 2 pi^2 u_theta sin(theta_m) du.
   // Constant factors cancel in the normalization, so the model is D(m) max(0, i.m) u_theta sin(theta_m).
+  // Anisotropic files: the azimuths absolute, i at the slice's phi_i, D read off the whole table.
   const std::size_t slice = t.vx * t.vy;
   std::vector<double> model(slice);
-  for (std::size_t s = 0; s < t.theta_i.size(); ++s) {
-    const Vec3 i = spherical_direction(t.theta_i[s], 0.0);
+  for (std::size_t s = 0; s < t.phi_i.size() * t.theta_i.size(); ++s) {
+    const std::size_t n_theta = t.theta_i.size();
+    const Vec3 i = spherical_direction(t.theta_i[s % n_theta], t.isotropic ? 0.0 : t.phi_i[s / n_theta]);
     double model_total = 0.0, table_total = 0.0;
     for (std::size_t y = 0; y < t.vy; ++y)
       for (std::size_t x = 0; x < t.vx; ++x) {
         const double u0 = double(x) / double(t.vx - 1), u1 = double(y) / double(t.vy - 1);
         const double theta_m = 0.5 * kPi * u0 * u0;
         const Vec3 m = spherical_direction(theta_m, (2.0 * u1 - 1.0) * kPi);
-        const double v = lerp_nodes(t.ndf_iso, u0) * std::max(0.0, glm::dot(i, m)) * u0 * std::sin(theta_m);
+        const double d = t.isotropic ? lerp_nodes(t.ndf_iso, u0) : bilinear(t.ndf, u0, u1);
+        const double v = d * std::max(0.0, glm::dot(i, m)) * u0 * std::sin(theta_m);
         model[y * t.vx + x] = v;
         model_total += v;
         table_total += t.vndf_pdf[s * slice + y * t.vx + x];
@@ -575,28 +630,36 @@ RglBsdf::Consistency RglBsdf::self_consistency() const {
   return c;
 }
 
-Rgb RglBsdf::table_value(const Vec3& p, const Vec3& q) const {
+Rgb RglBsdf::table_value(const Vec3& p_in, const Vec3& q_in) const {
   const Tables& t = *t_;
+  Vec3 p = p_in, q = q_in;
+  if (t.reduction >= 2) {
+    // Into the span of phi_i, as Mitsuba does: p to y <= 0 (r = 4: and x <= 0), q moved alike. For
+    // r = 2 both axes follow the sign of p.y, a half turn.
+    const auto into_span = [](double& a, double& b, double sign_of) {
+      if (!std::signbit(sign_of)) a = -a, b = -b;
+    };
+    const double sy = p.y, sx = t.reduction == 4 ? p.x : sy;
+    into_span(p.x, q.x, sx);
+    into_span(p.y, q.y, sy);
+  }
   const Vec3 h = glm::normalize(p + q);
   const double theta_p = elevation(p), phi_p = std::atan2(p.y, p.x);
   const double theta_h = elevation(h), phi_h = std::atan2(h.y, h.x);
   // Isotropic tables measure the half vector's azimuth from the plane of the slice direction.
-  double u_h1 = (phi_h - phi_p + kPi) / (2.0 * kPi);
+  double u_h1 = (phi_h - (t.isotropic ? phi_p : 0.0) + kPi) / (2.0 * kPi);
   u_h1 -= std::floor(u_h1);
   const double u_h0 = theta_to_u(theta_h);
 
-  const SliceBlend b = blend_for(t.theta_i, theta_p);
+  const SliceBlend b = blend_for(t.phi_i, phi_p, t.theta_i, theta_p);
   const std::array<double, 2> s = t.invert_vndf(b, u_h0, u_h1);
 
-  Rgb v;
+  Rgb v(0.0);
   const std::size_t plane = t.rx * t.ry;
-  for (int c = 0; c < 3; ++c) {
-    const auto at = [&](std::size_t slice) {
-      return bilinear(t.rgb.data() + (slice * 3 + std::size_t(c)) * plane, t.rx, t.ry, s[0], s[1]);
-    };
-    const double a = at(b.s0);
-    v[c] = b.w1 == 0.0 ? a : a + b.w1 * (at(b.s1) - a);  // negative entries kept, as Mitsuba does
-  }
+  for (int k = 0; k < b.n; ++k)  // negative entries kept, as Mitsuba does
+    for (int c = 0; c < 3; ++c)
+      v[c] += b.weight[std::size_t(k)] *
+              bilinear(t.rgb.data() + (b.slice[std::size_t(k)] * 3 + std::size_t(c)) * plane, t.rx, t.ry, s[0], s[1]);
   if (!t.jacobian) return v;
   const double u_p1 = (phi_p + kPi) / (2.0 * kPi);
   return v * (bilinear(t.ndf, u_h0, u_h1) / (4.0 * bilinear(t.sigma, theta_to_u(theta_p), u_p1)));

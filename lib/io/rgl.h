@@ -20,7 +20,10 @@
 // `rgb` table, however, does not reproduce `ndf` through the 2015 power iteration (docs/accuracy.md):
 // the acquisition measured `ndf` separately, and the files do not say how.
 //
-// Only isotropic files (phi_i with a single entry) are supported. Negative RGB values (measurement
+// Anisotropic files (phi_i with more than two entries, Mitsuba's test) hold slices over (phi_i, theta_i),
+// blended bilinearly between the bracketing ones, and measure the half vector's azimuth absolutely; a
+// phi_i span of pi or pi/2 declares a half-turn or two-mirror symmetry, and directions are carried
+// into the span first, as Mitsuba does. Negative RGB values (measurement
 // noise around zero, out-of-gamut colour of the converted spectra) are kept, as Mitsuba's `measured`
 // does: clipping them biases dark channels upward (docs/conventions.md).
 #pragma once
@@ -30,13 +33,14 @@
 #include <vector>
 
 #include "core/brdf.h"
+#include "io/backscatter_lattice.h"
 
 namespace facetfit {
 
 class RglBsdf final : public Brdf {
  public:
-  // Throws Error("<path>: <problem>") for anything that is not a complete, consistent, finite,
-  // isotropic RGB tensor file. Every size in the header is checked before it is trusted.
+  // Throws Error("<path>: <problem>") for anything that is not a complete, consistent, finite RGB
+  // tensor file. Every size in the header is checked before it is trusted.
   static RglBsdf read(const std::string& path);
 
   // Which direction picks the theta_i slices. A one-sided estimate divides T by a cosine that
@@ -75,6 +79,12 @@ class RglBsdf final : public Brdf {
   // The incident elevations theta_i of the file's slices, increasing. Only at these angles does the
   // RGB table hold a measurement of a given configuration; in between, eval blends two slices.
   const std::vector<double>& slice_elevations() const;
+  // Whether the file is anisotropic (its slices span incident azimuths too).
+  bool anisotropic() const;
+
+  // Back-scattering f(k, k) on `thetas` polar angles, at the middle of equal steps up to 89.5 degrees,
+  // times `azimuths` azimuths: what an anisotropic fit reads (fit/extract_2d.h).
+  BackscatterLattice backscatter(int thetas, int azimuths) const;
 
   // How well the file's tables agree with each other under this reader's parameterization (the
   // theta -> u = sqrt(theta / (pi/2)) and phi -> (phi - phi_i + pi) / 2pi maps, node-centred grids,

@@ -1,10 +1,13 @@
 #include "support/ground_truth.h"
 
 #include <cmath>
+#include <fstream>
 
 #include "fit/roughness.h"
+#include "io/rgl.h"
 #include "io/utia.h"
 #include "model/analytic.h"
+#include "support/tensor_file.h"
 
 namespace facetfit {
 
@@ -55,17 +58,25 @@ std::vector<AnisotropicCase> utia_anisotropic_cases() {
           {NdfType::beckmann, 0.5, 0.25, 30.0}, {NdfType::beckmann, 0.3, 0.2, -20.0}};
 }
 
-AnisotropicError measure_anisotropic(const AnisotropicCase& c, const Quadrature2D& quad, const std::string& utia_path) {
+AnisotropicError measure_anisotropic(const AnisotropicCase& c, const Quadrature2D& quad, AnisotropicInput input,
+                                     const std::string& path) {
   const Ndf ndf{c.type, c.alpha_x, c.alpha_y};
   const MicrofacetBrdf brdf(ndf, c.smith, Fresnel::one());
   const double angle = c.angle_degrees * kPi / 180.0;
   const RotatedBrdf turned(brdf, angle);
   Backscatter2D back;
-  if (utia_path.empty()) {
-    back = backscatter_2d(turned, quad);
-  } else {
-    UtiaBrdf::tabulate(turned).write(utia_path);
-    back = backscatter_2d(UtiaBrdf::read(utia_path).backscatter(), quad);
+  switch (input) {
+    case AnisotropicInput::dense: back = backscatter_2d(turned, quad); break;
+    case AnisotropicInput::utia:
+      UtiaBrdf::tabulate(turned).write(path);
+      back = backscatter_2d(UtiaBrdf::read(path).backscatter(), quad);
+      break;
+    case AnisotropicInput::rgl: {
+      const std::vector<unsigned char> bytes = test::serialize(test::microfacet_tensor_fields(ndf, c.smith, angle, 25, 32, 64));
+      std::ofstream(path, std::ios::binary).write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
+      back = backscatter_2d(RglBsdf::read(path).backscatter(90, quad.phi_count()), quad);
+      break;
+    }
   }
   const Extraction2D x = extract_ndf_2d(back, quad, {c.smith, 1e-10, 1000});
   AnisotropicError e;

@@ -75,8 +75,13 @@ struct AnisotropicError {
 std::vector<AnisotropicCase> dense_anisotropic_cases();
 std::vector<AnisotropicCase> utia_anisotropic_cases();
 
-// Through the analytic back-scattering at MERL's theta_h bins, or, with `utia_path`, through a UTIA file
-// written by facetfit's writer and read back (six polar angles).
-AnisotropicError measure_anisotropic(const AnisotropicCase& c, const Quadrature2D& quadrature, const std::string& utia_path = "");
+// Where the back-scattering comes from: the analytic model at MERL's theta_h bins; a UTIA file written by
+// facetfit's writer and read back (six polar angles); an RGL tensor file written by the tests' writer
+// (support/tensor_file.h: 25 x 16 slices) and read back through its evaluation on 90 polar angles.
+enum class AnisotropicInput { dense, utia, rgl };
+
+// The files go to `path` (UTIA and RGL inputs).
+AnisotropicError measure_anisotropic(const AnisotropicCase& c, const Quadrature2D& quadrature,
+                                     AnisotropicInput input = AnisotropicInput::dense, const std::string& path = "");
 
 }  // namespace facetfit
