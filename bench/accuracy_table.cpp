@@ -102,7 +102,11 @@ void anisotropic_section(std::ostringstream& md, const std::string& scratch) {
         "alphas, angle and D (projected-area weighted relative L1 at the grid's nodes) from the back-scattering. Dense: "
         "the analytic back-scattering at MERL's 90 theta_h bins on a 90 x 64 grid, bars 1% and 0.5 degree "
         "(tests/test_extract_2d.cpp). UTIA: written by facetfit's UTIA writer and read back, six polar angles 15 degrees "
-        "apart, masking form, 90 x 48 grid, bar 3% for alpha >= 0.2 (tests/test_utia.cpp).\n\n"
+        "apart, masking form, 90 x 48 grid, bar 3% for alpha >= 0.2 (tests/test_utia.cpp). RGL: the dense cases written "
+        "as an anisotropic RGL tensor file by the tests' writer (tests/support/tensor_file.h: 25 x 32 slices, 64 x 64 RGB "
+        "nodes, identity warp) and read back through the file's evaluation at 90 polar angles x 64 azimuths "
+        "(tests/test_rgl.cpp: bar 1% for Beckmann, 4% for GGX, whose long tail weighs the file's grazing "
+        "back-scattering, 2-5% low beyond 70 degrees at this resolution).\n\n"
         "| input | NDF | smith | alpha_x, alpha_y, angle | fitted | alpha_x error | alpha_y error | angle error | D L1 |\n"
         "|---|---|---|---|---|---|---|---|---|\n";
   const auto row = [&](const char* input, const AnisotropicCase& c, const AnisotropicError& e) {
@@ -113,6 +117,7 @@ void anisotropic_section(std::ostringstream& md, const std::string& scratch) {
   const Quadrature2D dense(90, 64), utia(90, 48);
   for (const AnisotropicCase& c : dense_anisotropic_cases()) row("dense", c, measure_anisotropic(c, dense));
   for (const AnisotropicCase& c : utia_anisotropic_cases()) row("UTIA", c, measure_anisotropic(c, utia, AnisotropicInput::utia, scratch));
+  for (const AnisotropicCase& c : dense_anisotropic_cases()) row("RGL", c, measure_anisotropic(c, dense, AnisotropicInput::rgl, scratch + ".bsdf"));
   md << "\n";
 }
 
@@ -320,6 +325,7 @@ int main(int argc, char** argv) {
     anisotropic_section(md, scratch);
     utia_fit_section(md, scratch);
     std::filesystem::remove(scratch);
+    std::filesystem::remove(scratch + ".bsdf");
     rgl_section(md, argc > 2 ? argv[2] : "");
     write_file_atomic(argv[1], md.str());
     std::printf("%s\n", argv[1]);

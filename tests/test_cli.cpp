@@ -9,6 +9,7 @@
 #include "io/merl.h"
 #include "io/utia.h"
 #include "model/analytic.h"
+#include "support/tensor_file.h"
 #include "test_util.h"
 
 namespace facetfit {
@@ -152,6 +153,28 @@ TEST(Cli, ConvertToUtiaThenFitTheFile) {
   const RunResult bad = facetfit("convert builtin:silver-ggx-0.60 -o " + dir.file("x.png"));
   EXPECT_EQ(bad.status, 1);
   EXPECT_NE(bad.err.find("x.png: unsupported output format '.png' (supported: .binary, .bin)"), std::string::npos) << bad.err;
+}
+
+// An anisotropic RGL file (the tests' tensor writer: GGX 0.45 x 0.25 turned 30 degrees, F = 1): the
+// isotropic fits see its azimuthal mean, the 2D extraction its axes.
+TEST(Cli, FitsAnAnisotropicRglFile) {
+  TempDir dir;
+  const std::vector<unsigned char> bytes =
+      test::serialize(test::microfacet_tensor_fields(Ndf{NdfType::ggx, 0.45, 0.25}, Smith::correlated, 30.0 * kPi / 180.0, 25, 32, 64));
+  test::write_bytes(dir.file("aniso.bsdf"), std::string(bytes.begin(), bytes.end()));
+  const RunResult r = facetfit("fit " + dir.file("aniso.bsdf") + " --json");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  const nlohmann::json a = j["anisotropic"];
+  std::printf("[ rgl fit ] isotropic GGX %.4f; 2D: %.4f x %.4f at %.2f degrees\n", j["alpha_ggx"].get<double>(),
+              a["ggx"]["alpha_x"].get<double>(), a["ggx"]["alpha_y"].get<double>(), a["ggx"]["angle_degrees"].get<double>());
+  EXPECT_NEAR(a["ggx"]["alpha_x"].get<double>(), 0.45, 0.45 * 0.04);
+  EXPECT_NEAR(a["ggx"]["alpha_y"].get<double>(), 0.25, 0.25 * 0.04);
+  EXPECT_NEAR(a["ggx"]["angle_degrees"].get<double>(), 30.0, 0.5);
+  // The isotropic GGX of the mean lies between the two axes.
+  EXPECT_GT(j["alpha_ggx"].get<double>(), 0.25);
+  EXPECT_LT(j["alpha_ggx"].get<double>(), 0.45);
+  EXPECT_NE(r.err.find("anisotropic (GGX 0.4"), std::string::npos) << r.err;
 }
 
 TEST(Cli, FolderInputFitsEveryTableInIt) {

@@ -3,6 +3,7 @@
 #include <glob.h>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 
 #include "core/error.h"
@@ -52,6 +53,34 @@ std::shared_ptr<const Brdf> load_brdf(const std::string& source, MerlTable::BinP
   fail(source, "unsupported format '" + path.extension().string() + "' (supported: .binary, .bsdf, .bin, builtin:NAME)");
 }
 
+namespace {
+
+// The mean of a BRDF over turns of both directions about the normal: what an isotropic table holds of an
+// anisotropic measurement that has no lattice of its own to average on (RGL files; UTIA files average at
+// their nodes instead). 32 turns: on an analytic anisotropic GGX a 16-turn mean was 3.1% off the exact
+// one, 32 turns 1e-4.
+class AzimuthalMean final : public Brdf {
+ public:
+  static constexpr int kTurns = 32;
+  explicit AzimuthalMean(const Brdf& source) : source_(source) {}
+  std::optional<Rgb> eval(const Vec3& o, const Vec3& i) const override {
+    Rgb sum(0.0);
+    for (int k = 0; k < kTurns; ++k) {
+      const double a = 2.0 * kPi * k / kTurns, c = std::cos(a), s = std::sin(a);
+      const auto turn = [&](const Vec3& v) { return Vec3(c * v.x - s * v.y, s * v.x + c * v.y, v.z); };
+      const auto f = source_.eval(turn(o), turn(i));
+      if (!f) return std::nullopt;
+      sum += *f;
+    }
+    return sum / double(kTurns);
+  }
+
+ private:
+  const Brdf& source_;
+};
+
+}  // namespace
+
 MerlTable table_of(const Brdf& source) {
   if (const auto* table = dynamic_cast<const MerlTable*>(&source)) return *table;
   // UTIA: anisotropic, tabulated as its azimuthal mean (the isotropic fits see that; fit/extract_2d.h
@@ -59,6 +88,12 @@ MerlTable table_of(const Brdf& source) {
   if (const auto* utia = dynamic_cast<const UtiaBrdf*>(&source)) {
     MerlTable table = MerlTable::tabulate(utia->azimuthal_mean());
     table.set_source_backscatter(utia->backscatter());
+    return table;
+  }
+  // Anisotropic RGL: the same, the lattice read through the file's evaluation (90 polar angles, 64 azimuths).
+  if (const auto* rgl = dynamic_cast<const RglBsdf*>(&source); rgl && rgl->anisotropic()) {
+    MerlTable table = MerlTable::tabulate(AzimuthalMean(*rgl));
+    table.set_source_backscatter(rgl->backscatter(90, 64));
     return table;
   }
   return MerlTable::tabulate(source);
