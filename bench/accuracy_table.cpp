@@ -103,10 +103,10 @@ void anisotropic_section(std::ostringstream& md, const std::string& scratch) {
         "the analytic back-scattering at MERL's 90 theta_h bins on a 90 x 64 grid, bars 1% and 0.5 degree "
         "(tests/test_extract_2d.cpp). UTIA: written by facetfit's UTIA writer and read back, six polar angles 15 degrees "
         "apart, masking form, 90 x 48 grid, bar 3% for alpha >= 0.2 (tests/test_utia.cpp). RGL: the dense cases written "
-        "as an anisotropic RGL tensor file by the tests' writer (tests/support/tensor_file.h: 25 x 32 slices, 64 x 64 RGB "
-        "nodes, identity warp) and read back through the file's evaluation at 90 polar angles x 64 azimuths "
-        "(tests/test_rgl.cpp: bar 1% for Beckmann, 4% for GGX, whose long tail weighs the file's grazing "
-        "back-scattering, 2-5% low beyond 70 degrees at this resolution).\n\n"
+        "as an anisotropic RGL tensor file by the tests' writer (tests/support/tensor_file.h: 25 x 48 slices, 64 x 64 RGB "
+        "nodes warped toward grazing half vectors) and read back through the file's evaluation at 90 polar angles x 64 "
+        "azimuths, bar 1% (tests/test_rgl.cpp). The writer's resolution near grazing decides GGX, whose long tail weighs "
+        "grazing back-scattering: on an unwarped 64-node square with 32 slices it came back 1.4-3.2% low.\n\n"
         "| input | NDF | smith | alpha_x, alpha_y, angle | fitted | alpha_x error | alpha_y error | angle error | D L1 |\n"
         "|---|---|---|---|---|---|---|---|---|\n";
   const auto row = [&](const char* input, const AnisotropicCase& c, const AnisotropicError& e) {

@@ -168,8 +168,8 @@ TEST(Cli, FitsAnAnisotropicRglFile) {
   const nlohmann::json a = j["anisotropic"];
   std::printf("[ rgl fit ] isotropic GGX %.4f; 2D: %.4f x %.4f at %.2f degrees\n", j["alpha_ggx"].get<double>(),
               a["ggx"]["alpha_x"].get<double>(), a["ggx"]["alpha_y"].get<double>(), a["ggx"]["angle_degrees"].get<double>());
-  EXPECT_NEAR(a["ggx"]["alpha_x"].get<double>(), 0.45, 0.45 * 0.04);
-  EXPECT_NEAR(a["ggx"]["alpha_y"].get<double>(), 0.25, 0.25 * 0.04);
+  EXPECT_NEAR(a["ggx"]["alpha_x"].get<double>(), 0.45, 0.45 * 0.02);
+  EXPECT_NEAR(a["ggx"]["alpha_y"].get<double>(), 0.25, 0.25 * 0.02);
   EXPECT_NEAR(a["ggx"]["angle_degrees"].get<double>(), 30.0, 0.5);
   // The isotropic GGX of the mean lies between the two axes.
   EXPECT_GT(j["alpha_ggx"].get<double>(), 0.25);

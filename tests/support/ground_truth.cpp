@@ -72,7 +72,7 @@ AnisotropicError measure_anisotropic(const AnisotropicCase& c, const Quadrature2
       back = backscatter_2d(UtiaBrdf::read(path).backscatter(), quad);
       break;
     case AnisotropicInput::rgl: {
-      const std::vector<unsigned char> bytes = test::serialize(test::microfacet_tensor_fields(ndf, c.smith, angle, 25, 32, 64));
+      const std::vector<unsigned char> bytes = test::serialize(test::microfacet_tensor_fields(ndf, c.smith, angle, 25, 48, 64));
       std::ofstream(path, std::ios::binary).write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
       back = backscatter_2d(RglBsdf::read(path).backscatter(90, quad.phi_count()), quad);
       break;

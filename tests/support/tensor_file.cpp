@@ -84,6 +84,32 @@ std::vector<TensorField> microfacet_tensor_fields(const Ndf& ndf, Smith smith, d
   }
   const bool isotropic = phi_slices <= 2;
 
+  // The warp: a density over the half-vector square that grows toward the horizon (u_theta -> 1), the same
+  // in every row and slice, linear between 33 columns. The sample square's uniform RGB nodes land where
+  // it is high: near grazing half vectors, where the table changes fastest (G2 as the other direction
+  // nears the horizon, moving twice as fast as h). Its conditional CDF, inverted here by bisection, gives
+  // each node's half vector; rows are uniform, so u_phi is the sample's own.
+  constexpr std::uint64_t kWarpX = 33;
+  std::vector<float> warp_row(kWarpX);
+  for (std::uint64_t x = 0; x < kWarpX; ++x) warp_row[x] = float(1.0 + 40.0 * std::pow(double(x) / double(kWarpX - 1), 6.0));
+  std::vector<double> cdf(kWarpX, 0.0);  // at the columns, trapezoids of the linear density
+  for (std::uint64_t x = 1; x < kWarpX; ++x) cdf[x] = cdf[x - 1] + 0.5 * (double(warp_row[x - 1]) + double(warp_row[x])) / double(kWarpX - 1);
+  const auto cdf_at = [&](double u) {
+    const double g = u * double(kWarpX - 1);
+    const std::uint64_t k = std::min<std::uint64_t>(std::uint64_t(g), kWarpX - 2);
+    const double t = g - double(k), d0 = warp_row[k], d1 = warp_row[k + 1];
+    return cdf[k] + (t * d0 + 0.5 * t * t * (d1 - d0)) / double(kWarpX - 1);
+  };
+  const auto warped_u_theta = [&](double sample) {
+    double lo = 0.0, hi = 1.0;
+    for (int it = 0; it < 60; ++it) (cdf_at(0.5 * (lo + hi)) < sample * cdf.back() ? lo : hi) = 0.5 * (lo + hi);
+    return 0.5 * (lo + hi);
+  };
+  std::vector<double> node_u_theta(static_cast<std::size_t>(rgb_nodes));
+  for (int x = 0; x < rgb_nodes; ++x) node_u_theta[std::size_t(x)] = warped_u_theta(double(x) / double(rgb_nodes - 1));
+  std::vector<float> vndf;
+  for (std::size_t k = 0; k < phi_i.size() * theta_i.size() * 2; ++k) vndf.insert(vndf.end(), warp_row.begin(), warp_row.end());
+
   const std::uint64_t n = std::uint64_t(rgb_nodes), np = phi_i.size(), nt = theta_i.size();
   std::vector<float> rgb, luminance;
   for (std::uint64_t p = 0; p < np; ++p)
@@ -93,7 +119,7 @@ std::vector<TensorField> microfacet_tensor_fields(const Ndf& ndf, Smith smith, d
       for (std::uint64_t y = 0; y < n; ++y)
         for (std::uint64_t x = 0; x < n; ++x) {
           // Isotropic files measure the half vector's azimuth from the slice's plane (i at phi 0 here).
-          const Vec3 h = half_vector(double(x) / double(n - 1), double(y) / double(n - 1));
+          const Vec3 h = half_vector(node_u_theta[x], double(y) / double(n - 1));
           const Vec3 o = 2.0 * glm::dot(i, h) * h - i;
           // T 4 sigma / D = G2(i, o) sigma(i) / cos(i): D cancels. G2 falls to zero linearly as o reaches
           // the horizon; beyond it the table holds that line's continuation (-G2 of o mirrored), so
@@ -112,7 +138,7 @@ std::vector<TensorField> microfacet_tensor_fields(const Ndf& ndf, Smith smith, d
       f32("theta_i", {nt}, theta_i),
       f32("ndf", {kNdfY, kNdfX}, ndf_table),
       f32("sigma", {kNdfY, kNdfX}, sigma_table),
-      f32("vndf", {np, nt, 2, 2}, std::vector<float>(np * nt * 4, 1.0f)),
+      f32("vndf", {np, nt, 2, kWarpX}, vndf),
       f32("luminance", {np, nt, n, n}, luminance),
       f32("rgb", {np, nt, 3, n, n}, rgb),
       u8("jacobian", {1}, {1}),

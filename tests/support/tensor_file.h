@@ -32,10 +32,10 @@ std::vector<unsigned char> serialize(const std::vector<TensorField>& fields, uns
 // An analytic microfacet BRDF (F = 1, `smith` masking) with its axes turned by `angle` about the normal,
 // as an RGL file stores it: `ndf` and `sigma` (Smith's projected area, sigma(0) = 1) tabulated over the
 // half vector's (u_theta, u_phi) on 128 x 256 nodes; slices at `phi_slices` incident azimuths over
-// [-pi, pi] (anisotropic when more than two) and `theta_slices` elevations from 0 to 89 degrees; a
-// uniform VNDF, so that the warp is the identity and the sample square is the half-vector square; and the
-// RGB table T(p, q) 4 sigma(p) / D(h) (jacobian set) on its `rgb_nodes` x `rgb_nodes` nodes, T = f cos(q),
-// continued past q's horizon (see the writer).
+// [-pi, pi] (anisotropic when more than two) and `theta_slices` elevations from 0 to 89 degrees, closer
+// toward the horizon; a VNDF that is not the material's but a warp putting the sample square's nodes near
+// grazing half vectors (see the writer); and the RGB table T(p, q) 4 sigma(p) / D(h) (jacobian set) on its
+// `rgb_nodes` x `rgb_nodes` nodes, T = f cos(q), continued past q's horizon.
 // The format's reference evaluation (Mitsuba's `measured`) reads the BRDF back up to interpolation.
 std::vector<TensorField> microfacet_tensor_fields(const Ndf& ndf, Smith smith, double angle, int phi_slices,
                                                   int theta_slices, int rgb_nodes);
