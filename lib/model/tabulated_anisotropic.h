@@ -1,0 +1,85 @@
+// An anisotropic microfacet lobe from a tabulated NDF D(theta, phi): the 2D extraction's result
+// (fit/extract_2d.h) as a BRDF that renders, with visible-normal sampling.
+//
+//   f(o, i) = F(o.h) D(h) G2(o, i) / (4 cos(theta_o) cos(theta_i)),   Lambda(w) = sigma(w) / cos(theta_w) - 1,
+//
+// sigma(w) = integral max(0, w.h) D(h) dw_h the projected area, tabulated beside D (Smith: the
+// masking of a direction depends on the NDF only through its projected area). Both tables hold values at
+// the extraction grid's polar nodes (model/theta_grid.h) times `phi_count` azimuths phi_m = 2 pi m / M;
+// between them the grid's spline in u along theta and the same spline along phi, periodic.
+//
+// Visible normals h ~ D(h) max(0, o.h) depend on both angles of o. They are tabulated at view nodes
+// (10 polar angles up to 85 degrees times 12 azimuths), each a piecewise-constant density over cells of
+// the grid (polar intervals x azimuths, uniform in solid angle within a cell); a view between nodes draws
+// from the mixture of its four bracketing nodes, bilinear weights, and pdf() is that mixture's density,
+// so sampling and pdf agree exactly while the mixture only approximates the view's own distribution.
+#pragma once
+
+#include <optional>
+#include <vector>
+
+#include "core/brdf.h"
+#include "core/piecewise_constant.h"
+#include "model/fresnel_curve.h"
+#include "model/smith.h"
+#include "model/theta_grid.h"
+
+namespace facetfit {
+
+struct AnisotropicTables {
+  ThetaGrid grid;
+  int phi_count = 0;
+  std::vector<double> ndf;    // D(theta_j, phi_m), [j * phi_count + m], 1/sr
+  std::vector<double> sigma;  // sigma at the direction (theta_j, phi_m)
+  Smith smith = Smith::correlated;
+  FresnelCurve fresnel;
+};
+
+class TabulatedAnisotropic final : public Brdf {
+ public:
+  // Throws Error when the tables' sizes disagree or D has no mass.
+  explicit TabulatedAnisotropic(AnisotropicTables tables);
+
+  std::optional<Rgb> eval(const Vec3& o, const Vec3& i) const override;
+
+  struct Sample {
+    Vec3 i;
+    Rgb weight;  // f(o, i) cos(theta_i) / pdf
+    double pdf;  // per steradian of i
+  };
+  // A light direction i for the view o from two uniform numbers in [0, 1); nullopt when o is at or below
+  // the horizon or the reflection of o about the drawn normal is.
+  std::optional<Sample> sample(const Vec3& o, double u1, double u2) const;
+  // Density of sample() per steradian of i; over the upper hemisphere it integrates to the fraction of
+  // draws that land there.
+  double pdf(const Vec3& o, const Vec3& i) const;
+
+  double D(const Vec3& h) const;
+  double sigma(const Vec3& w) const;
+  double g1(const Vec3& w) const;
+  // Density of the drawn normals per steradian of h.
+  double visible_normal_pdf(const Vec3& o, const Vec3& h) const;
+
+  const AnisotropicTables& tables() const { return t_; }
+
+ private:
+  static constexpr int kViewThetas = 10, kViewPhis = 12;
+  static constexpr double kViewThetaMax = 85.0 * kPi / 180.0;
+
+  // Spline in u along theta and, periodic, in phi, over a J x M table.
+  double lookup(const std::vector<double>& table, const Vec3& w) const;
+  // The (up to four) view nodes bracketing o and their weights.
+  struct ViewBlend {
+    int view[4];
+    double weight[4];
+  };
+  ViewBlend blend(const Vec3& o) const;
+  // Cell of h: polar interval j (row) and azimuth x (column); its solid angle.
+  void cell_of(const Vec3& h, int* x, int* y) const;
+  double cell_solid_angle(int y) const;
+
+  AnisotropicTables t_;
+  std::vector<PiecewiseConstant2D> views_;  // [theta node * kViewPhis + phi node]
+};
+
+}  // namespace facetfit
