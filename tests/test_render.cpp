@@ -136,16 +136,26 @@ TEST(Render, RayStreamsAndOneRayAtATimeGiveTheSameImage) {
   one_ray.ray_streams = false;
   const RenderedImage a = render(s), b = render(s, one_ray);
   ASSERT_EQ(a.rgba.size(), b.rgba.size());
-  double worst = 0.0, coverage = 0.0, lit = 0.0;
+  double worst = 0.0, mean = 0.0, coverage = 0.0, lit = 0.0;
+  int beyond = 0;
   for (std::size_t k = 0; k < a.rgba.size(); ++k) {
-    worst = std::max(worst, std::abs(double(a.rgba[k]) - double(b.rgba[k])) / std::max(1.0, std::abs(double(b.rgba[k]))));
+    const double d = std::abs(double(a.rgba[k]) - double(b.rgba[k])) / std::max(1.0, std::abs(double(b.rgba[k])));
+    worst = std::max(worst, d);
+    mean += d / double(a.rgba.size());
+    beyond += d > 1e-5;
     if (k % 4 == 3) coverage += b.rgba[k];
     else lit += b.rgba[k];
   }
   // Float rounding: the same numbers through the same shading code; Embree's stream kernels compute the hit
   // distance (in float) with other instructions than its one-ray kernel, which moves the shading point by
-  // ~1e-7 (1.2e-5 relative here at worst).
-  EXPECT_LT(worst, 1e-4);
+  // ~1e-7. Which kernels run depends on the CPU: with AVX-512 the worst value moved by 1.2e-5; with
+  // AVX2 (an AMD EPYC) one pixel of 1,200 moved by 5.6e-4, a sample there landing on the other side of
+  // a discontinuity, while the mean moved by 2.4e-7. So: the mean at rounding level, a handful of values
+  // beyond 1e-5, none beyond 1e-3.
+  std::printf("[ streams ] mean relative difference %.2e, worst %.2e, %d of %zu values beyond 1e-5\n", mean, worst, beyond, a.rgba.size());
+  EXPECT_LT(mean, 1e-6);
+  EXPECT_LE(beyond, int(a.rgba.size() / 400));
+  EXPECT_LT(worst, 1e-3);
   EXPECT_GT(coverage, 0.5 * 40 * 30);  // the scene is in view and lit: the comparison is not of empty images
   EXPECT_GT(lit, 0.0);
 }
