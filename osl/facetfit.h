@@ -237,7 +237,9 @@ FacetfitLut facetfit_open(string file) {
   int res[2] = {0, 0};
   int version = 0, resolution = 0, sampling = 0;
   if (gettextureinfo(file, "resolution", res) && gettextureinfo(file, "facetfit:format_version", version) &&
-      gettextureinfo(file, "facetfit:resolution", resolution) && (version == 1 || version == 2)) {
+      gettextureinfo(file, "facetfit:resolution", resolution) && version >= 1 && version <= 3) {
+    // Version 3 appends the anisotropic lobe's rows below version 2's, which read as before: the shaders
+    // render the isotropic representation (the rows' t comes from the image's height, read here).
     gettextureinfo(file, "facetfit:sampling", sampling);
     lut.width = res[0];
     lut.height = res[1];
@@ -245,7 +247,7 @@ FacetfitLut facetfit_open(string file) {
     lut.sampling = sampling;
     lut.smith = facetfit_smith_code(file);
     lut.ok = lut.smith >= 0 && lut.smith <= 2;
-    if (version == 2) {
+    if (version >= 2) {
       gettextureinfo(file, "facetfit:body", lut.body);
       gettextureinfo(file, "facetfit:coat_alpha", lut.coat_alpha);
       gettextureinfo(file, "facetfit:coat_f0", lut.coat_f0);

@@ -9,6 +9,8 @@
 
 #include "core/error.h"
 #include "fit/fit.h"
+#include "io/input.h"
+#include "io/utia.h"
 #include "lut/lut.h"
 #include "model/analytic.h"
 #include "test_util.h"
@@ -128,6 +130,48 @@ TEST(Lut, EvalOnlyLeavesOutTheSamplingTables) {
   EXPECT_LT(std::filesystem::file_size(dir.file("eval.exr")), std::filesystem::file_size(dir.file("full.exr")));
   const Vec3 i = spherical_direction(0.3, 0.0), o = spherical_direction(0.5, 2.0);
   EXPECT_EQ(full.model().eval(o, i)->r, eval.model().eval(o, i)->r);
+}
+
+// An anisotropic input (a UTIA file) bakes version 3: the 2D extraction's tables come back to float
+// precision and evaluate as in memory; the same material's isotropic LUT stays version 2.
+TEST(Lut, AnisotropicLobeRoundTrip) {
+  TempDir dir;
+  UtiaBrdf::tabulate(MicrofacetBrdf(Ndf{NdfType::ggx, 0.5, 0.25}, Smith::correlated, Fresnel::schlick(Rgb(0.9, 0.6, 0.3))))
+      .write(dir.file("a.bin"));
+  const Fitter fitter{FitOptions::paper()};
+  const FitResult fit = fitter.fit(load_table(dir.file("a.bin")));
+  ASSERT_TRUE(fit.ok() && fit.anisotropic) << fit.problem;
+  const Lut baked = make_lut(fit, fitter.quadrature(), "a.bin", "", 0.02, true);
+  write_lut(dir.file("a.exr"), baked);
+  const Lut lut = read_lut(dir.file("a.exr"));
+  EXPECT_EQ(lut.meta.format_version, kLutAnisotropicVersion);
+  ASSERT_TRUE(lut.anisotropic);
+  EXPECT_EQ(lut.anisotropic->phi_count, 48);
+  EXPECT_NEAR(lut.meta.anisotropic_ggx.alpha_x, fit.anisotropic->ggx.alpha_x, 1e-6);
+  const TabulatedAnisotropic in_memory(*baked.anisotropic), read_back(*lut.anisotropic);
+  for (const auto& [o, i] : {std::pair{spherical_direction(0.3, 0.2), spherical_direction(0.5, 3.0)},
+                            {spherical_direction(1.1, 1.0), spherical_direction(0.9, 4.5)}}) {
+    const Rgb a = *in_memory.eval(o, i), b = *read_back.eval(o, i);
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(b[c], a[c], 1e-5 * std::max(1.0, a[c]));
+    EXPECT_NEAR(read_back.pdf(o, i), in_memory.pdf(o, i), 1e-5 * std::max(1.0, in_memory.pdf(o, i)));
+  }
+  // Without the anisotropic fit, version 2 as before.
+  FitResult isotropic = fit;
+  isotropic.anisotropic.reset();
+  write_lut(dir.file("iso.exr"), make_lut(isotropic, fitter.quadrature(), "a.bin", "", 0.02, true));
+  EXPECT_EQ(read_lut(dir.file("iso.exr")).meta.format_version, kLutFormatVersion);
+  // A damaged azimuth count is refused before anything is sized from it.
+  {
+    auto in = OIIO::ImageInput::open(dir.file("a.exr"));
+    OIIO::ImageSpec spec = in->spec();
+    std::vector<float> px(std::size_t(spec.width) * std::size_t(spec.height) * std::size_t(spec.nchannels));
+    ASSERT_TRUE(in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, px.data()));
+    spec.attribute("facetfit:anisotropic_phi_count", 1 << 30);
+    auto out = OIIO::ImageOutput::create(dir.file("bad.exr"));
+    ASSERT_TRUE(out->open(dir.file("bad.exr"), spec) && out->write_image(OIIO::TypeDesc::FLOAT, px.data()) && out->close());
+  }
+  EXPECT_NE(error_of([&] { read_lut(dir.file("bad.exr")); }).find("bad.exr: facetfit:anisotropic_resolution or facetfit:anisotropic_phi_count"),
+            std::string::npos);
 }
 
 TEST(Lut, BadFilesGetOneClearLine) {

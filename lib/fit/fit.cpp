@@ -136,6 +136,7 @@ FitResult Fitter::fit(const MerlTable& table) const {
     return result;
   }
   result.lobe.fresnel = *fresnel;
+  const FresnelCurve paper_fresnel = *fresnel;  // the anisotropic lobe's: the refinement is isotropic
 
   const bool refine = options_.refine == FitOptions::Refine::full;
   result.refined = refine;
@@ -176,7 +177,8 @@ FitResult Fitter::fit(const MerlTable& table) const {
     const Extraction2D e = extract_ndf_2d(backscatter_2d(lattice, quadrature), quadrature,
                                           {options_.smith, options_.tolerance, options_.max_iterations});
     if (e.problem.empty()) {
-      const AnisotropicFit a{alpha_ggx_2d(e.ndf, quadrature), alpha_beckmann_2d(e.ndf, quadrature), e.iterations, e.residual};
+      const AnisotropicFit a{alpha_ggx_2d(e.ndf, quadrature), alpha_beckmann_2d(e.ndf, quadrature), e.iterations, e.residual,
+                             AnisotropicTables{quadrature.grid(), quadrature.phi_count(), e.ndf, e.sigma, options_.smith, paper_fresnel}};
       result.anisotropic = a;
       // Anisotropic beyond what the 15-degree grid resolves (a 10% ratio): say what an isotropic LUT loses.
       if (a.ggx.alpha_x > 1.1 * a.ggx.alpha_y) {

@@ -17,6 +17,7 @@
 #include "fit/quadrature.h"
 #include "fit/refine.h"
 #include "io/merl.h"
+#include "model/tabulated_anisotropic.h"
 
 namespace facetfit {
 
@@ -44,11 +45,13 @@ const char* to_string(FitOptions::Refine r);
 std::optional<FitOptions::Refine> parse_refine(const std::string& name);
 
 // The 2D extraction (fit/extract_2d.h) of a source that measured back-scattering along azimuths (a
-// UTIA file): its principal roughness in each family.
+// UTIA file, an anisotropic RGL file): its principal roughness in each family, and its tables, which
+// with the paper's Fresnel curve make the anisotropic tabulated lobe (model/tabulated_anisotropic.h).
 struct AnisotropicFit {
   AnisotropicAlpha ggx, beckmann;
   int iterations = 0;
   double residual = 0.0;
+  AnisotropicTables tables;
 };
 
 struct FitResult {

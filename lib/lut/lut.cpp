@@ -69,8 +69,10 @@ std::optional<Representation> parse_representation(const std::string& name) {
   return std::nullopt;
 }
 
-LutLayout LutLayout::of(int resolution, bool sampling) {
-  return {std::max(resolution + 1, FresnelCurve::kSize), kSamplingRow + (sampling ? resolution + 1 : 0)};
+LutLayout LutLayout::of(int resolution, bool sampling, int anisotropic_resolution, int anisotropic_phi_count) {
+  const int rows = kSamplingRow + (sampling ? resolution + 1 : 0);
+  const int width = std::max({resolution + 1, FresnelCurve::kSize, anisotropic_phi_count > 0 ? anisotropic_resolution + 1 : 0});
+  return {rows, width, rows + (anisotropic_phi_count > 0 ? 1 + anisotropic_phi_count : 0)};
 }
 
 Lut make_lut(const FitResult& fit, const Quadrature& quadrature, const std::string& source, const std::string& sha256,
@@ -118,12 +120,19 @@ Lut make_lut(const FitResult& fit, const Quadrature& quadrature, const std::stri
                          : Representation::tabulated;
   m.sampling = with_sampling;
   m.warnings = fit.warnings;
+  if (fit.anisotropic) {
+    lut.anisotropic = fit.anisotropic->tables;
+    m.format_version = kLutAnisotropicVersion;
+    m.anisotropic_resolution = lut.anisotropic->grid.resolution;
+    m.anisotropic_phi_count = lut.anisotropic->phi_count;
+    m.anisotropic_ggx = fit.anisotropic->ggx;
+  }
   return lut;
 }
 
 void write_lut(const std::string& path, const Lut& lut) {
   const int r = lut.meta.resolution, nodes = r + 1;
-  const LutLayout layout = LutLayout::of(r, lut.meta.sampling);
+  const LutLayout layout = LutLayout::of(r, lut.meta.sampling, lut.meta.anisotropic_resolution, lut.meta.anisotropic_phi_count);
   std::vector<float> pixels(std::size_t(layout.width) * layout.height * 3, 0.0f);
   const auto put = [&](int row, int x, const Rgb& v) {
     float* p = pixels.data() + (std::size_t(row) * layout.width + x) * 3;
@@ -137,6 +146,14 @@ void write_lut(const std::string& path, const Lut& lut) {
     put(LutLayout::kFresnelRow, x, lut.tables.fresnel.value[std::size_t(std::min(x, FresnelCurve::kSize - 1))]);
     if (lut.meta.sampling)
       for (int s = 0; s < nodes; ++s) put(LutLayout::kSamplingRow + s, x, Rgb(lut.sampling.cdf_at(s, node)));
+  }
+  if (const auto& a = lut.anisotropic) {
+    for (int x = 0; x < layout.width; ++x) {
+      put(layout.anisotropic_row, x, a->fresnel.value[std::size_t(std::min(x, FresnelCurve::kSize - 1))]);
+      const std::size_t node = std::size_t(std::min(x, a->grid.resolution));
+      for (int m = 0; m < a->phi_count; ++m)
+        put(layout.anisotropic_row + 1 + m, x, Rgb(a->ndf[node * a->phi_count + m], a->sigma[node * a->phi_count + m], 0.0));
+    }
   }
 
   ImageSpec spec(layout.width, layout.height, 3, TypeDesc::FLOAT);
@@ -181,6 +198,13 @@ void write_lut(const std::string& path, const Lut& lut) {
   spec.attribute(key("error_lsq"), float(m.error_lsq));
   spec.attribute(key("error_extraction"), float(m.error_extraction));
   spec.attribute(key("sampling"), m.sampling ? 1 : 0);
+  if (lut.anisotropic) {
+    spec.attribute(key("anisotropic_resolution"), m.anisotropic_resolution);
+    spec.attribute(key("anisotropic_phi_count"), m.anisotropic_phi_count);
+    spec.attribute(key("anisotropic_ggx_alpha_x"), float(m.anisotropic_ggx.alpha_x));
+    spec.attribute(key("anisotropic_ggx_alpha_y"), float(m.anisotropic_ggx.alpha_y));
+    spec.attribute(key("anisotropic_ggx_angle"), float(m.anisotropic_ggx.angle));
+  }
   // One line per warning; absent when there is none.
   if (!m.warnings.empty()) {
     std::string text;
@@ -214,6 +238,9 @@ void validate(const std::string& path, const LutMetadata& m) {
     for (int k = 0; k < 3; ++k) in_range(name, c[k], 0.0, hi);
   };
   in_range("alpha_ggx", m.alpha_ggx, 0.0, 10.0);
+  in_range("anisotropic_ggx_alpha_x", m.anisotropic_ggx.alpha_x, 0.0, 10.0);
+  in_range("anisotropic_ggx_alpha_y", m.anisotropic_ggx.alpha_y, 0.0, 10.0);
+  in_range("anisotropic_ggx_angle", m.anisotropic_ggx.angle, -kPi, kPi);
   in_range("alpha_beckmann", m.alpha_beckmann, 0.0, 10.0);
   colour("f0", m.f0, 1e3);  // an implausible measurement may give F > 1: baked with a warning, kept finite
   colour("f82", m.f82, 1e3);
@@ -243,9 +270,9 @@ Lut read_lut(const std::string& path) {
   const ImageSpec& spec = image->spec();
   const int version = spec.get_int_attribute(key("format_version"), -1);
   if (version < 0) fail(path, "not a facetfit LUT (no facetfit:format_version attribute)");
-  if (version != 1 && version != kLutFormatVersion)
-    fail(path, "LUT format version " + std::to_string(version) + "; this facetfit reads versions 1 and " +
-                   std::to_string(kLutFormatVersion));
+  if (version < 1 || version > kLutAnisotropicVersion)
+    fail(path, "LUT format version " + std::to_string(version) + "; this facetfit reads versions 1 to " +
+                   std::to_string(kLutAnisotropicVersion));
 
   Lut lut;
   LutMetadata& m = lut.meta;
@@ -308,8 +335,19 @@ Lut read_lut(const std::string& path) {
     m.error_extraction = spec.get_float_attribute(key("error_extraction"));
   }
 
+  if (version == kLutAnisotropicVersion) {
+    m.anisotropic_resolution = spec.get_int_attribute(key("anisotropic_resolution"), -1);
+    m.anisotropic_phi_count = spec.get_int_attribute(key("anisotropic_phi_count"), -1);
+    // Bounded before anything is sized from them; the quadrature's own limits.
+    if (m.anisotropic_resolution < 4 || m.anisotropic_resolution > 4096 || m.anisotropic_phi_count < 4 ||
+        m.anisotropic_phi_count > 4096 || m.anisotropic_phi_count % 2 != 0)
+      fail(path, "facetfit:anisotropic_resolution or facetfit:anisotropic_phi_count is missing or out of range (" +
+                     std::to_string(m.anisotropic_resolution) + ", " + std::to_string(m.anisotropic_phi_count) + ")");
+    m.anisotropic_ggx = {spec.get_float_attribute(key("anisotropic_ggx_alpha_x")), spec.get_float_attribute(key("anisotropic_ggx_alpha_y")),
+                         spec.get_float_attribute(key("anisotropic_ggx_angle"))};
+  }
   validate(path, m);
-  const LutLayout layout = LutLayout::of(m.resolution, m.sampling);
+  const LutLayout layout = LutLayout::of(m.resolution, m.sampling, m.anisotropic_resolution, m.anisotropic_phi_count);
   if (spec.width != layout.width || spec.height != layout.height)
     fail(path, "image is " + std::to_string(spec.width) + " x " + std::to_string(spec.height) + ", expected " +
                    std::to_string(layout.width) + " x " + std::to_string(layout.height) + " for resolution " +
@@ -340,6 +378,23 @@ Lut read_lut(const std::string& path) {
     lut.sampling.cdf.resize(std::size_t(nodes) * nodes);
     for (int s = 0; s < nodes; ++s)
       for (int x = 0; x < nodes; ++x) lut.sampling.cdf[std::size_t(s) * nodes + x] = get(LutLayout::kSamplingRow + s, x, 0);
+  }
+  if (m.anisotropic_phi_count > 0) {
+    AnisotropicTables a;
+    a.grid = ThetaGrid{m.anisotropic_resolution};
+    a.phi_count = m.anisotropic_phi_count;
+    a.smith = m.smith;
+    for (int x = 0; x < FresnelCurve::kSize; ++x)
+      a.fresnel.value[std::size_t(x)] = Rgb(get(layout.anisotropic_row, x, 0), get(layout.anisotropic_row, x, 1), get(layout.anisotropic_row, x, 2));
+    for (int x = 0; x <= m.anisotropic_resolution; ++x)
+      for (int p = 0; p < a.phi_count; ++p) {
+        a.ndf.push_back(get(layout.anisotropic_row + 1 + p, x, 0));
+        a.sigma.push_back(get(layout.anisotropic_row + 1 + p, x, 1));
+        if (!(a.ndf.back() >= 0.0 && a.sigma.back() > 0.0))
+          fail(path, "anisotropic row " + std::to_string(layout.anisotropic_row + 1 + p) + ", column " + std::to_string(x) +
+                         ": D must be >= 0 and sigma > 0");
+      }
+    lut.anisotropic = std::move(a);
   }
   return lut;
 }

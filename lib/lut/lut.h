@@ -12,8 +12,10 @@
 namespace facetfit {
 
 // Version 2 adds the body and the parametric fits on the whole measurement; version 1 LUTs (no body)
-// still read, with a zero body.
+// still read, with a zero body. Version 3 is version 2 with the anisotropic lobe's rows appended (written
+// only for a fit that has one: LUTs without it stay version 2, which readers of version 2 take).
 constexpr int kLutFormatVersion = 2;
+constexpr int kLutAnisotropicVersion = 3;
 
 // Which model a renderer should use for this material.
 enum class Representation { tabulated, ggx, beckmann };
@@ -52,6 +54,9 @@ struct LutMetadata {
   Representation representation = Representation::tabulated;
   double tolerance = 0.0;  // the NDF error a parametric fit was allowed when choosing the representation
   bool sampling = true;    // sampling tables present (absent with --eval-only)
+  // The anisotropic lobe (version 3): its grid's resolution and azimuths (0: none), principal GGX alphas.
+  int anisotropic_resolution = 0, anisotropic_phi_count = 0;
+  AnisotropicAlpha anisotropic_ggx;
   std::vector<std::string> warnings;  // implausible values found when fitting (fit/plausibility.h)
 };
 
@@ -61,13 +66,17 @@ struct LutLayout {
   static constexpr int kSigmaRow = 1;     // sigma at grid node x
   static constexpr int kFresnelRow = 2;   // RGB Fresnel at theta_d = x pi/180 (x = 0..89)
   static constexpr int kSamplingRow = 3;  // + s: CDF of visible normals of view slice s at node x
+  // Version 3, after the rows above: the anisotropic lobe's Fresnel curve (RGB, as row 2), then one row
+  // per azimuth m with D(theta_x, phi_m) in R and sigma in G.
+  int anisotropic_row = 0;
   int width = 0, height = 0;
-  static LutLayout of(int resolution, bool sampling);
+  static LutLayout of(int resolution, bool sampling, int anisotropic_resolution = 0, int anisotropic_phi_count = 0);
 };
 
 struct Lut {
   MicrofacetTables tables;
   VisibleNormalTables sampling;  // empty when baked with --eval-only
+  std::optional<AnisotropicTables> anisotropic;  // version 3
   LutMetadata meta;
 
   TabulatedMicrofacet model() const { return TabulatedMicrofacet(tables, sampling); }

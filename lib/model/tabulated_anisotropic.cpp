@@ -128,6 +128,15 @@ double TabulatedAnisotropic::pdf(const Vec3& o, const Vec3& i) const {
 }
 
 std::optional<TabulatedAnisotropic::Sample> TabulatedAnisotropic::sample(const Vec3& o, double u1, double u2) const {
+  const std::optional<Vec3> i = sample_direction(o, u1, u2);
+  if (!i) return std::nullopt;
+  const double density = pdf(o, *i);
+  const auto f = eval(o, *i);
+  if (!(density > 0.0) || !f) return std::nullopt;
+  return Sample{*i, *f * (i->z / density), density};
+}
+
+std::optional<Vec3> TabulatedAnisotropic::sample_direction(const Vec3& o, double u1, double u2) const {
   if (o.z <= 0.0) return std::nullopt;
   // u1 picks the view node by its weight, then is reused within it.
   const ViewBlend v = blend(o);
@@ -142,10 +151,7 @@ std::optional<TabulatedAnisotropic::Sample> TabulatedAnisotropic::sample(const V
   const Vec3 h = spherical_direction(std::acos(clamp(c, 0.0, 1.0)), s.u * 2.0 * kPi);
   const Vec3 i = 2.0 * glm::dot(o, h) * h - o;
   if (i.z <= 0.0) return std::nullopt;
-  const double density = pdf(o, i);
-  const auto f = eval(o, i);
-  if (!(density > 0.0) || !f) return std::nullopt;
-  return Sample{i, *f * (i.z / density), density};
+  return i;
 }
 
 }  // namespace facetfit

@@ -21,6 +21,7 @@
 #include "core/brdf.h"
 #include "core/piecewise_constant.h"
 #include "model/fresnel_curve.h"
+#include "model/proposal.h"
 #include "model/smith.h"
 #include "model/theta_grid.h"
 
@@ -35,7 +36,7 @@ struct AnisotropicTables {
   FresnelCurve fresnel;
 };
 
-class TabulatedAnisotropic final : public Brdf {
+class TabulatedAnisotropic final : public Brdf, public Proposal {
  public:
   // Throws Error when the tables' sizes disagree or D has no mass.
   explicit TabulatedAnisotropic(AnisotropicTables tables);
@@ -52,7 +53,8 @@ class TabulatedAnisotropic final : public Brdf {
   std::optional<Sample> sample(const Vec3& o, double u1, double u2) const;
   // Density of sample() per steradian of i; over the upper hemisphere it integrates to the fraction of
   // draws that land there.
-  double pdf(const Vec3& o, const Vec3& i) const;
+  double pdf(const Vec3& o, const Vec3& i) const override;
+  std::optional<Vec3> sample_direction(const Vec3& o, double u1, double u2) const override;
 
   double D(const Vec3& h) const;
   double sigma(const Vec3& w) const;

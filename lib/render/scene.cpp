@@ -116,6 +116,10 @@ MaterialDesc parse_material(const std::string& name, const json& j, const std::s
   if (j.contains("tangent") && m.type != "lut" && m.type != "measured")
     fail(path, "material " + name + ": \"tangent\" is for lut and measured materials (an anisotropic measurement turns with it)");
   if (j.contains("tangent")) m.tangent = direction(j["tangent"], "material " + name + ": tangent", path);
+  if (j.contains("anisotropic")) {
+    if (m.type != "lut" || !j["anisotropic"].is_boolean()) fail(path, "material " + name + ": \"anisotropic\" is true or false, for lut materials");
+    m.anisotropic = j["anisotropic"].get<bool>();
+  }
   if (j.contains("stretch") || j.contains("rotation") || j.contains("stretch_texture")) {
     if (m.type != "lut") fail(path, "material " + name + ": \"stretch\", \"rotation\" and \"stretch_texture\" are for lut materials");
     m.stretch_texture = get<std::string>(j, "stretch_texture", "", path);
@@ -378,7 +382,17 @@ std::shared_ptr<const ShadingModel> load_material(const SceneDesc& scene, const 
     return std::make_shared<ShadingModel>(table, proposal);
   }
   if (m.type == "lut") {
-    std::shared_ptr<const TabulatedMicrofacet> model = sampled_lut_model(resolve(scene, m.file));
+    const std::string path = resolve(scene, m.file);
+    if (m.anisotropic) {
+      Lut lut = read_lut(path);
+      if (lut.anisotropic) {
+        if (!m.stretch.identity() || !m.stretch_texture.empty())
+          fail(path, "a stretch reshapes the isotropic lobe: this LUT's is anisotropic (set \"anisotropic\": false)");
+        const auto lobe = std::make_shared<TabulatedAnisotropic>(std::move(*lut.anisotropic));
+        return std::make_shared<ShadingModel>(lobe, lobe);
+      }
+    }
+    std::shared_ptr<const TabulatedMicrofacet> model = sampled_lut_model(path);
     if (!m.stretch.identity()) model = std::make_shared<TabulatedMicrofacet>(model->stretched(m.stretch));
     return std::make_shared<ShadingModel>(model, model);
   }

@@ -57,6 +57,9 @@ struct MaterialDesc {
   // lut: an image whose R and G multiply the stretch's x and y per shading point (render/texture.h: its
   // coordinates, and how it is read), for spheres and planes.
   std::string stretch_texture;
+  // lut: a LUT with an anisotropic lobe (version 3, from an anisotropic input) renders it, along the
+  // tangent; false renders its isotropic representation instead.
+  bool anisotropic = true;
 };
 
 struct ObjectDesc {
