@@ -10,6 +10,13 @@ namespace facetfit {
 // A BRDF f(o, i) in 1/sr. Conventions (docs/conventions.md): both directions are unit vectors in the
 // local frame with the surface normal along +z, pointing away from the surface; o toward the viewer,
 // i toward the light, in that order in every eval, pdf and sample (as pbrt's f(wo, wi)). Implementations are reciprocal where the physics is, and thread-safe for eval.
+// A light direction drawn for a view direction: what every sampler of a lobe or a material returns.
+struct BrdfSample {
+  Vec3 i;
+  Rgb weight;  // f(o, i) cos(theta_i) / pdf
+  double pdf;  // per steradian of i
+};
+
 class Brdf {
  public:
   virtual ~Brdf() = default;

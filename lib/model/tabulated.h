@@ -55,11 +55,7 @@ class TabulatedMicrofacet final : public Brdf, public Proposal {
 
   std::optional<Rgb> eval(const Vec3& o, const Vec3& i) const override;
 
-  struct Sample {
-    Vec3 i;
-    Rgb weight;  // f(o, i) cos(theta_i) / pdf
-    double pdf;  // per steradian of i
-  };
+  using Sample = BrdfSample;
   // Samples a light direction i for the view direction o from two uniform numbers in [0, 1) (u1 also
   // picks the part: its first lobe_weight() selects the lobe, the next body_weight() the body). nullopt
   // when the reflected direction falls below the horizon (the sample carries no energy), when o is at

@@ -43,11 +43,7 @@ class TabulatedAnisotropic final : public Brdf, public Proposal {
 
   std::optional<Rgb> eval(const Vec3& o, const Vec3& i) const override;
 
-  struct Sample {
-    Vec3 i;
-    Rgb weight;  // f(o, i) cos(theta_i) / pdf
-    double pdf;  // per steradian of i
-  };
+  using Sample = BrdfSample;
   // A light direction i for the view o from two uniform numbers in [0, 1); nullopt when o is at or below
   // the horizon or the reflection of o about the drawn normal is.
   std::optional<Sample> sample(const Vec3& o, double u1, double u2) const;

@@ -23,11 +23,7 @@ class ShadingModel {
   // f(o, i) in the local frame (missing measurements count as zero).
   Rgb f(const Vec3& o, const Vec3& i) const;
 
-  struct Sample {
-    Vec3 i;
-    Rgb weight;  // f cos(theta_i) / pdf
-    double pdf;
-  };
+  using Sample = BrdfSample;
   std::optional<Sample> sample(const Vec3& o, double u1, double u2, double u3) const;
   double pdf(const Vec3& o, const Vec3& i) const;
 
