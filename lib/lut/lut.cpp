@@ -204,6 +204,9 @@ void write_lut(const std::string& path, const Lut& lut) {
     spec.attribute(key("anisotropic_ggx_alpha_x"), float(m.anisotropic_ggx.alpha_x));
     spec.attribute(key("anisotropic_ggx_alpha_y"), float(m.anisotropic_ggx.alpha_y));
     spec.attribute(key("anisotropic_ggx_angle"), float(m.anisotropic_ggx.angle));
+    // The lobe's Fresnel at 0 and 82 degrees, for a closure that takes F82-tint (the OSL material shader).
+    set_color(spec, "anisotropic_f0", lut.anisotropic->fresnel.value[0]);
+    set_color(spec, "anisotropic_f82", lut.anisotropic->fresnel.eval(f82_theta()));
   }
   // One line per warning; absent when there is none.
   if (!m.warnings.empty()) {
