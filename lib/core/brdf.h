@@ -7,9 +7,6 @@
 
 namespace facetfit {
 
-// A BRDF f(o, i) in 1/sr. Conventions (docs/conventions.md): both directions are unit vectors in the
-// local frame with the surface normal along +z, pointing away from the surface; o toward the viewer,
-// i toward the light, in that order in every eval, pdf and sample (as pbrt's f(wo, wi)). Implementations are reciprocal where the physics is, and thread-safe for eval.
 // A light direction drawn for a view direction: what every sampler of a lobe or a material returns.
 struct BrdfSample {
   Vec3 i;
@@ -17,6 +14,9 @@ struct BrdfSample {
   double pdf;  // per steradian of i
 };
 
+// A BRDF f(o, i) in 1/sr. Conventions (docs/conventions.md): both directions are unit vectors in the
+// local frame with the surface normal along +z, pointing away from the surface; o toward the viewer,
+// i toward the light, in that order in every eval, pdf and sample (as pbrt's f(wo, wi)). Implementations are reciprocal where the physics is, and thread-safe for eval.
 class Brdf {
  public:
   virtual ~Brdf() = default;

@@ -3,7 +3,9 @@
 #include <glob.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <utility>
 #include <filesystem>
 
 #include "core/error.h"
@@ -62,12 +64,13 @@ namespace {
 class AzimuthalMean final : public Brdf {
  public:
   static constexpr int kTurns = 32;
-  explicit AzimuthalMean(const Brdf& source) : source_(source) {}
+  explicit AzimuthalMean(const Brdf& source) : source_(source) {
+    for (int k = 0; k < kTurns; ++k) cos_sin_[std::size_t(k)] = {std::cos(2.0 * kPi * k / kTurns), std::sin(2.0 * kPi * k / kTurns)};
+  }
   std::optional<Rgb> eval(const Vec3& o, const Vec3& i) const override {
     Rgb sum(0.0);
-    for (int k = 0; k < kTurns; ++k) {
-      const double a = 2.0 * kPi * k / kTurns, c = std::cos(a), s = std::sin(a);
-      const auto turn = [&](const Vec3& v) { return Vec3(c * v.x - s * v.y, s * v.x + c * v.y, v.z); };
+    for (const auto& [c, s] : cos_sin_) {
+      const auto turn = [&, c = c, s = s](const Vec3& v) { return Vec3(c * v.x - s * v.y, s * v.x + c * v.y, v.z); };
       const auto f = source_.eval(turn(o), turn(i));
       if (!f) return std::nullopt;
       sum += *f;
@@ -77,6 +80,7 @@ class AzimuthalMean final : public Brdf {
 
  private:
   const Brdf& source_;
+  std::array<std::pair<double, double>, kTurns> cos_sin_;  // of each turn, computed once: eval runs per bin
 };
 
 }  // namespace

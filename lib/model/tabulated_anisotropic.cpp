@@ -1,6 +1,7 @@
 #include "model/tabulated_anisotropic.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <string>
 
@@ -61,13 +62,12 @@ double TabulatedAnisotropic::lookup(const std::vector<double>& table, const Vec3
   const int m = t_.phi_count;
   const double x = azimuth(w) / (2.0 * kPi) * m;
   const int m0 = std::min(int(x), m - 1);
-  const double f = x - m0, f2 = f * f, f3 = f2 * f;
-  const double wp[4] = {0.5 * (-f + 2.0 * f2 - f3), 0.5 * (2.0 - 5.0 * f2 + 3.0 * f3), 0.5 * (f + 4.0 * f2 - 3.0 * f3), 0.5 * (f3 - f2)};
+  const std::array<double, 4> wp = catmull_rom_weights(x - m0);
   double v = 0.0;
   for (int q = 0; q < 4; ++q) {
     const std::size_t row = std::size_t(s.index[q]) * m;
     double along_phi = 0.0;
-    for (int r = 0; r < 4; ++r) along_phi += wp[r] * table[row + std::size_t((m0 - 1 + r + m) % m)];
+    for (int r = 0; r < 4; ++r) along_phi += wp[std::size_t(r)] * table[row + std::size_t((m0 - 1 + r + m) % m)];
     v += s.weight[q] * along_phi;
   }
   return v;

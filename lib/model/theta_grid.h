@@ -8,12 +8,19 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <vector>
 
 #include "core/vec.h"
 
 namespace facetfit {
+
+// Weights of nodes k-1, k, k+1, k+2 of the uniform Catmull-Rom spline at fraction t of interval k.
+inline std::array<double, 4> catmull_rom_weights(double t) {
+  const double t2 = t * t, t3 = t2 * t;
+  return {0.5 * (-t + 2.0 * t2 - t3), 0.5 * (2.0 - 5.0 * t2 + 3.0 * t3), 0.5 * (t + 4.0 * t2 - 3.0 * t3), 0.5 * (t3 - t2)};
+}
 
 struct ThetaGrid {
   int resolution = 90;
@@ -33,10 +40,8 @@ struct ThetaGrid {
     double weight[4];
   };
   Stencil stencil(int j, double t) const {
-    const double t2 = t * t, t3 = t2 * t;
-    Stencil s{{j - 1, j, j + 1, j + 2},
-              {0.5 * (-t + 2.0 * t2 - t3), 0.5 * (2.0 - 5.0 * t2 + 3.0 * t3), 0.5 * (t + 4.0 * t2 - 3.0 * t3),
-               0.5 * (t3 - t2)}};
+    const std::array<double, 4> w = catmull_rom_weights(t);
+    Stencil s{{j - 1, j, j + 1, j + 2}, {w[0], w[1], w[2], w[3]}};
     if (j == 0) s.index[0] = 1;
     if (j + 2 > resolution) {  // ghost = 2 node(R) - node(R - 1)
       s.weight[2] += 2.0 * s.weight[3];

@@ -311,8 +311,7 @@ std::string resolve(const SceneDesc& scene, const std::string& file) {
 namespace {
 
 // A LUT's tabulated model, able to sample: an --eval-only LUT gets its sampling tables built here.
-std::shared_ptr<const TabulatedMicrofacet> sampled_lut_model(const std::string& path) {
-  Lut lut = read_lut(path);
+std::shared_ptr<const TabulatedMicrofacet> sampled_lut_model(Lut lut) {
   if (lut.sampling.empty()) return std::make_shared<TabulatedMicrofacet>(std::move(lut.tables));
   return std::make_shared<TabulatedMicrofacet>(std::move(lut.tables), std::move(lut.sampling));
 }
@@ -365,7 +364,7 @@ std::shared_ptr<const ShadingModel> load_material(const SceneDesc& scene, const 
     if (!table && (!(rgl || utia) || m.proposal.empty())) table = std::make_shared<MerlTable>(table_of(*measurement));
     std::shared_ptr<const TabulatedMicrofacet> proposal;
     if (!m.proposal.empty()) {
-      proposal = sampled_lut_model(resolve(scene, m.proposal));
+      proposal = sampled_lut_model(read_lut(resolve(scene, m.proposal)));
     } else {
       const FitResult fit = Fitter{FitOptions::paper()}.fit(*table);
       if (fit.ok()) proposal = std::make_shared<TabulatedMicrofacet>(MicrofacetTables{fit.ndf(), fit.smith, fit.fresnel(), {}, {}});
@@ -383,16 +382,14 @@ std::shared_ptr<const ShadingModel> load_material(const SceneDesc& scene, const 
   }
   if (m.type == "lut") {
     const std::string path = resolve(scene, m.file);
-    if (m.anisotropic) {
-      Lut lut = read_lut(path);
-      if (lut.anisotropic) {
-        if (!m.stretch.identity() || !m.stretch_texture.empty())
-          fail(path, "a stretch reshapes the isotropic lobe: this LUT's is anisotropic (set \"anisotropic\": false)");
-        const auto lobe = std::make_shared<TabulatedAnisotropic>(std::move(*lut.anisotropic));
-        return std::make_shared<ShadingModel>(lobe, lobe);
-      }
+    Lut lut = read_lut(path);
+    if (m.anisotropic && lut.anisotropic) {
+      if (!m.stretch.identity() || !m.stretch_texture.empty())
+        fail(path, "a stretch reshapes the isotropic lobe: this LUT's is anisotropic (set \"anisotropic\": false)");
+      const auto lobe = std::make_shared<TabulatedAnisotropic>(std::move(*lut.anisotropic));
+      return std::make_shared<ShadingModel>(lobe, lobe);
     }
-    std::shared_ptr<const TabulatedMicrofacet> model = sampled_lut_model(path);
+    std::shared_ptr<const TabulatedMicrofacet> model = sampled_lut_model(std::move(lut));
     if (!m.stretch.identity()) model = std::make_shared<TabulatedMicrofacet>(model->stretched(m.stretch));
     return std::make_shared<ShadingModel>(model, model);
   }
