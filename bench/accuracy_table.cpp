@@ -146,7 +146,7 @@ void utia_fit_section(std::ostringstream& md, const std::string& scratch) {
     const Fitter fitter = fitter_for(c.smith, 90);
     const FitResult fit = fitter.fit(table), from_table = fitter.fit(without);
     if (!fit.ok() || !from_table.ok() || !fit.anisotropic) throw Error("UTIA fit failed: " + fit.problem + from_table.problem);
-    const AnisotropicAlpha& a = fit.anisotropic->ggx;
+    const AnisotropicAlpha& a = fit.anisotropic->alpha_ggx;
     // An isotropic lobe has no axis: its angle is whatever the eigen-decomposition returns.
     const std::string angle = a.alpha_x > 1.001 * a.alpha_y ? format("%.2f deg", a.angle * 180.0 / kPi) : "no axis (isotropic)";
     md << format("| %.2f x %.2f at %.1f deg | %s | %.4f | %.4f | %.4f, %.4f, %s |\n", c.alpha_x, c.alpha_y, c.degrees, to_string(c.smith),

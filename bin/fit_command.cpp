@@ -31,7 +31,8 @@ void print_row(const std::string& source, const FitResult& r, double seconds) {
               r.extraction.residual, seconds * 1e3);
   if (const auto& a = r.anisotropic)
     std::printf("%-28s  anisotropic: ggx %.4f x %.4f, beckmann %.4f x %.4f, x axis at %.1f degrees (the row above: the azimuthal mean)\n", "",
-                a->ggx.alpha_x, a->ggx.alpha_y, a->beckmann.alpha_x, a->beckmann.alpha_y, a->ggx.angle * 180.0 / kPi);
+                a->ggx.alpha.alpha_x, a->ggx.alpha.alpha_y, a->beckmann.alpha.alpha_x, a->beckmann.alpha.alpha_y,
+                a->ggx.alpha.angle * 180.0 / kPi);
 }
 
 void run_fit(const FitArgs& args, Context& ctx) {

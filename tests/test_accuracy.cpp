@@ -103,13 +103,13 @@ TEST(Utia, LoadsAsItsAzimuthalMeanForTheIsotropicFit) {
   // Beside it, the 2D extraction of the file's own back-scattering (fit/extract_2d.h): its principal
   // alphas and angle, within the UTIA bar (3%); an isotropic file gets equal alphas.
   ASSERT_TRUE(a.anisotropic && b.anisotropic);
-  std::cout << "anisotropic fit: " << b.anisotropic->ggx.alpha_x << " x " << b.anisotropic->ggx.alpha_y << " at "
-            << b.anisotropic->ggx.angle * 180.0 / kPi << " degrees; isotropic file " << a.anisotropic->ggx.alpha_x << " x "
-            << a.anisotropic->ggx.alpha_y << "\n";
-  EXPECT_NEAR(b.anisotropic->ggx.alpha_x, 0.45, 0.03 * 0.45);
-  EXPECT_NEAR(b.anisotropic->ggx.alpha_y, 0.2, 0.03 * 0.2);
-  EXPECT_NEAR(b.anisotropic->ggx.angle, 0.6, 2.0 * kPi / 180.0);
-  EXPECT_NEAR(a.anisotropic->ggx.alpha_x, a.anisotropic->ggx.alpha_y, 1e-3 * a.anisotropic->ggx.alpha_x);
+  std::cout << "anisotropic fit: " << b.anisotropic->alpha_ggx.alpha_x << " x " << b.anisotropic->alpha_ggx.alpha_y << " at "
+            << b.anisotropic->alpha_ggx.angle * 180.0 / kPi << " degrees; isotropic file " << a.anisotropic->alpha_ggx.alpha_x << " x "
+            << a.anisotropic->alpha_ggx.alpha_y << "\n";
+  EXPECT_NEAR(b.anisotropic->alpha_ggx.alpha_x, 0.45, 0.03 * 0.45);
+  EXPECT_NEAR(b.anisotropic->alpha_ggx.alpha_y, 0.2, 0.03 * 0.2);
+  EXPECT_NEAR(b.anisotropic->alpha_ggx.angle, 0.6, 2.0 * kPi / 180.0);
+  EXPECT_NEAR(a.anisotropic->alpha_ggx.alpha_x, a.anisotropic->alpha_ggx.alpha_y, 1e-3 * a.anisotropic->alpha_ggx.alpha_x);
   EXPECT_NE(test::error_of([&] { load_table(dir.file("nothing.bin")); }).find("nothing.bin"), std::string::npos);
 }
 

@@ -147,7 +147,15 @@ TEST(Lut, AnisotropicLobeRoundTrip) {
   EXPECT_EQ(lut.meta.format_version, kLutAnisotropicVersion);
   ASSERT_TRUE(lut.anisotropic);
   EXPECT_EQ(lut.anisotropic->phi_count, 48);
-  EXPECT_NEAR(lut.meta.anisotropic_ggx.alpha_x, fit.anisotropic->ggx.alpha_x, 1e-6);
+  const AnisotropicParametricFit &g = lut.meta.anisotropic_ggx, &want = fit.anisotropic->ggx;
+  EXPECT_NEAR(g.alpha.alpha_x, want.alpha.alpha_x, 1e-6);
+  EXPECT_NEAR(g.alpha.alpha_y, want.alpha.alpha_y, 1e-6);
+  EXPECT_NEAR(g.alpha.angle, want.alpha.angle, 1e-6);
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_NEAR(g.body[c], want.body[c], 1e-6);
+    EXPECT_NEAR(g.f0[c], want.f0[c], 1e-6);
+    EXPECT_NEAR(g.f82[c], want.f82[c], 1e-6);
+  }
   const TabulatedAnisotropic in_memory(*baked.anisotropic), read_back(*lut.anisotropic);
   for (const auto& [o, i] : {std::pair{spherical_direction(0.3, 0.2), spherical_direction(0.5, 3.0)},
                             {spherical_direction(1.1, 1.0), spherical_direction(0.9, 4.5)}}) {

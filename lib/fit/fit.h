@@ -48,7 +48,13 @@ std::optional<FitOptions::Refine> parse_refine(const std::string& name);
 // UTIA file, an anisotropic RGL file): its principal roughness in each family, and its tables, which
 // with the paper's Fresnel curve make the anisotropic tabulated lobe (model/tabulated_anisotropic.h).
 struct AnisotropicFit {
-  AnisotropicAlpha ggx, beckmann;
+  AnisotropicAlpha alpha_ggx, alpha_beckmann;  // moment estimates of the 2D NDF (fit/extract_2d.h)
+  // Anisotropic GGX and Beckmann lobes with a body (fit/parametric_fit.h): with Refine::full, fitted on the
+  // source's half/difference lattice (MerlTable::source_half_diff) from the moment estimates and the
+  // isotropic fit's body and Fresnel; with Refine::none, or with no lattice, the moment estimates with the
+  // paper's Fresnel at 0 and 82 degrees, no body (error 0: nothing measured).
+  AnisotropicParametricFit ggx, beckmann;
+  bool refined = false;
   int iterations = 0;
   double residual = 0.0;
   AnisotropicTables tables;
@@ -96,6 +102,8 @@ class Fitter {
  private:
   // --refine full: the parametric fits and the body + tabulated lobe on the whole measurement.
   void refine_on_measurement(const MerlTable& table, FitResult& result) const;
+  // The anisotropic GGX and Beckmann lobes of `a` (AnisotropicFit::ggx, beckmann) from its moment alphas.
+  void fit_anisotropic_lobes(const MerlTable& table, const FresnelCurve& paper_fresnel, const FitResult& result, AnisotropicFit& a) const;
 
   FitOptions options_;
   Quadrature quadrature_;

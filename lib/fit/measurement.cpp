@@ -6,13 +6,47 @@
 
 namespace facetfit {
 
+namespace {
+
+// Appends one bin: its directions, the cell's measure in the parameterization (times cos(theta_i)
+// cos(theta_o) here, see measurement.h) and the measurement, NaN where a channel is missing. Returns the
+// measure it added to the total, 0 for a bin left out (below the horizon, nothing measured).
+double add_bin(MeasuredBins& bins, const Vec3& wi, const Vec3& wo, double cos_h, double cos_d, double measure, const Rgb& measured) {
+  if (wi.z <= 1e-6 || wo.z <= 1e-6) return 0.0;
+  std::uint8_t valid = 0;
+  Rgb v(0.0);
+  for (int c = 0; c < 3; ++c)
+    if (!std::isnan(measured[c])) valid |= std::uint8_t(1u << c), v[c] = measured[c];
+  if (!valid) return 0.0;
+  const double cos_mean = 0.5 * (wi.z + wo.z);
+  Rgb lightness(0.0);
+  for (int c = 0; c < 3; ++c)
+    if (valid >> c & 1u) lightness[c] = metric_transform(v[c] * cos_mean);
+  bins.i.push_back(wi);
+  bins.o.push_back(wo);
+  bins.cos_mean.push_back(cos_mean);
+  bins.cos_h.push_back(cos_h);
+  bins.cos_d.push_back(cos_d);
+  bins.lightness.push_back(lightness);
+  bins.weight.push_back(measure * wi.z * wo.z);
+  bins.value.push_back(v);
+  bins.valid.push_back(valid);
+  return measure;
+}
+
+void normalize_weights(MeasuredBins& bins, double total) {
+  if (total > 0.0)
+    for (double& w : bins.weight) w /= total;
+}
+
+}  // namespace
+
 MeasuredBins measured_bins(const MerlTable& table, int stride_d, int stride_phi) {
   MeasuredBins bins;
   double total = 0.0;
   for (int i = 0; i < MerlTable::kThetaH; ++i) {
     // The cell's measure, 4 cos(theta_d) sin(theta_d) sin(theta_h) dtheta_h dtheta_d dphi_d (the Jacobian of
     // the half/difference parameterization), at the cell's centre; theta_h = u^2 pi/2, so dtheta_h = u pi du.
-    // Each bin then weighs by cos(theta_i) cos(theta_o) too (below).
     const double u = (i + 0.5) / MerlTable::kThetaH;
     const double theta_h_mid = u * u * 0.5 * kPi;
     const double h_measure = std::sin(theta_h_mid) * u * kPi;
@@ -22,34 +56,37 @@ MeasuredBins measured_bins(const MerlTable& table, int stride_d, int stride_phi)
       MeasuredBins::Row row{i, j, bins.size(), bins.size()};
       for (int k = 0; k < MerlTable::kPhiD; k += stride_phi) {
         const auto [wi, wo] = from_half_diff(MerlTable::theta_h(i), MerlTable::theta_d(j), MerlTable::phi_d(k));
-        if (wi.z <= 1e-6 || wo.z <= 1e-6) continue;
-        std::uint8_t valid = 0;
-        Rgb v(0.0);
-        for (int c = 0; c < 3; ++c) {
-          const float x = table.value(c, i, j, k);
-          if (!MerlTable::missing(x)) valid |= std::uint8_t(1u << c), v[c] = x;
-        }
-        if (!valid) continue;
-        bins.i.push_back(wi);
-        bins.o.push_back(wo);
-        bins.cos_mean.push_back(0.5 * (wi.z + wo.z));
-        bins.cos_h.push_back(std::cos(MerlTable::theta_h(i)));
-        bins.cos_d.push_back(std::cos(MerlTable::theta_d(j)));
-        Rgb lightness(0.0);
-        for (int c = 0; c < 3; ++c)
-          if (valid >> c & 1u) lightness[c] = metric_transform(v[c] * bins.cos_mean.back());
-        bins.lightness.push_back(lightness);
-        bins.weight.push_back(measure * wi.z * wo.z);
-        bins.value.push_back(v);
-        bins.valid.push_back(valid);
-        total += measure;
+        Rgb v;
+        for (int c = 0; c < 3; ++c) v[c] = table.value(c, i, j, k);  // missing: NaN (MerlTable::missing)
+        total += add_bin(bins, wi, wo, std::cos(MerlTable::theta_h(i)), std::cos(MerlTable::theta_d(j)), measure, v);
       }
       row.end = bins.size();
       if (row.end > row.begin) bins.rows.push_back(row);
     }
   }
-  if (total > 0.0)
-    for (double& w : bins.weight) w /= total;
+  normalize_weights(bins, total);
+  return bins;
+}
+
+MeasuredBins measured_bins(const HalfDiffLattice& lattice, int stride) {
+  using L = HalfDiffLattice;
+  MeasuredBins bins;
+  if (lattice.empty()) return bins;
+  double total = 0.0;
+  for (int h = 0; h < L::kThetaH; ++h)
+    for (int d = 0; d < L::kThetaD; ++d) {
+      MeasuredBins::Row row{h, d, bins.size(), bins.size()};
+      // Strided over the whole (phi_h, phi_d) square, so every azimuth of the half vector is kept.
+      for (int a = (h + d) % stride; a < L::kPhiH * L::kPhiD; a += stride) {
+        const int ph = a / L::kPhiD, pd = a % L::kPhiD;
+        const auto [wi, wo] = L::directions(h, ph, d, pd);
+        total += add_bin(bins, wi, wo, std::cos(L::theta_h(h)), std::cos(L::theta_d(d)), L::measure(h, d),
+                         lattice.value[L::index(h, ph, d, pd)]);
+      }
+      row.end = bins.size();
+      if (row.end > row.begin) bins.rows.push_back(row);
+    }
+  normalize_weights(bins, total);
   return bins;
 }
 

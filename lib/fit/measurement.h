@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "core/brdf.h"
+#include "io/half_diff_lattice.h"
 #include "io/merl.h"
 
 namespace facetfit {
@@ -26,11 +27,11 @@ namespace facetfit {
 struct MeasuredBins {
   // Bins of one (theta_h, theta_d) row of the table: entries [begin, end) of the arrays below.
   struct Row {
-    int theta_h = 0, theta_d = 0;  // MERL bin indices
+    int theta_h = 0, theta_d = 0;  // MERL bin indices (a half/difference lattice's, for its bins)
     std::size_t begin = 0, end = 0;
   };
   std::vector<Row> rows;
-  std::vector<Vec3> i, o;           // directions of each bin (phi_h = 0)
+  std::vector<Vec3> i, o;           // directions of each bin (MERL bins: phi_h = 0)
   std::vector<double> cos_mean;     // c = (cos theta_i + cos theta_o) / 2
   std::vector<double> cos_h, cos_d; // cos theta_h, cos theta_d (= i . h)
   std::vector<double> weight;       // measure weight; the weights sum to one
@@ -44,6 +45,11 @@ struct MeasuredBins {
 // Every valid bin with both directions above the horizon, theta_d and phi_d taken every `stride_d` and
 // `stride_phi` bins (theta_h: every bin). Empty when the table has no valid bin.
 MeasuredBins measured_bins(const MerlTable& table, int stride_d, int stride_phi);
+
+// The nodes of an anisotropic source's lattice (io/half_diff_lattice.h), every `stride`-th of each
+// (theta_h, theta_d) row's phi_h x phi_d nodes (the start staggered from row to row); a row is one
+// (theta_h, theta_d) pair of lattice indices. Empty for an empty lattice.
+MeasuredBins measured_bins(const HalfDiffLattice& lattice, int stride);
 
 // The bin sets of the fits: the tabulated lobe's refinement solves on the sparse one (6.4k bins: the
 // fitted distances move by < 1% between 93k bins and this), the parametric fits (8 to 12 unknowns) on

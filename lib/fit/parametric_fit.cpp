@@ -8,10 +8,23 @@
 
 #include "model/fresnel.h"
 #include "model/parametric.h"
+#include "model/rotated.h"
 
 namespace facetfit {
 
 namespace {
+
+// The parametric fits' solve: a dense problem of 8 to 13 unknowns.
+void solve(ceres::Problem& problem, int max_iterations) {
+  if (max_iterations <= 0) return;
+  ceres::Solver::Options options;
+  options.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
+  options.max_num_iterations = max_iterations;
+  options.function_tolerance = 1e-6;
+  options.logging_type = ceres::SILENT;
+  ceres::Solver::Summary summary;
+  ceres::Solve(options, &problem, &summary);
+}
 
 // A value and its derivative with respect to alpha.
 struct WithSlope {
@@ -236,13 +249,7 @@ ParametricFit fit_parametric(const MeasuredBins& bins, const MeasuredBins& error
     problem.SetParameterBlockConstant(coat);
   }
 
-  ceres::Solver::Options options;
-  options.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
-  options.max_num_iterations = max_iterations;
-  options.function_tolerance = 1e-6;
-  options.logging_type = ceres::SILENT;
-  ceres::Solver::Summary summary;
-  if (max_iterations > 0) ceres::Solve(options, &problem, &summary);
+  solve(problem, max_iterations);
 
   fit.body = Rgb(body[0], body[1], body[2]);
   fit.alpha = std::exp(log_alpha[0]);
@@ -250,6 +257,80 @@ ParametricFit fit_parametric(const MeasuredBins& bins, const MeasuredBins& error
   fit.f82 = fit.fresnel == ParametricFit::FresnelForm::f82 ? Rgb(f82[0], f82[1], f82[2])
                                                            : fresnel_schlick(fit.f0, 1.0 / 7.0);
   if (with_coat) fit.coat = Coat{std::exp(coat[0]), coat[1]};
+  fit.error = parametric_error(error_bins, smith, fit);
+  return fit;
+}
+
+namespace {
+
+// The anisotropic model's residuals over one row of bins (3 per bin). Parameter blocks: body (3), shape
+// (log alpha_x, log alpha_y, angle), f0 (3), f82 (3). Differentiated numerically: the model is the
+// library's own BRDF, so what is fitted is what is measured and rendered.
+struct AnisotropicRow {
+  const MeasuredBins* bins;
+  const MeasuredBins::Row* row;
+  NdfType type;
+  Smith smith;
+
+  bool operator()(const double* body, const double* shape, const double* f0, const double* f82, double* residuals) const {
+    const ParametricBrdf lobe(Ndf{type, std::exp(shape[0]), std::exp(shape[1])}, smith, Rgb(f0[0], f0[1], f0[2]),
+                              Rgb(f82[0], f82[1], f82[2]), Rgb(body[0], body[1], body[2]));
+    const RotatedBrdf model(lobe, shape[2]);
+    for (std::size_t k = row->begin; k < row->end; ++k) {
+      const Rgb m = model.eval(bins->o[k], bins->i[k]).value_or(Rgb(0.0));
+      const double w = std::sqrt(bins->weight[k]);
+      for (int e = 0; e < 3; ++e)
+        residuals[3 * (k - row->begin) + std::size_t(e)] =
+            (bins->valid[k] >> e & 1u) ? w * metric_residual(m[e], bins->cos_mean[k], bins->lightness[k][e]).value : 0.0;
+    }
+    return true;
+  }
+};
+
+// The same axes named so that alpha_x >= alpha_y, the angle in (-pi/2, pi/2].
+AnisotropicAlpha principal(double alpha_x, double alpha_y, double angle) {
+  if (alpha_y > alpha_x) std::swap(alpha_x, alpha_y), angle += 0.5 * kPi;
+  angle = std::remainder(angle, kPi);  // [-pi/2, pi/2]
+  if (angle <= -0.5 * kPi) angle += kPi;
+  return {alpha_x, alpha_y, angle};
+}
+
+}  // namespace
+
+double parametric_error(const MeasuredBins& bins, Smith smith, const AnisotropicParametricFit& fit) {
+  const ParametricBrdf lobe(Ndf{fit.type, fit.alpha.alpha_x, fit.alpha.alpha_y}, smith, fit.f0, fit.f82, fit.body);
+  return measurement_error(bins, RotatedBrdf(lobe, fit.alpha.angle));
+}
+
+AnisotropicParametricFit fit_parametric_anisotropic(const MeasuredBins& bins, const MeasuredBins& error_bins, Smith smith,
+                                                    const AnisotropicParametricFit& start, int max_iterations) {
+  AnisotropicParametricFit fit = start;
+  double body[3] = {start.body.r, start.body.g, start.body.b};
+  double shape[3] = {std::log(std::max(start.alpha.alpha_x, 1e-3)), std::log(std::max(start.alpha.alpha_y, 1e-3)), start.alpha.angle};
+  double f0[3] = {start.f0.r, start.f0.g, start.f0.b};
+  double f82[3] = {start.f82.r, start.f82.g, start.f82.b};
+  if (bins.rows.empty()) return fit;
+  ceres::Problem problem;
+  for (const MeasuredBins::Row& row : bins.rows) {
+    auto* cost = new ceres::NumericDiffCostFunction<AnisotropicRow, ceres::CENTRAL, ceres::DYNAMIC, 3, 3, 3, 3>(
+        new AnisotropicRow{&bins, &row, start.type, smith}, ceres::TAKE_OWNERSHIP, int(3 * (row.end - row.begin)));
+    problem.AddResidualBlock(cost, nullptr, body, shape, f0, f82);
+  }
+  for (int a = 0; a < 2; ++a) {
+    problem.SetParameterLowerBound(shape, a, std::log(1e-3));
+    problem.SetParameterUpperBound(shape, a, std::log(4.0));
+  }
+  for (double* p : {body, f0, f82})
+    for (int c = 0; c < 3; ++c) problem.SetParameterLowerBound(p, c, 0.0);
+  for (double* p : {f0, f82})
+    for (int c = 0; c < 3; ++c) problem.SetParameterUpperBound(p, c, 1.0);
+
+  solve(problem, max_iterations);
+
+  fit.body = Rgb(body[0], body[1], body[2]);
+  fit.alpha = principal(std::exp(shape[0]), std::exp(shape[1]), shape[2]);
+  fit.f0 = Rgb(f0[0], f0[1], f0[2]);
+  fit.f82 = Rgb(f82[0], f82[1], f82[2]);
   fit.error = parametric_error(error_bins, smith, fit);
   return fit;
 }

@@ -10,6 +10,7 @@
 
 #include <string>
 
+#include "fit/extract_2d.h"
 #include "fit/measurement.h"
 #include "model/coat.h"
 #include "model/ndf.h"
@@ -40,5 +41,24 @@ double parametric_jacobian_error(const MeasuredBins& bins, Smith smith, const Pa
 
 // The fit's distance from the measurement (measurement_error of its BRDF).
 double parametric_error(const MeasuredBins& bins, Smith smith, const ParametricFit& fit);
+
+// An anisotropic lobe with a body, fitted on an anisotropic source's lattice (io/half_diff_lattice.h):
+//   f(o, i) = body / pi + F(theta_d) D(h') G2(o', i') / (4 cos theta_i cos theta_o),
+// primes the directions in the frame whose x axis lies at `alpha.angle`, D the family's (alpha_x, alpha_y)
+// distribution, F the F82-tint model (the form an anisotropic closure takes).
+struct AnisotropicParametricFit {
+  NdfType type = NdfType::ggx;
+  AnisotropicAlpha alpha;  // alpha_x >= alpha_y, angle in (-pi/2, pi/2]
+  Rgb body{0.0}, f0{0.0}, f82{0.0};
+  double error = 0.0;  // measurement_error of the fit
+};
+
+// Least squares in the metric of fit/measurement.h from `start` (its principal alphas > 0; body, f0, f82
+// in [0, 1]), derivatives by central differences (13 unknowns). The error is measured on `error_bins`.
+AnisotropicParametricFit fit_parametric_anisotropic(const MeasuredBins& bins, const MeasuredBins& error_bins, Smith smith,
+                                                    const AnisotropicParametricFit& start, int max_iterations = 50);
+
+// The fit's distance from the measurement (measurement_error of its BRDF).
+double parametric_error(const MeasuredBins& bins, Smith smith, const AnisotropicParametricFit& fit);
 
 }  // namespace facetfit

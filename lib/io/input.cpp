@@ -92,12 +92,14 @@ MerlTable table_of(const Brdf& source) {
   if (const auto* utia = dynamic_cast<const UtiaBrdf*>(&source)) {
     MerlTable table = MerlTable::tabulate(utia->azimuthal_mean());
     table.set_source_backscatter(utia->backscatter());
+    table.set_source_half_diff(HalfDiffLattice::of(*utia));
     return table;
   }
   // Anisotropic RGL: the same, the lattice read through the file's evaluation (90 polar angles, 64 azimuths).
   if (const auto* rgl = dynamic_cast<const RglBsdf*>(&source); rgl && rgl->anisotropic()) {
     MerlTable table = MerlTable::tabulate(AzimuthalMean(*rgl));
     table.set_source_backscatter(rgl->backscatter(90, 64));
+    table.set_source_half_diff(HalfDiffLattice::of(*rgl));
     return table;
   }
   return MerlTable::tabulate(source);

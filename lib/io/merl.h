@@ -16,6 +16,7 @@
 
 #include "core/brdf.h"
 #include "io/backscatter_lattice.h"
+#include "io/half_diff_lattice.h"
 
 namespace facetfit {
 
@@ -79,6 +80,10 @@ class MerlTable final : public Brdf {
   // is, a table resampled or written as MERL (centres_to_edges, write) does not carry it.
   const BackscatterLattice& source_backscatter() const { return source_backscatter_; }
   void set_source_backscatter(BackscatterLattice lattice) { source_backscatter_ = std::move(lattice); }
+  // An anisotropic source at nodes over the half vector's azimuth too (io/half_diff_lattice.h): what its
+  // anisotropic fits are measured against. Empty for every other source; carried like source_backscatter.
+  const HalfDiffLattice& source_half_diff() const { return source_half_diff_; }
+  void set_source_half_diff(HalfDiffLattice lattice) { source_half_diff_ = std::move(lattice); }
 
  private:
   std::optional<Rgb> eval_nearest(double x_h, double x_d, double x_p) const;
@@ -106,6 +111,7 @@ class MerlTable final : public Brdf {
 
   std::vector<float, UninitializedAllocator<float>> data_;  // 3 * kBins, channel-planar as in the file
   BackscatterLattice source_backscatter_;
+  HalfDiffLattice source_half_diff_;
   Lookup lookup_ = Lookup::linear;
 };
 

@@ -201,12 +201,15 @@ void write_lut(const std::string& path, const Lut& lut) {
   if (lut.anisotropic) {
     spec.attribute(key("anisotropic_resolution"), m.anisotropic_resolution);
     spec.attribute(key("anisotropic_phi_count"), m.anisotropic_phi_count);
-    spec.attribute(key("anisotropic_ggx_alpha_x"), float(m.anisotropic_ggx.alpha_x));
-    spec.attribute(key("anisotropic_ggx_alpha_y"), float(m.anisotropic_ggx.alpha_y));
-    spec.attribute(key("anisotropic_ggx_angle"), float(m.anisotropic_ggx.angle));
-    // The lobe's Fresnel at 0 and 82 degrees, for a closure that takes F82-tint (the OSL material shader).
-    set_color(spec, "anisotropic_f0", lut.anisotropic->fresnel.value[0]);
-    set_color(spec, "anisotropic_f82", lut.anisotropic->fresnel.eval(f82_theta()));
+    // The anisotropic GGX fit, what an anisotropic closure takes (the OSL material shader).
+    const AnisotropicParametricFit& g = m.anisotropic_ggx;
+    spec.attribute(key("anisotropic_ggx_alpha_x"), float(g.alpha.alpha_x));
+    spec.attribute(key("anisotropic_ggx_alpha_y"), float(g.alpha.alpha_y));
+    spec.attribute(key("anisotropic_ggx_angle"), float(g.alpha.angle));
+    set_color(spec, "anisotropic_ggx_body", g.body);
+    set_color(spec, "anisotropic_ggx_f0", g.f0);
+    set_color(spec, "anisotropic_ggx_f82", g.f82);
+    spec.attribute(key("anisotropic_ggx_error"), float(g.error));
   }
   // One line per warning; absent when there is none.
   if (!m.warnings.empty()) {
@@ -241,9 +244,12 @@ void validate(const std::string& path, const LutMetadata& m) {
     for (int k = 0; k < 3; ++k) in_range(name, c[k], 0.0, hi);
   };
   in_range("alpha_ggx", m.alpha_ggx, 0.0, 10.0);
-  in_range("anisotropic_ggx_alpha_x", m.anisotropic_ggx.alpha_x, 0.0, 10.0);
-  in_range("anisotropic_ggx_alpha_y", m.anisotropic_ggx.alpha_y, 0.0, 10.0);
-  in_range("anisotropic_ggx_angle", m.anisotropic_ggx.angle, -kPi, kPi);
+  in_range("anisotropic_ggx_alpha_x", m.anisotropic_ggx.alpha.alpha_x, 0.0, 10.0);
+  in_range("anisotropic_ggx_alpha_y", m.anisotropic_ggx.alpha.alpha_y, 0.0, 10.0);
+  in_range("anisotropic_ggx_angle", m.anisotropic_ggx.alpha.angle, -kPi, kPi);
+  colour("anisotropic_ggx_body", m.anisotropic_ggx.body, 1e3);
+  colour("anisotropic_ggx_f0", m.anisotropic_ggx.f0, 1e3);
+  colour("anisotropic_ggx_f82", m.anisotropic_ggx.f82, 1e3);
   in_range("alpha_beckmann", m.alpha_beckmann, 0.0, 10.0);
   colour("f0", m.f0, 1e3);  // an implausible measurement may give F > 1: baked with a warning, kept finite
   colour("f82", m.f82, 1e3);
@@ -346,8 +352,14 @@ Lut read_lut(const std::string& path) {
         m.anisotropic_phi_count > 4096 || m.anisotropic_phi_count % 2 != 0)
       fail(path, "facetfit:anisotropic_resolution or facetfit:anisotropic_phi_count is missing or out of range (" +
                      std::to_string(m.anisotropic_resolution) + ", " + std::to_string(m.anisotropic_phi_count) + ")");
-    m.anisotropic_ggx = {spec.get_float_attribute(key("anisotropic_ggx_alpha_x")), spec.get_float_attribute(key("anisotropic_ggx_alpha_y")),
-                         spec.get_float_attribute(key("anisotropic_ggx_angle"))};
+    AnisotropicParametricFit& g = m.anisotropic_ggx;
+    g.alpha = {spec.get_float_attribute(key("anisotropic_ggx_alpha_x")), spec.get_float_attribute(key("anisotropic_ggx_alpha_y")),
+               spec.get_float_attribute(key("anisotropic_ggx_angle"))};
+    const auto g_body = get_color(spec, "anisotropic_ggx_body"), g_f0 = get_color(spec, "anisotropic_ggx_f0"),
+               g_f82 = get_color(spec, "anisotropic_ggx_f82");
+    if (!g_body || !g_f0 || !g_f82) fail(path, "facetfit LUT version 3 without facetfit:anisotropic_ggx_body, _f0 or _f82");
+    g.body = *g_body, g.f0 = *g_f0, g.f82 = *g_f82;
+    g.error = spec.get_float_attribute(key("anisotropic_ggx_error"));
   }
   validate(path, m);
   const LutLayout layout = LutLayout::of(m.resolution, m.sampling, m.anisotropic_resolution, m.anisotropic_phi_count);

@@ -54,9 +54,10 @@ struct LutMetadata {
   Representation representation = Representation::tabulated;
   double tolerance = 0.0;  // the NDF error a parametric fit was allowed when choosing the representation
   bool sampling = true;    // sampling tables present (absent with --eval-only)
-  // The anisotropic lobe (version 3): its grid's resolution and azimuths (0: none), principal GGX alphas.
+  // The anisotropic lobe (version 3): its grid's resolution and azimuths (0: none), and the anisotropic
+  // GGX fit (fit/fit.h, AnisotropicFit::ggx: principal alphas, axis, body, F82-tint Fresnel).
   int anisotropic_resolution = 0, anisotropic_phi_count = 0;
-  AnisotropicAlpha anisotropic_ggx;
+  AnisotropicParametricFit anisotropic_ggx;
   std::vector<std::string> warnings;  // implausible values found when fitting (fit/plausibility.h)
 };
 

@@ -46,8 +46,14 @@ nlohmann::json fit_record(const std::string& source, const FitResult& fit, doubl
       const auto principal = [](const AnisotropicAlpha& p) {
         return nlohmann::json{{"alpha_x", p.alpha_x}, {"alpha_y", p.alpha_y}, {"angle_degrees", p.angle * 180.0 / kPi}};
       };
-      j["anisotropic"] = {{"ggx", principal(a->ggx)}, {"beckmann", principal(a->beckmann)}, {"iterations", a->iterations},
-                          {"residual", a->residual}};
+      const auto lobe = [&](const AnisotropicParametricFit& p) {
+        nlohmann::json l = principal(p.alpha);
+        l["body"] = rgb(p.body), l["f0"] = rgb(p.f0), l["f82"] = rgb(p.f82), l["error"] = p.error;
+        return l;
+      };
+      j["anisotropic"] = {{"alpha_ggx", principal(a->alpha_ggx)}, {"alpha_beckmann", principal(a->alpha_beckmann)},
+                          {"ggx", lobe(a->ggx)}, {"beckmann", lobe(a->beckmann)}, {"refine", a->refined ? "full" : "none"},
+                          {"iterations", a->iterations}, {"residual", a->residual}};
     }
   } else {
     for (const char* k : {"alpha_ggx", "alpha_beckmann", "f0", "f82"}) j[k] = nullptr;

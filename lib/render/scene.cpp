@@ -18,6 +18,7 @@
 #include "model/analytic.h"
 #include "model/builtin.h"
 #include "model/parametric.h"
+#include "model/rotated.h"
 
 namespace facetfit {
 
@@ -113,11 +114,12 @@ MaterialDesc parse_material(const std::string& name, const json& j, const std::s
   if (!smith) fail(path, "material " + name + ": smith must be masking, correlated or separable");
   m.smith = *smith;
   if (j.contains("albedo")) m.albedo = nonnegative(j["albedo"], "material " + name + ": albedo", path);
-  if (j.contains("tangent") && m.type != "lut" && m.type != "measured")
-    fail(path, "material " + name + ": \"tangent\" is for lut and measured materials (an anisotropic measurement turns with it)");
+  if (j.contains("tangent") && m.type != "lut" && m.type != "measured" && m.type != "ggx")
+    fail(path, "material " + name + ": \"tangent\" is for lut, ggx and measured materials (an anisotropic fit or measurement turns with it)");
   if (j.contains("tangent")) m.tangent = direction(j["tangent"], "material " + name + ": tangent", path);
   if (j.contains("anisotropic")) {
-    if (m.type != "lut" || !j["anisotropic"].is_boolean()) fail(path, "material " + name + ": \"anisotropic\" is true or false, for lut materials");
+    if ((m.type != "lut" && m.type != "ggx") || !j["anisotropic"].is_boolean())
+      fail(path, "material " + name + ": \"anisotropic\" is true or false, for lut and ggx materials");
     m.anisotropic = j["anisotropic"].get<bool>();
   }
   if (j.contains("stretch") || j.contains("rotation") || j.contains("stretch_texture")) {
@@ -318,9 +320,22 @@ std::shared_ptr<const TabulatedMicrofacet> sampled_lut_model(Lut lut) {
 
 }  // namespace
 
-std::shared_ptr<const ShadingModel> lut_parametric_model(const Lut& lut, const std::string& family, Smith smith, bool fresnel_curve) {
+std::shared_ptr<const ShadingModel> lut_parametric_model(const Lut& lut, const std::string& family, Smith smith, bool fresnel_curve,
+                                                         bool anisotropic) {
   const LutMetadata::Parametric* p = lut.meta.fit(family);
   if (!p) fail("family '" + family + "'", "must be ggx, beckmann or lsq");
+  if (anisotropic && family == "ggx" && lut.anisotropic) {
+    // The anisotropic GGX fit with its body; the proposal is the isotropic GGX of the same area (alpha_x
+    // alpha_y), tabulated like the one below: the axes change which directions are likely, not coverage.
+    const AnisotropicParametricFit& g = lut.meta.anisotropic_ggx;
+    const auto lobe = std::make_shared<ParametricBrdf>(Ndf{NdfType::ggx, g.alpha.alpha_x, g.alpha.alpha_y}, smith, g.f0, g.f82, g.body);
+    MicrofacetTables tables;
+    tables.smith = smith;
+    tables.ndf = tabulate_ndf(Ndf::isotropic(NdfType::ggx, std::sqrt(g.alpha.alpha_x * g.alpha.alpha_y)));
+    std::fill(tables.fresnel.value.begin(), tables.fresnel.value.end(), g.f0);
+    tables.body = g.body;
+    return std::make_shared<ShadingModel>(std::make_shared<RotatedBrdf>(lobe, g.alpha.angle), std::make_shared<TabulatedMicrofacet>(tables));
+  }
   // The LUT's fit of this family on the whole measurement: its alpha, body and coat, with its own F82-tint
   // (lsq: Schlick) Fresnel or the tabulated curve.
   const Ndf ndf = Ndf::isotropic(family == "beckmann" ? NdfType::beckmann : NdfType::ggx, p->alpha);
@@ -396,7 +411,7 @@ std::shared_ptr<const ShadingModel> load_material(const SceneDesc& scene, const 
   // ggx | beckmann | lsq (the LUT's classical baseline: Lambert + GGX + Schlick); nothing else renders as them
   if (m.type != "ggx" && m.type != "beckmann" && m.type != "lsq")
     fail("material type '" + m.type + "'", "must be measured, lut, ggx, beckmann, lsq, lambert or analytic");
-  if (!m.file.empty()) return lut_parametric_model(read_lut(resolve(scene, m.file)), m.type, m.smith, m.fresnel == "curve");
+  if (!m.file.empty()) return lut_parametric_model(read_lut(resolve(scene, m.file)), m.type, m.smith, m.fresnel == "curve", m.anisotropic);
   const Ndf ndf = Ndf::isotropic(m.type == "beckmann" ? NdfType::beckmann : NdfType::ggx, m.alpha);
   // The proposal samples the lobe, weighted by f0: GGX's visible normals in closed form (model/proposal.h),
   // Beckmann's tabulated.

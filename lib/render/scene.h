@@ -58,7 +58,7 @@ struct MaterialDesc {
   // coordinates, and how it is read), for spheres and planes.
   std::string stretch_texture;
   // lut: a LUT with an anisotropic lobe (version 3, from an anisotropic input) renders it, along the
-  // tangent; false renders its isotropic representation instead.
+  // tangent, and ggx with such a LUT its anisotropic GGX fit; false renders the isotropic representation.
   bool anisotropic = true;
 };
 
@@ -103,8 +103,10 @@ struct Lut;
 
 // One of the parametric fits a LUT carries ("ggx", "beckmann" or "lsq") as a shading model, evaluated
 // with `smith`, with the fit's F82-tint (lsq: Schlick) Fresnel or, with `fresnel_curve`, the LUT's curve.
-// Throws Error for another family.
-std::shared_ptr<const ShadingModel> lut_parametric_model(const Lut& lut, const std::string& family, Smith smith, bool fresnel_curve);
+// Throws Error for another family. With `anisotropic`, a version 3 LUT's ggx is its anisotropic GGX fit
+// (LutMetadata::anisotropic_ggx), in the shading frame whose x axis is the tangent.
+std::shared_ptr<const ShadingModel> lut_parametric_model(const Lut& lut, const std::string& family, Smith smith, bool fresnel_curve,
+                                                         bool anisotropic = false);
 
 // The shading model of a material: loads its file (and fits or tabulates what sampling needs).
 std::shared_ptr<const ShadingModel> load_material(const SceneDesc& scene, const MaterialDesc& m);

@@ -13,6 +13,7 @@
 #include "fit/fit.h"
 #include "model/fresnel.h"
 #include "model/ndf.h"
+#include "model/rotated.h"
 
 namespace facetfit {
 
@@ -39,18 +40,6 @@ std::vector<GroundTruthCase> standard_ground_truth_cases();
 // Tabulates the case into a MERL table (through `merl_path` on disk when not empty, exercising the
 // writer and reader) and fits it with `fitter`.
 GroundTruthError measure_ground_truth(const GroundTruthCase& c, const Fitter& fitter, const std::string& merl_path = "");
-
-// A BRDF with its frame turned by `angle` about the normal: the analytic models are axis-aligned.
-class RotatedBrdf final : public Brdf {
- public:
-  RotatedBrdf(const Brdf& base, double angle) : base_(base), c_(std::cos(angle)), s_(std::sin(angle)) {}
-  std::optional<Rgb> eval(const Vec3& o, const Vec3& i) const override { return base_.eval(turn(o), turn(i)); }
-
- private:
-  Vec3 turn(const Vec3& v) const { return {c_ * v.x + s_ * v.y, -s_ * v.x + c_ * v.y, v.z}; }  // by -angle
-  const Brdf& base_;
-  double c_, s_;
-};
 
 // Anisotropic ground truth: an analytic NDF with F = 1 and axes turned by `angle_degrees`, its
 // back-scattering extracted in 2D (fit/extract_2d.h), principal alphas and angle compared.
