@@ -13,8 +13,12 @@
 // the grid (polar intervals x azimuths, uniform in solid angle within a cell); a view between nodes draws
 // from the mixture of its four bracketing nodes, bilinear weights, and pdf() is that mixture's density,
 // so sampling and pdf agree exactly while the mixture only approximates the view's own distribution.
+//
+// A stretch (model/stretch.h) reshapes the lobe as it does the isotropic one: the measured lobe is read
+// at transformed directions and normals, in the tangent frame its tables are in.
 #pragma once
 
+#include <memory>
 #include <optional>
 #include <vector>
 
@@ -23,6 +27,7 @@
 #include "model/fresnel_curve.h"
 #include "model/proposal.h"
 #include "model/smith.h"
+#include "model/stretch.h"
 #include "model/theta_grid.h"
 
 namespace facetfit {
@@ -39,7 +44,7 @@ struct AnisotropicTables {
 class TabulatedAnisotropic final : public Brdf, public Proposal {
  public:
   // Throws Error when the tables' sizes disagree or D has no mass.
-  explicit TabulatedAnisotropic(AnisotropicTables tables);
+  explicit TabulatedAnisotropic(AnisotropicTables tables, Stretch stretch = {});
 
   std::optional<Rgb> eval(const Vec3& o, const Vec3& i) const override;
 
@@ -52,20 +57,38 @@ class TabulatedAnisotropic final : public Brdf, public Proposal {
   double pdf(const Vec3& o, const Vec3& i) const override;
   std::optional<Vec3> sample_direction(const Vec3& o, double u1, double u2) const override;
 
+  // Of the (stretched) lobe.
   double D(const Vec3& h) const;
-  double sigma(const Vec3& w) const;
-  double g1(const Vec3& w) const;
+  double lambda(const Vec3& w) const;
+  double g1(const Vec3& w) const { return w.z > 0.0 ? 1.0 / (1.0 + lambda(w)) : 0.0; }
   // Density of the drawn normals per steradian of h.
   double visible_normal_pdf(const Vec3& o, const Vec3& h) const;
 
-  const AnisotropicTables& tables() const { return t_; }
+  const AnisotropicTables& tables() const { return shared_->tables; }
+  const Stretch& stretch() const { return stretch_; }
+  // The same lobe under another stretch: shares the tables, cheap enough per shading point.
+  TabulatedAnisotropic stretched(const Stretch& stretch) const;
 
  private:
   static constexpr int kViewThetas = 10, kViewPhis = 12;
   static constexpr double kViewThetaMax = 85.0 * kPi / 180.0;
 
-  // Spline in u along theta and, periodic, in phi, over a J x M table.
-  double lookup(const std::vector<double>& table, const Vec3& w) const;
+  // What a stretch does not change, immutable and shared between copies.
+  struct Shared {
+    AnisotropicTables tables;
+    std::vector<PiecewiseConstant2D> views;  // [theta node * kViewPhis + phi node]
+  };
+  std::shared_ptr<const Shared> shared_;
+  Stretch stretch_;
+
+  // The measured (unstretched) lobe, in the tangent frame.
+  double lookup(const std::vector<double>& table, const Vec3& w) const;  // spline in u and, periodic, phi
+  double measured_D(const Vec3& h) const;
+  double measured_lambda(const Vec3& w) const;
+  double measured_visible_normal_pdf(const Vec3& o, const Vec3& h) const;
+  Vec3 measured_visible_normal(const Vec3& o, double u1, double u2) const;
+  // A direction of the stretched lobe as the measured lobe sees it, tangent frame to tangent frame.
+  Vec3 measured_direction(const Vec3& w) const { return stretch_.from_frame(stretch_.direction(stretch_.to_frame(w))); }
   // The (up to four) view nodes bracketing o and their weights.
   struct ViewBlend {
     int view[4];
@@ -75,9 +98,6 @@ class TabulatedAnisotropic final : public Brdf, public Proposal {
   // Cell of h: polar interval j (row) and azimuth x (column); its solid angle.
   void cell_of(const Vec3& h, int* x, int* y) const;
   double cell_solid_angle(int y) const;
-
-  AnisotropicTables t_;
-  std::vector<PiecewiseConstant2D> views_;  // [theta node * kViewPhis + phi node]
 };
 
 }  // namespace facetfit

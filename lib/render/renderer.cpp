@@ -16,6 +16,7 @@
 #include "io/image_file.h"
 #include "io/input.h"
 #include "model/tabulated.h"
+#include "model/tabulated_anisotropic.h"
 #include "render/environment.h"
 #include "render/texture.h"
 
@@ -124,10 +125,12 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
   // Only what the scene uses is loaded.
   std::vector<std::shared_ptr<const ShadingModel>> materials;
   std::vector<std::optional<Vec3>> tangents;  // per material: the world direction its tangent follows
-  // Per material with a stretch_texture: the texture, and the tabulated lobe it stretches per point.
+  // Per material with a stretch_texture: the texture, and the tabulated lobe it stretches per point (the
+  // isotropic or the anisotropic one).
   struct StretchTexture {
     Texture texture;
     const TabulatedMicrofacet* lobe;
+    const TabulatedAnisotropic* anisotropic;
     Stretch stretch;
   };
   std::vector<std::optional<StretchTexture>> stretch_textures;
@@ -142,8 +145,9 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
     stretch_textures.emplace_back();
     if (!m.stretch_texture.empty()) {
       const auto* lobe = dynamic_cast<const TabulatedMicrofacet*>(&materials.back()->brdf());
-      if (!lobe) fail(m.file, "a stretch_texture needs a tabulated lobe");
-      stretch_textures.back() = StretchTexture{Texture::load(resolve(desc, m.stretch_texture), left), lobe, m.stretch};
+      const auto* anisotropic = dynamic_cast<const TabulatedAnisotropic*>(&materials.back()->brdf());
+      if (!lobe && !anisotropic) fail(m.file, "a stretch_texture needs a tabulated lobe");
+      stretch_textures.back() = StretchTexture{Texture::load(resolve(desc, m.stretch_texture), left), lobe, anisotropic, m.stretch};
       left -= stretch_textures.back()->texture.bytes();
     }
   }
@@ -266,13 +270,20 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
     // A stretch_texture reshapes the lobe here: a copy sharing its tables, owned by this call (the
     // shading model refers to it without owning it).
     std::optional<TabulatedMicrofacet> textured_lobe;
+    std::optional<TabulatedAnisotropic> textured_anisotropic;
     std::optional<ShadingModel> textured;
     if (const auto& st = stretch_textures[std::size_t(geo.material)]) {
       const Rgb scale = st->texture.lookup(texture_coordinates(*geo.object, p));
-      const auto stretch = [](double a, double b) { return clamp(a * b, Stretch::kMin, Stretch::kMax); };
-      textured_lobe.emplace(st->lobe->stretched(Stretch(stretch(st->stretch.x, scale.r), stretch(st->stretch.y, scale.g), st->stretch.rotation())));
-      const std::shared_ptr<const TabulatedMicrofacet> unowned(std::shared_ptr<void>(), &*textured_lobe);
-      textured.emplace(unowned, unowned);
+      const auto clamped = [](double a, double b) { return clamp(a * b, Stretch::kMin, Stretch::kMax); };
+      const Stretch stretch(clamped(st->stretch.x, scale.r), clamped(st->stretch.y, scale.g), st->stretch.rotation());
+      const auto unowned = [](const auto& lobe) { return std::shared_ptr<const std::decay_t<decltype(lobe)>>(std::shared_ptr<void>(), &lobe); };
+      if (st->lobe) {
+        const auto lobe = unowned(textured_lobe.emplace(st->lobe->stretched(stretch)));
+        textured.emplace(lobe, lobe);
+      } else {
+        const auto lobe = unowned(textured_anisotropic.emplace(st->anisotropic->stretched(stretch)));
+        textured.emplace(lobe, lobe);
+      }
     }
     const ShadingModel& model = textured ? *textured : *materials[std::size_t(geo.material)];
     const Vec3 origin = p + eps * n;

@@ -399,9 +399,7 @@ std::shared_ptr<const ShadingModel> load_material(const SceneDesc& scene, const 
     const std::string path = resolve(scene, m.file);
     Lut lut = read_lut(path);
     if (m.anisotropic && lut.anisotropic) {
-      if (!m.stretch.identity() || !m.stretch_texture.empty())
-        fail(path, "a stretch reshapes the isotropic lobe: this LUT's is anisotropic (set \"anisotropic\": false)");
-      const auto lobe = std::make_shared<TabulatedAnisotropic>(std::move(*lut.anisotropic));
+      const auto lobe = std::make_shared<TabulatedAnisotropic>(std::move(*lut.anisotropic), m.stretch);
       return std::make_shared<ShadingModel>(lobe, lobe);
     }
     std::shared_ptr<const TabulatedMicrofacet> model = sampled_lut_model(std::move(lut));
