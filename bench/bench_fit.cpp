@@ -19,6 +19,8 @@
 #include "lut/bake.h"
 #include "lut/lut.h"
 #include "model/analytic.h"
+#include "model/tabulated.h"
+#include "model/tabulated_anisotropic.h"
 
 namespace facetfit {
 namespace {
@@ -169,6 +171,63 @@ void BM_FitUtia(benchmark::State& state) {
   for (auto _ : state) benchmark::DoNotOptimize(fitter.fit(table));
 }
 BENCHMARK(BM_FitUtia)->ArgName("refine")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+
+// The anisotropic GGX lobe with a body fitted on that file's half/difference lattice, one core: the part of
+// BM_FitUtia/refine:1 the anisotropic input adds (twice: GGX and Beckmann).
+void BM_FitAnisotropicLobe(benchmark::State& state) {
+  const auto limit = limit_threads(state);
+  const MerlTable table = load_table(utia_file());
+  const MeasuredBins solve = measured_bins(table.source_half_diff(), 24), all = measured_bins(table.source_half_diff(), 1);
+  AnisotropicParametricFit start;
+  start.alpha = {0.5, 0.3, 0.2};
+  start.body = Rgb(0.05);
+  start.f0 = start.f82 = Rgb(0.5);
+  for (auto _ : state) benchmark::DoNotOptimize(fit_parametric_anisotropic(solve, all, Smith::correlated, start));
+}
+BENCHMARK(BM_FitAnisotropicLobe)->ArgName("threads")->Arg(1)->Unit(benchmark::kMillisecond);
+
+// One eval and one draw (sample + pdf + eval) of the tabulated lobes at random directions: the isotropic
+// lobe (the anchor) and the anisotropic one, GGX 0.4 x 0.15 tabulated at 90 x 64 nodes, plain and stretched.
+AnisotropicTables anisotropic_ggx_tables() {
+  AnisotropicTables t;
+  t.grid.resolution = 90;
+  t.phi_count = 64;
+  for (int j = 0; j < FresnelCurve::kSize; ++j) t.fresnel.value[std::size_t(j)] = Rgb(1.0);
+  const Ndf ndf{NdfType::ggx, 0.4, 0.15};
+  for (int j = 0; j < t.grid.size(); ++j)
+    for (int m = 0; m < t.phi_count; ++m) {
+      const Vec3 w = spherical_direction(std::min(t.grid.theta(j), 0.5 * kPi - 1e-6), 2.0 * kPi * m / t.phi_count);
+      t.ndf.push_back(ndf.D(w));
+      t.sigma.push_back(ndf.sigma(w));
+    }
+  return t;
+}
+template <class Lobe>
+void lobe_benchmark(benchmark::State& state, const Lobe& lobe) {
+  std::vector<Vec3> directions;
+  for (int k = 0; k < 1024; ++k) directions.push_back(spherical_direction(std::acos(1.0 - 0.98 * ((k * 37 % 1024) + 0.5) / 1024.0), 0.0061 * k * 1000.0));
+  std::size_t k = 0;
+  const bool draw = state.range(0) == 1;
+  for (auto _ : state) {
+    const Vec3 &o = directions[k % 1024], &i = directions[(k * 7 + 3) % 1024];
+    ++k;
+    if (draw) {
+      benchmark::DoNotOptimize(lobe.sample(o, 0.37, double(k % 997) / 997.0));
+    } else {
+      benchmark::DoNotOptimize(lobe.eval(o, i));
+    }
+  }
+}
+void BM_TabulatedLobe(benchmark::State& state) {
+  static const TabulatedMicrofacet lobe(MicrofacetTables{tabulate_ndf(Ndf::isotropic(NdfType::ggx, 0.25)), Smith::correlated, FresnelCurve{}, Rgb(0.0), {}});
+  lobe_benchmark(state, state.range(1) ? lobe.stretched(Stretch(0.5, 2.0, 0.5)) : lobe);
+}
+BENCHMARK(BM_TabulatedLobe)->ArgNames({"draw", "stretched"})->Args({0, 0})->Args({1, 0})->Args({0, 1})->Args({1, 1})->Unit(benchmark::kNanosecond);
+void BM_TabulatedAnisotropicLobe(benchmark::State& state) {
+  static const TabulatedAnisotropic lobe(anisotropic_ggx_tables());
+  lobe_benchmark(state, state.range(1) ? lobe.stretched(Stretch(0.5, 2.0, 0.5)) : lobe);
+}
+BENCHMARK(BM_TabulatedAnisotropicLobe)->ArgNames({"draw", "stretched"})->Args({0, 0})->Args({1, 0})->Args({0, 1})->Args({1, 1})->Unit(benchmark::kNanosecond);
 
 // A MERL file on disk for the bake benchmarks, written once.
 const std::string& gold_file() {

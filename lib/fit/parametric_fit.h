@@ -54,7 +54,7 @@ struct AnisotropicParametricFit {
 };
 
 // Least squares in the metric of fit/measurement.h from `start` (its principal alphas > 0; body, f0, f82
-// in [0, 1]), derivatives by central differences (13 unknowns). The error is measured on `error_bins`.
+// in [0, 1]); the shape's derivatives by central differences. The error is measured on `error_bins`.
 AnisotropicParametricFit fit_parametric_anisotropic(const MeasuredBins& bins, const MeasuredBins& error_bins, Smith smith,
                                                     const AnisotropicParametricFit& start, int max_iterations = 50);
 
