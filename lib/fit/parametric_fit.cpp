@@ -92,6 +92,33 @@ double f82_basis(double mu) {
   return mu * m3 * m3;
 }
 
+// One channel's Fresnel in the fits' forms and its derivatives in f0 and f82: F82-tint,
+//   F = Schlick(f0, mu) - (Schlick(f0, 1/7) - f82) mu (1 - mu)^6 / b82,
+// or, without `tint`, Schlick alone (f82 unused).
+struct FresnelTerms {
+  double value = 0.0, d_f0 = 0.0, d_f82 = 0.0;
+};
+FresnelTerms fresnel_terms(double f0, double f82, double mu, bool tint) {
+  const double s_mu = schlick_slope(mu);
+  FresnelTerms f{f0 * s_mu + (1.0 - s_mu), s_mu, 0.0};
+  if (!tint) return f;
+  constexpr double kMu82 = 1.0 / 7.0;
+  const double b82 = f82_basis(kMu82), schlick82 = 1.0 - schlick_slope(kMu82), basis = f82_basis(mu);
+  const double shift = (f0 * (1.0 - schlick82) + schlick82 - f82) / b82;
+  f.value -= shift * basis;
+  f.d_f0 -= (1.0 - schlick82) / b82 * basis;
+  f.d_f82 = basis / b82;
+  return f;
+}
+
+// The derivatives of residual r (channel e) in the colour blocks, body (0), f0 (2) and f82 (3), of a model
+// body / pi + F lobe + ...; dm is the residual's derivative in the model.
+void colour_jacobians(double** jacobians, std::size_t r, int e, double dm, const FresnelTerms& f, double lobe) {
+  if (jacobians[0]) jacobians[0][3 * r + std::size_t(e)] = dm * kInvPi;
+  if (jacobians[2]) jacobians[2][3 * r + std::size_t(e)] = dm * f.d_f0 * lobe;
+  if (jacobians[3]) jacobians[3][3 * r + std::size_t(e)] = dm * f.d_f82 * lobe;
+}
+
 // The residuals of one row of bins (3 per bin), with analytic derivatives: 5 to 8 times cheaper than
 // automatic differentiation, which carried 12 derivatives through every transcendental. Parameter
 // blocks: body (3), log alpha (1), f0 (3), f82 (3), coat (log alpha, f0). The model:
@@ -110,8 +137,6 @@ class RowCost final : public ceres::CostFunction {
   bool Evaluate(double const* const* p, double* residuals, double** jacobians) const override {
     const double *body = p[0], *f0 = p[2], *f82 = p[3];
     const double alpha = std::exp(p[1][0]), coat_alpha = std::exp(p[4][0]), coat_f0 = p[4][1];
-    constexpr double kMu82 = 1.0 / 7.0;
-    const double b82 = f82_basis(kMu82), schlick82 = 1.0 - schlick_slope(kMu82);
     const std::size_t n = row_.end - row_.begin;
     if (jacobians)
       for (int b = 0; b < 5; ++b)
@@ -124,7 +149,7 @@ class RowCost final : public ceres::CostFunction {
       const WithSlope g = g2_of(smith_, lambda_of(type_, alpha, ci), lambda_of(type_, alpha, co));
       const double lobe = d.value * g.value * inv4;
       const double lobe_slope = (d.slope * g.value + d.value * g.slope) * inv4 * alpha;  // d/d log alpha
-      const double s_mu = schlick_slope(mu), basis = f82_basis(mu);
+      const double s_mu = schlick_slope(mu);
       double coat = 0.0, coat_d_log_alpha = 0.0, coat_d_f0 = 0.0;
       if (with_coat_) {
         const WithSlope dc = ndf_of(NdfType::ggx, coat_alpha, ch);
@@ -141,23 +166,15 @@ class RowCost final : public ceres::CostFunction {
           residuals[r] = 0.0;
           continue;
         }
-        double fresnel = f0[e] * s_mu + (1.0 - s_mu), fresnel_d_f0 = s_mu, fresnel_d_f82 = 0.0;
-        if (f82_) {
-          const double shift = (f0[e] * (1.0 - schlick82) + schlick82 - f82[e]) / b82;
-          fresnel -= shift * basis;
-          fresnel_d_f0 -= (1.0 - schlick82) / b82 * basis;
-          fresnel_d_f82 = basis / b82;
-        }
-        const double m = body[e] * kInvPi + fresnel * lobe + coat;
+        const FresnelTerms fresnel = fresnel_terms(f0[e], f82[e], mu, f82_);
+        const double m = body[e] * kInvPi + fresnel.value * lobe + coat;
         // F82-tint can dip below zero for extreme f82: no negative reflectance, and no slope there.
         const MetricResidual res = metric_residual(m, c, bins_.lightness[k][e]);
         residuals[r] = w * res.value;
         if (!jacobians || m < 0.0) continue;
         const double dm = w * res.slope;
-        if (jacobians[0]) jacobians[0][3 * r + std::size_t(e)] = dm * kInvPi;
-        if (jacobians[1]) jacobians[1][r] = dm * fresnel * lobe_slope;
-        if (jacobians[2]) jacobians[2][3 * r + std::size_t(e)] = dm * fresnel_d_f0 * lobe;
-        if (jacobians[3]) jacobians[3][3 * r + std::size_t(e)] = dm * fresnel_d_f82 * lobe;
+        colour_jacobians(jacobians, r, e, dm, fresnel, lobe);
+        if (jacobians[1]) jacobians[1][r] = dm * fresnel.value * lobe_slope;
         if (jacobians[4]) jacobians[4][2 * r] = dm * coat_d_log_alpha, jacobians[4][2 * r + 1] = dm * coat_d_f0;
       }
     }
@@ -287,8 +304,7 @@ class AnisotropicRowCost final : public ceres::CostFunction {
 
   bool Evaluate(double const* const* p, double* residuals, double** jacobians) const override {
     const double *body = p[0], *shape = p[1], *f0 = p[2], *f82 = p[3];
-    constexpr double kMu82 = 1.0 / 7.0, kStep = 1e-5;
-    const double b82 = f82_basis(kMu82), schlick82 = 1.0 - schlick_slope(kMu82);
+    constexpr double kStep = 1e-5;
     const std::size_t n = row_.end - row_.begin;
     if (jacobians)
       for (int b = 0; b < 4; ++b)
@@ -306,7 +322,6 @@ class AnisotropicRowCost final : public ceres::CostFunction {
           plus[e] += kStep, minus[e] -= kStep;
           lobe_slope[e] = (lobe_at(plus, k) - lobe_at(minus, k)) / (2.0 * kStep);
         }
-      const double mu = bins_.cos_d[k], s_mu = schlick_slope(mu), basis = f82_basis(mu);
       const double w = std::sqrt(bins_.weight[k]), c = bins_.cos_mean[k];
       for (int e = 0; e < 3; ++e) {
         const std::size_t r = 3 * q + std::size_t(e);
@@ -314,20 +329,15 @@ class AnisotropicRowCost final : public ceres::CostFunction {
           residuals[r] = 0.0;
           continue;
         }
-        // F82-tint (fit/parametric_fit.h's RowCost): Schlick(f0, mu) - (Schlick(f0, 1/7) - f82) mu (1 - mu)^6 / b82.
-        const double shift = (f0[e] * (1.0 - schlick82) + schlick82 - f82[e]) / b82;
-        const double fresnel = f0[e] * s_mu + (1.0 - s_mu) - shift * basis;
-        const double fresnel_d_f0 = s_mu - (1.0 - schlick82) / b82 * basis, fresnel_d_f82 = basis / b82;
-        const double m = body[e] * kInvPi + fresnel * lobe;
+        const FresnelTerms fresnel = fresnel_terms(f0[e], f82[e], bins_.cos_d[k], true);
+        const double m = body[e] * kInvPi + fresnel.value * lobe;
         const MetricResidual res = metric_residual(m, c, bins_.lightness[k][e]);
         residuals[r] = w * res.value;
         if (!jacobians || m < 0.0) continue;
         const double dm = w * res.slope;
-        if (jacobians[0]) jacobians[0][3 * r + std::size_t(e)] = dm * kInvPi;
+        colour_jacobians(jacobians, r, e, dm, fresnel, lobe);
         if (jacobians[1])
-          for (int a = 0; a < 3; ++a) jacobians[1][3 * r + std::size_t(a)] = dm * fresnel * lobe_slope[a];
-        if (jacobians[2]) jacobians[2][3 * r + std::size_t(e)] = dm * fresnel_d_f0 * lobe;
-        if (jacobians[3]) jacobians[3][3 * r + std::size_t(e)] = dm * fresnel_d_f82 * lobe;
+          for (int a = 0; a < 3; ++a) jacobians[1][3 * r + std::size_t(a)] = dm * fresnel.value * lobe_slope[a];
       }
     }
     return true;
