@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cstdarg>
 #include <filesystem>
+#include <memory>
 #include <cmath>
 #include <cstdio>
 #include <sstream>
@@ -12,6 +13,7 @@
 #include "fit/extract.h"
 #include "fit/fit.h"
 #include "support/ground_truth.h"
+#include "support/tensor_file.h"
 #include "fit/roughness.h"
 #include "io/atomic_file.h"
 #include "io/input.h"
@@ -152,6 +154,42 @@ void utia_fit_section(std::ostringstream& md, const std::string& scratch) {
     md << format("| %.2f x %.2f at %.1f deg | %s | %.4f | %.4f | %.4f, %.4f, %s |\n", c.alpha_x, c.alpha_y, c.degrees, to_string(c.smith),
                  fit.alpha_ggx, from_table.alpha_ggx, a.alpha_x, a.alpha_y, angle.c_str());
   }
+  md << "\n";
+}
+
+// The anisotropic lobes with a body fitted on the whole file (--refine full; fit/parametric_fit.h) beside
+// the 2D extraction's moment alphas, for anisotropic materials written as UTIA and RGL files.
+void anisotropic_lobe_section(std::ostringstream& md, const std::string& scratch) {
+  md << "## Anisotropic lobes with a body, fitted on the whole file\n\n"
+        "The default fit (`--refine full`) of anisotropic materials written by facetfit's UTIA writer and the tests' RGL "
+        "tensor writer (F = 1, no body: the format stores a microfacet lobe): the 2D extraction's moment estimates "
+        "(no body: a body broadens them) and the anisotropic GGX lobe with a body and F82-tint Fresnel fitted on the "
+        "file's half/difference lattice (docs/conventions.md). Height-correlated Smith. The UTIA file's 15-degree "
+        "nodes, between which the lobe is interpolated linearly, limit its rows (tests/test_refine.cpp).\n\n"
+        "| file | written: GGX alpha_x, alpha_y, angle; body; f0 | moments: alpha_x, alpha_y, angle | fitted: alpha_x, alpha_y, angle | body | f0 | distance |\n"
+        "|---|---|---|---|---|---|---|\n";
+  FitOptions options;
+  const Fitter fitter(options);
+  const auto row = [&](const char* input, const std::string& path, const std::string& written) {
+    const FitResult fit = fitter.fit(load_table(path));
+    if (!fit.ok() || !fit.anisotropic) throw Error(path + ": no anisotropic fit: " + fit.problem);
+    const AnisotropicFit& a = *fit.anisotropic;
+    const auto deg = [](double r) { return r * 180.0 / kPi; };
+    md << format("| %s | %s | %.3f, %.3f, %.2f deg | %.4f, %.4f, %.2f deg | %.3f %.3f %.3f | %.3f %.3f %.3f | %.4f |\n", input, written.c_str(),
+                 a.alpha_ggx.alpha_x, a.alpha_ggx.alpha_y, deg(a.alpha_ggx.angle), a.ggx.alpha.alpha_x, a.ggx.alpha.alpha_y,
+                 deg(a.ggx.alpha.angle), a.ggx.body.r, a.ggx.body.g, a.ggx.body.b, a.ggx.f0.r, a.ggx.f0.g, a.ggx.f0.b, a.ggx.error);
+  };
+  const Rgb f0(0.9, 0.6, 0.3);
+  for (const Rgb& albedo : {Rgb(0.0), Rgb(0.4, 0.25, 0.1)}) {
+    const auto lobe = std::make_shared<MicrofacetBrdf>(Ndf{NdfType::ggx, 0.45, 0.2}, Smith::correlated, Fresnel::schlick(f0));
+    const SumBrdf material({std::make_shared<LambertBrdf>(albedo), lobe});
+    UtiaBrdf::tabulate(RotatedBrdf(material, 0.6)).write(scratch);
+    row("UTIA", scratch, format("0.45, 0.2, 34.38 deg; %.2f %.2f %.2f; 0.9 0.6 0.3", albedo.r, albedo.g, albedo.b));
+  }
+  const std::vector<unsigned char> bytes =
+      test::serialize(test::microfacet_tensor_fields(Ndf{NdfType::ggx, 0.45, 0.25}, Smith::correlated, 30.0 * kPi / 180.0, 25, 32, 64));
+  write_file_atomic(scratch + ".bsdf", std::string(bytes.begin(), bytes.end()));
+  row("RGL", scratch + ".bsdf", "0.45, 0.25, 30 deg; 0; 1");
   md << "\n";
 }
 
@@ -324,6 +362,7 @@ int main(int argc, char** argv) {
     const std::string scratch = (std::filesystem::temp_directory_path() / "facetfit-accuracy-utia.bin").string();
     anisotropic_section(md, scratch);
     utia_fit_section(md, scratch);
+    anisotropic_lobe_section(md, scratch);
     std::filesystem::remove(scratch);
     std::filesystem::remove(scratch + ".bsdf");
     rgl_section(md, argc > 2 ? argv[2] : "");
