@@ -14,6 +14,19 @@ namespace facetfit {
 
 namespace {
 
+// The parametric fits' bounds: the first `alphas` entries of `log_alpha` within log [1e-3, 4], a nonnegative
+// body, reflectances f0 and f82 in [0, 1] (the starts are clamped there by the callers).
+void bound_lobe(ceres::Problem& problem, double* log_alpha, int alphas, double* body, double* f0, double* f82) {
+  for (int a = 0; a < alphas; ++a) {
+    problem.SetParameterLowerBound(log_alpha, a, std::log(1e-3));
+    problem.SetParameterUpperBound(log_alpha, a, std::log(4.0));
+  }
+  for (double* p : {body, f0, f82})
+    for (int c = 0; c < 3; ++c) problem.SetParameterLowerBound(p, c, 0.0);
+  for (double* p : {f0, f82})
+    for (int c = 0; c < 3; ++c) problem.SetParameterUpperBound(p, c, 1.0);
+}
+
 // The parametric fits' solve: a dense problem of 8 to 13 unknowns.
 void solve(ceres::Problem& problem, int max_iterations) {
   if (max_iterations <= 0) return;
@@ -250,12 +263,7 @@ ParametricFit fit_parametric(const MeasuredBins& bins, const MeasuredBins& error
     problem.AddResidualBlock(new RowCost(bins, row, start.type, smith, start.fresnel, with_coat), nullptr, body, log_alpha, f0, f82, coat);
   }
   if (bins.rows.empty()) return fit;
-  problem.SetParameterLowerBound(log_alpha, 0, std::log(1e-3));
-  problem.SetParameterUpperBound(log_alpha, 0, std::log(4.0));
-  for (double* p : {body, f0, f82})
-    for (int c = 0; c < 3; ++c) problem.SetParameterLowerBound(p, c, 0.0);
-  for (double* p : {f0, f82})  // reflectances: at most 1 (the start is clamped to [0, 1] by the caller)
-    for (int c = 0; c < 3; ++c) problem.SetParameterUpperBound(p, c, 1.0);
+  bound_lobe(problem, log_alpha, 1, body, f0, f82);
   if (start.fresnel == ParametricFit::FresnelForm::schlick) problem.SetParameterBlockConstant(f82);
   if (with_coat) {
     problem.SetParameterLowerBound(coat, 0, std::log(1e-3));
@@ -377,14 +385,7 @@ AnisotropicParametricFit fit_parametric_anisotropic(const MeasuredBins& bins, co
   for (const MeasuredBins::Row& row : bins.rows) {
     problem.AddResidualBlock(new AnisotropicRowCost(bins, row, start.type, smith), nullptr, body, shape, f0, f82);
   }
-  for (int a = 0; a < 2; ++a) {
-    problem.SetParameterLowerBound(shape, a, std::log(1e-3));
-    problem.SetParameterUpperBound(shape, a, std::log(4.0));
-  }
-  for (double* p : {body, f0, f82})
-    for (int c = 0; c < 3; ++c) problem.SetParameterLowerBound(p, c, 0.0);
-  for (double* p : {f0, f82})
-    for (int c = 0; c < 3; ++c) problem.SetParameterUpperBound(p, c, 1.0);
+  bound_lobe(problem, shape, 2, body, f0, f82);  // log alpha_x, log alpha_y; the angle is free
 
   solve(problem, max_iterations);
 
