@@ -6,6 +6,8 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <tuple>
+#include <utility>
 
 #include "core/error.h"
 #include "fit/plausibility.h"
@@ -47,6 +49,11 @@ Backscatter backscatter_of(const MerlTable& table) {
 }
 
 namespace {
+
+// A Fresnel curve's reflectance at 0 and 82 degrees, clamped to [0, 1]: the parametric fits' start.
+std::pair<Rgb, Rgb> f0_f82_of(const FresnelCurve& curve) {
+  return {glm::clamp(curve.value[0], Rgb(0.0), Rgb(1.0)), glm::clamp(curve.eval(f82_theta()), Rgb(0.0), Rgb(1.0))};
+}
 
 Quadrature checked_quadrature(const FitOptions& options) {
   if (options.resolution < 4 || options.resolution > 4096)
@@ -126,8 +133,7 @@ void Fitter::fit_anisotropic_lobes(const MerlTable& table, const FresnelCurve& p
     AnisotropicParametricFit p;
     p.type = type;
     p.alpha = alpha;
-    p.f0 = glm::clamp(paper_fresnel.value[0], Rgb(0.0), Rgb(1.0));
-    p.f82 = glm::clamp(paper_fresnel.eval(f82_theta()), Rgb(0.0), Rgb(1.0));
+    std::tie(p.f0, p.f82) = f0_f82_of(paper_fresnel);
     return p;
   };
   a.ggx = moments(NdfType::ggx, a.alpha_ggx);
@@ -169,8 +175,8 @@ FitResult Fitter::fit(const MerlTable& table) const {
   result.alpha_beckmann = alpha_beckmann_from_moments(result.ndf(), quadrature_);
   // The parametric representations of the paper's method: the moment alphas with the extraction's
   // Fresnel at 0 and 82 degrees (Schlick's for lsq), no body.
-  const Rgb f0 = glm::clamp(result.fresnel().value[0], Rgb(0.0), Rgb(1.0));
-  const Rgb f82 = glm::clamp(result.fresnel().eval(f82_theta()), Rgb(0.0), Rgb(1.0));
+  const std::pair<Rgb, Rgb> reflectance = f0_f82_of(result.fresnel());
+  const Rgb &f0 = reflectance.first, &f82 = reflectance.second;
   const auto moments = [&](NdfType type, double alpha, ParametricFit::FresnelForm form) {
     ParametricFit p;
     p.type = type;

@@ -318,6 +318,19 @@ std::shared_ptr<const TabulatedMicrofacet> sampled_lut_model(Lut lut) {
   return std::make_shared<TabulatedMicrofacet>(std::move(lut.tables), std::move(lut.sampling));
 }
 
+// A parametric lobe's proposal, tabulated (model/tabulated.h): the isotropic `ndf` with a flat Fresnel of
+// f0, the body and the coat, so its draws are weighted by f0 and the body.
+std::shared_ptr<const TabulatedMicrofacet> tabulated_proposal(const Ndf& ndf, Smith smith, const Rgb& f0, const Rgb& body = Rgb(0.0),
+                                                              const Coat& coat = {}) {
+  MicrofacetTables tables;
+  tables.smith = smith;
+  tables.ndf = tabulate_ndf(ndf);
+  std::fill(tables.fresnel.value.begin(), tables.fresnel.value.end(), f0);
+  tables.body = body;
+  tables.coat = coat;
+  return std::make_shared<TabulatedMicrofacet>(tables);
+}
+
 }  // namespace
 
 std::shared_ptr<const ShadingModel> lut_parametric_model(const Lut& lut, const std::string& family, Smith smith, bool fresnel_curve,
@@ -329,12 +342,9 @@ std::shared_ptr<const ShadingModel> lut_parametric_model(const Lut& lut, const s
     // alpha_y), tabulated like the one below: the axes change which directions are likely, not coverage.
     const AnisotropicParametricFit& g = lut.meta.anisotropic_ggx;
     const auto lobe = std::make_shared<ParametricBrdf>(Ndf{NdfType::ggx, g.alpha.alpha_x, g.alpha.alpha_y}, smith, g.f0, g.f82, g.body);
-    MicrofacetTables tables;
-    tables.smith = smith;
-    tables.ndf = tabulate_ndf(Ndf::isotropic(NdfType::ggx, std::sqrt(g.alpha.alpha_x * g.alpha.alpha_y)));
-    std::fill(tables.fresnel.value.begin(), tables.fresnel.value.end(), g.f0);
-    tables.body = g.body;
-    return std::make_shared<ShadingModel>(std::make_shared<RotatedBrdf>(lobe, g.alpha.angle), std::make_shared<TabulatedMicrofacet>(tables));
+    return std::make_shared<ShadingModel>(
+        std::make_shared<RotatedBrdf>(lobe, g.alpha.angle),
+        tabulated_proposal(Ndf::isotropic(NdfType::ggx, std::sqrt(g.alpha.alpha_x * g.alpha.alpha_y)), smith, g.f0, g.body));
   }
   // The LUT's fit of this family on the whole measurement: its alpha, body and coat, with its own F82-tint
   // (lsq: Schlick) Fresnel or the tabulated curve.
@@ -345,13 +355,7 @@ std::shared_ptr<const ShadingModel> lut_parametric_model(const Lut& lut, const s
   // Tabulated even for GGX: the report compares this render with the measured material's and the LUT's,
   // whose proposals are tabulated too, so the same random numbers give nearly the same directions and
   // most of the noise cancels in their difference (at the report's 32 spp, and at 4 spp in its test).
-  MicrofacetTables tables;
-  tables.smith = smith;
-  tables.ndf = tabulate_ndf(ndf);
-  std::fill(tables.fresnel.value.begin(), tables.fresnel.value.end(), p->f0);
-  tables.body = p->body;
-  tables.coat = p->coat;
-  return std::make_shared<ShadingModel>(brdf, std::make_shared<TabulatedMicrofacet>(tables));
+  return std::make_shared<ShadingModel>(brdf, tabulated_proposal(ndf, smith, p->f0, p->body, p->coat));
 }
 
 std::shared_ptr<const ShadingModel> load_material(const SceneDesc& scene, const MaterialDesc& m) {
@@ -415,11 +419,7 @@ std::shared_ptr<const ShadingModel> load_material(const SceneDesc& scene, const 
   // Beckmann's tabulated.
   const auto brdf = std::make_shared<ParametricBrdf>(ndf, m.smith, m.f0, m.f82);
   if (ndf.type == NdfType::ggx) return std::make_shared<ShadingModel>(brdf, std::make_shared<GgxProposal>(m.alpha, m.f0, Rgb(0.0), Coat{}));
-  MicrofacetTables tables;
-  tables.smith = m.smith;
-  tables.ndf = tabulate_ndf(ndf);
-  std::fill(tables.fresnel.value.begin(), tables.fresnel.value.end(), m.f0);
-  return std::make_shared<ShadingModel>(brdf, std::make_shared<TabulatedMicrofacet>(tables));
+  return std::make_shared<ShadingModel>(brdf, tabulated_proposal(ndf, m.smith, m.f0));
 }
 
 }  // namespace facetfit
