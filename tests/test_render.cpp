@@ -115,6 +115,55 @@ TEST(Render, SameSceneSameImage) {
   EXPECT_EQ(a.rgba, b.rgba);  // passes, tiles and threads do not change the per-pixel sequences
 }
 
+TEST(Tracer, SphereRootsStayAccurateFarAwayAndAtGrazingAngles) {
+  const Vec3 c(0.0, 0.0, 0.0);
+  // Far away: 1e6 units off, the root is 1e6 - 1 to a relative 1e-12 (b^2 - ac would lose half the digits).
+  EXPECT_NEAR(intersect_sphere(c, 1.0, Ray{Vec3(0, 0, 1e6), Vec3(0, 0, -1)}), 1e6 - 1.0, 1e-6);
+  // An unnormalized direction: t is in its units.
+  EXPECT_NEAR(intersect_sphere(c, 1.0, Ray{Vec3(0, 0, 5), Vec3(0, 0, -2)}), 2.0, 1e-12);
+  // From inside: the exit; from the surface outward past tnear: nothing; a line passing at 1 + 1e-9: nothing.
+  EXPECT_NEAR(intersect_sphere(c, 2.0, Ray{Vec3(0.5, 0, 0), Vec3(1, 0, 0)}), 1.5, 1e-12);
+  EXPECT_TRUE(std::isinf(intersect_sphere(c, 1.0, Ray{Vec3(0, 0, 1.0002), glm::normalize(Vec3(1, 0, 1e-3)), 2e-4})));
+  EXPECT_TRUE(std::isinf(intersect_sphere(c, 1.0, Ray{Vec3(-5, 1.0 + 1e-9, 0), Vec3(1, 0, 0)})));
+  // Grazing at 1 - 1e-6: the two roots are 2.8e-3 apart, both found.
+  const Ray graze{Vec3(-5, 1.0 - 1e-6, 0), Vec3(1, 0, 0)};
+  const double half_chord = std::sqrt(1.0 - (1.0 - 1e-6) * (1.0 - 1e-6));
+  EXPECT_NEAR(intersect_sphere(c, 1.0, graze), 5.0 - half_chord, 1e-12);
+  EXPECT_NEAR(intersect_sphere(c, 1.0, Ray{graze.origin, graze.dir, 5.0}), 5.0 + half_chord, 1e-12);
+  // Beyond tfar: nothing.
+  EXPECT_TRUE(std::isinf(intersect_sphere(c, 1.0, Ray{Vec3(0, 0, 5), Vec3(0, 0, -1), 0.0, 3.9})));
+}
+
+TEST(Tracer, SpheresAndTrianglesTogether) {
+  const SceneDesc s = parse_scene_text(R"({
+    "materials": {"m": {"type": "lambert"}},
+    "objects": [{"type": "sphere", "center": [0, 1, 0], "radius": 0.5, "material": "m"},
+                {"type": "sphere", "center": [0, 3, 0], "radius": 0.5, "material": "m"},
+                {"type": "plane", "point": [0, 0, 0], "normal": [0, 1, 0], "size": 4, "material": "m"}]
+  })", "tracer.json", ".");
+  const Tracer tracer(s);
+  const Ray down{Vec3(0, 5, 0), Vec3(0, -1, 0)}, beside{Vec3(1, 5, 0), Vec3(0, -1, 0)}, outside{Vec3(3, 5, 0), Vec3(0, -1, 0)};
+  EXPECT_EQ(tracer.intersect(down).object, 1);  // the upper sphere first
+  EXPECT_NEAR(tracer.intersect(down).t, 1.5, 1e-12);
+  EXPECT_EQ(tracer.intersect(beside).object, 2);  // the plane, a triangle hit
+  EXPECT_NEAR(tracer.intersect(beside).t, 5.0, 1e-5);
+  EXPECT_FALSE(tracer.intersect(outside).found());
+  EXPECT_TRUE(tracer.occluded(down));
+  EXPECT_FALSE(tracer.occluded(Ray{Vec3(0, 5, 0), Vec3(0, -1, 0), 0.0, 1.4}));  // stops short of the sphere
+  EXPECT_TRUE(tracer.occluded(beside));
+  EXPECT_FALSE(tracer.occluded(Ray{Vec3(1, 5, 0), Vec3(0, -1, 0), 0.0, 4.9}));
+  // The streams answer as the one-ray queries do.
+  const std::vector<Ray> rays = {down, beside, outside, Ray{Vec3(0, 5, 0), Vec3(0, -1, 0), 0.0, 1.4}};
+  std::vector<Hit> hits;
+  std::vector<char> blocked;
+  tracer.intersect(rays, hits, true);
+  tracer.occluded(rays, blocked);
+  for (std::size_t k = 0; k < rays.size(); ++k) {
+    EXPECT_EQ(hits[k].object, tracer.intersect(rays[k]).object) << k;
+    EXPECT_EQ(bool(blocked[k]), tracer.occluded(rays[k])) << k;
+  }
+}
+
 TEST(Render, RayStreamsAndOneRayAtATimeGiveTheSameImage) {
   // Everything that makes shadow rays: the sky (light and BRDF samples), both kinds of light, a plane the
   // spheres shadow, and the proposals of every kind (closed-form GGX, tabulated Beckmann, a measured table).

@@ -1,4 +1,4 @@
-// The reference renderer: Embree 3 for visibility, direct lighting from the environment and the
+// The reference renderer: render/tracer.h for visibility, direct lighting from the environment and the
 // scene's lights with multiple importance sampling, oneTBB over tiles, a fixed random sequence per
 // pixel (the same scene and settings give the same image on any number of threads).
 #pragma once
@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "render/scene.h"
+#include "render/tracer.h"  // read_obj, for the mesh fuzzer and tests
 
 namespace facetfit {
 
@@ -16,8 +17,8 @@ struct RenderSettings {
   int spp = 0;                // 0: the scene's
   std::uint64_t seed = 0;     // 0: the scene's
   int passes = 4;             // samples are added in passes (progressive), each over the whole image
-  // Rays traced as Embree ray streams, a tile at a time; false: one ray at a time (the same image, the
-  // reference the stream path is tested against).
+  // Rays traced as streams, a tile at a time (render/tracer.h); false: one ray at a time (the same image,
+  // the reference the stream path is tested against).
   bool ray_streams = true;
   // Bytes the image buffers and the environment map may take together (core/memory_budget.h); 0: half of
   // the machine's memory. A scene over it is refused before anything is allocated.
@@ -40,8 +41,5 @@ RenderedImage render(const SceneDesc& scene, const RenderSettings& settings = {}
 
 // Linear EXR (R, G, B, A, float) with the given string metadata, through a temporary file.
 void write_exr(const std::string& path, const RenderedImage& image, const std::vector<std::pair<std::string, std::string>>& metadata);
-
-// Reads the triangles of a Wavefront OBJ (v and f records; polygons fanned). Throws Error naming the file.
-void read_obj(const std::string& path, std::vector<float>& positions, std::vector<unsigned>& indices);
 
 }  // namespace facetfit

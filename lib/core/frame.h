@@ -1,0 +1,31 @@
+// An orthonormal shading frame (t, b, n) around a unit normal, and the change of coordinates to it.
+#pragma once
+
+#include <cmath>
+
+#include "core/vec.h"
+
+namespace facetfit {
+
+struct Frame {
+  Vec3 t, b, n;
+  // Any tangents: the branchless basis of Duff et al. 2017 (continuous except across n.z = 0's sign).
+  explicit Frame(const Vec3& normal) : n(normal) {
+    const double sign = std::copysign(1.0, n.z), a = -1.0 / (sign + n.z), c = n.x * n.y * a;
+    t = Vec3(1.0 + sign * n.x * n.x * a, sign * c, -sign * n.x);
+    b = Vec3(c, sign + n.y * n.y * a, -n.y);
+  }
+  // With its x axis along the projection of a given direction on the surface (an anisotropic lobe's axes
+  // follow it); the frame above where that projection vanishes.
+  Frame(const Vec3& normal, const Vec3& along) : Frame(normal) {
+    const Vec3 projected = along - glm::dot(along, n) * n;
+    const double len = glm::length(projected);
+    if (!(len > 1e-9)) return;
+    t = projected / len;
+    b = glm::cross(n, t);
+  }
+  Vec3 to_local(const Vec3& v) const { return {glm::dot(v, t), glm::dot(v, b), glm::dot(v, n)}; }
+  Vec3 to_world(const Vec3& v) const { return v.x * t + v.y * b + v.z * n; }
+};
+
+}  // namespace facetfit

@@ -1,0 +1,210 @@
+#include "render/tracer.h"
+
+#include <embree3/rtcore.h>
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include "core/error.h"
+#include "core/frame.h"
+#include "io/input.h"
+
+namespace facetfit {
+
+double intersect_sphere(const Vec3& center, double radius, const Ray& ray) {
+  const double inf = std::numeric_limits<double>::infinity();
+  const Vec3 f = ray.origin - center;
+  const double a = glm::dot(ray.dir, ray.dir), b = -glm::dot(f, ray.dir);  // half of the usual b, negated
+  // r^2 - |f + (b/a) d|^2 = discriminant / a: the squared half-chord, from the point of the line nearest
+  // the centre, instead of b^2 - ac, which cancels catastrophically far from the sphere.
+  const Vec3 nearest = f + (b / a) * ray.dir;
+  const double chord2 = radius * radius - glm::dot(nearest, nearest);
+  if (!(chord2 >= 0.0)) return inf;
+  const double c = glm::dot(f, f) - radius * radius;
+  const double q = b + std::copysign(std::sqrt(a * chord2), b);
+  double t0 = q / a, t1 = q != 0.0 ? c / q : t0;  // the roots; the second from their product c / a
+  if (t0 > t1) std::swap(t0, t1);
+  if (t0 > ray.tnear && t0 < ray.tfar) return t0;
+  if (t1 > ray.tnear && t1 < ray.tfar) return t1;
+  return inf;
+}
+
+// The triangles: an Embree device and scene, and which object each of its geometries is.
+struct Tracer::Embree {
+  RTCDevice device = nullptr;
+  RTCScene scene = nullptr;
+  std::vector<int> object;  // per geometry ID
+  ~Embree() {
+    if (scene) rtcReleaseScene(scene);
+    if (device) rtcReleaseDevice(device);
+  }
+};
+
+namespace {
+
+RTCRay embree_ray(const Ray& r) {
+  RTCRay ray{};
+  ray.org_x = float(r.origin.x), ray.org_y = float(r.origin.y), ray.org_z = float(r.origin.z);
+  ray.dir_x = float(r.dir.x), ray.dir_y = float(r.dir.y), ray.dir_z = float(r.dir.z);
+  ray.tnear = float(r.tnear);
+  ray.tfar = std::isinf(r.tfar) ? std::numeric_limits<float>::infinity() : float(r.tfar);
+  ray.mask = 0xFFFFFFFFu;
+  return ray;
+}
+
+}  // namespace
+
+Tracer::Tracer(const SceneDesc& desc) {
+  for (std::size_t k = 0; k < desc.objects.size(); ++k) {
+    const ObjectDesc& o = desc.objects[k];
+    if (o.kind == ObjectDesc::Kind::sphere) {
+      spheres_.push_back({o.center, o.radius, int(k)});
+      continue;
+    }
+    if (!triangles_) {
+      triangles_ = std::make_unique<Embree>();
+      triangles_->device = rtcNewDevice("threads=0");
+      if (!triangles_->device) throw Error("embree: cannot create a device");
+      triangles_->scene = rtcNewScene(triangles_->device);
+    }
+    std::vector<float> p;
+    std::vector<unsigned> idx;
+    if (o.kind == ObjectDesc::Kind::plane) {
+      const Frame f(o.normal);
+      const double h = 0.5 * o.size;
+      for (const auto& [a, b] : {std::pair{-h, -h}, {h, -h}, {h, h}, {-h, h}}) {
+        const Vec3 q = o.point + a * f.t + b * f.b;
+        p.insert(p.end(), {float(q.x), float(q.y), float(q.z)});
+      }
+      idx = {0, 1, 2, 0, 2, 3};
+    } else {
+      read_obj(resolve(desc, o.file), p, idx);
+    }
+    RTCGeometry g = rtcNewGeometry(triangles_->device, RTC_GEOMETRY_TYPE_TRIANGLE);
+    auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), p.size() / 3));
+    std::copy(p.begin(), p.end(), vb);
+    auto* ib = static_cast<unsigned*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), idx.size() / 3));
+    std::copy(idx.begin(), idx.end(), ib);
+    rtcCommitGeometry(g);
+    rtcAttachGeometryByID(triangles_->scene, g, unsigned(triangles_->object.size()));
+    rtcReleaseGeometry(g);
+    triangles_->object.push_back(int(k));
+  }
+  if (triangles_) rtcCommitScene(triangles_->scene);
+}
+
+Tracer::~Tracer() = default;
+
+Hit Tracer::intersect(const Ray& ray) const {
+  Hit hit;
+  Ray r = ray;
+  for (const Sphere& s : spheres_) {
+    const double t = intersect_sphere(s.center, s.radius, r);
+    if (t < r.tfar) r.tfar = hit.t = t, hit.object = s.object;
+  }
+  if (triangles_) {
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    RTCRayHit rh{};
+    rh.ray = embree_ray(r);
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(triangles_->scene, &ctx, &rh);
+    if (rh.hit.geomID != RTC_INVALID_GEOMETRY_ID)
+      hit = Hit{double(rh.ray.tfar), triangles_->object[rh.hit.geomID], Vec3(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z)};
+  }
+  return hit;
+}
+
+bool Tracer::occluded(const Ray& ray) const {
+  for (const Sphere& s : spheres_)
+    if (std::isfinite(intersect_sphere(s.center, s.radius, ray))) return true;
+  if (!triangles_) return false;
+  RTCIntersectContext ctx;
+  rtcInitIntersectContext(&ctx);
+  RTCRay r = embree_ray(ray);
+  rtcOccluded1(triangles_->scene, &ctx, &r);
+  return r.tfar < 0.0f;  // Embree sets tfar to -inf where something blocks the ray
+}
+
+void Tracer::intersect(const std::vector<Ray>& rays, std::vector<Hit>& hits, bool coherent) const {
+  hits.assign(rays.size(), Hit{});
+  for (std::size_t k = 0; k < rays.size(); ++k) {
+    Ray r = rays[k];
+    for (const Sphere& s : spheres_) {
+      const double t = intersect_sphere(s.center, s.radius, r);
+      if (t < r.tfar) r.tfar = hits[k].t = t, hits[k].object = s.object;
+    }
+  }
+  if (!triangles_ || rays.empty()) return;
+  std::vector<RTCRayHit> rh(rays.size());
+  for (std::size_t k = 0; k < rays.size(); ++k) {
+    rh[k] = RTCRayHit{};
+    rh[k].ray = embree_ray(rays[k]);
+    if (hits[k].found()) rh[k].ray.tfar = float(hits[k].t);
+    rh[k].hit.geomID = RTC_INVALID_GEOMETRY_ID;
+  }
+  RTCIntersectContext ctx;
+  rtcInitIntersectContext(&ctx);
+  if (coherent) ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+  rtcIntersect1M(triangles_->scene, &ctx, rh.data(), unsigned(rh.size()), sizeof(RTCRayHit));
+  for (std::size_t k = 0; k < rays.size(); ++k)
+    if (rh[k].hit.geomID != RTC_INVALID_GEOMETRY_ID)
+      hits[k] = Hit{double(rh[k].ray.tfar), triangles_->object[rh[k].hit.geomID], Vec3(rh[k].hit.Ng_x, rh[k].hit.Ng_y, rh[k].hit.Ng_z)};
+}
+
+void Tracer::occluded(const std::vector<Ray>& rays, std::vector<char>& blocked) const {
+  blocked.assign(rays.size(), 0);
+  for (std::size_t k = 0; k < rays.size(); ++k)
+    for (const Sphere& s : spheres_)
+      if (std::isfinite(intersect_sphere(s.center, s.radius, rays[k]))) {
+        blocked[k] = 1;
+        break;
+      }
+  if (!triangles_ || rays.empty()) return;
+  // Only the rays no sphere blocks go to Embree.
+  std::vector<RTCRay> open;
+  std::vector<std::size_t> which;
+  for (std::size_t k = 0; k < rays.size(); ++k)
+    if (!blocked[k]) open.push_back(embree_ray(rays[k])), which.push_back(k);
+  if (open.empty()) return;
+  RTCIntersectContext ctx;
+  rtcInitIntersectContext(&ctx);
+  rtcOccluded1M(triangles_->scene, &ctx, open.data(), unsigned(open.size()), sizeof(RTCRay));
+  for (std::size_t q = 0; q < open.size(); ++q)
+    if (open[q].tfar < 0.0f) blocked[which[q]] = 1;
+}
+
+void read_obj(const std::string& path, std::vector<float>& positions, std::vector<unsigned>& indices) {
+  require_regular_file(path);  // /dev/zero is one endless line
+  std::ifstream in(path);
+  if (!in) fail(path, "cannot open mesh");
+  std::string line;
+  std::size_t line_no = 0;
+  while (std::getline(in, line)) {
+    ++line_no;
+    std::istringstream ls(line);
+    std::string tag;
+    ls >> tag;
+    if (tag == "v") {
+      double x, y, z;
+      if (!(ls >> x >> y >> z)) fail(path, "line " + std::to_string(line_no) + ": bad vertex");
+      positions.insert(positions.end(), {float(x), float(y), float(z)});
+    } else if (tag == "f") {
+      std::vector<unsigned> face;
+      std::string corner;
+      while (ls >> corner) {
+        long k = std::strtol(corner.c_str(), nullptr, 10);  // "v", "v/t", "v/t/n", "v//n"
+        const long count = long(positions.size() / 3);
+        if (k < 0) k += count + 1;  // relative indices
+        if (k < 1 || k > count) fail(path, "line " + std::to_string(line_no) + ": vertex index out of range");
+        face.push_back(unsigned(k - 1));
+      }
+      if (face.size() < 3) fail(path, "line " + std::to_string(line_no) + ": face with fewer than 3 vertices");
+      for (std::size_t c = 1; c + 1 < face.size(); ++c) indices.insert(indices.end(), {face[0], face[c], face[c + 1]});
+    }
+  }
+  if (indices.empty()) fail(path, "no faces");
+}
+
+}  // namespace facetfit

@@ -1,0 +1,66 @@
+// The scene's geometry and its two ray queries: the closest hit, and whether anything blocks a segment.
+//
+// Spheres are intersected in closed form, in double precision; planes and meshes are triangles in an
+// Embree scene, which is not built at all when a scene has none. Embree's sphere primitive cost about
+// 95 ns per occlusion ray on the benchmark machine, most of the renderer's time on a sphere; the closed
+// form is a few nanoseconds (docs/render-speed.md). A scene holds a handful of spheres (look development:
+// a subject, maybe a few props), so they are tested one after the other rather than through a hierarchy.
+#pragma once
+
+#include <limits>
+#include <memory>
+#include <vector>
+
+#include "core/vec.h"
+#include "render/scene.h"
+
+namespace facetfit {
+
+struct Ray {
+  Vec3 origin, dir;
+  double tnear = 0.0;
+  double tfar = std::numeric_limits<double>::infinity();
+};
+
+struct Hit {
+  double t = std::numeric_limits<double>::infinity();
+  int object = -1;  // index into SceneDesc::objects; -1: nothing
+  Vec3 ng{0.0};     // triangles: the geometric normal, not normalized (spheres: unset)
+  bool found() const { return object >= 0; }
+};
+
+// Nearest root t in (tnear, tfar) of |origin + t dir - center| = radius, or infinity. Written as
+// Ray Tracing Gems I, ch. 7 recommends: the discriminant from the distance of the centre to the line and
+// the smaller root from the larger one, which keeps both accurate for rays far from or grazing the sphere.
+double intersect_sphere(const Vec3& center, double radius, const Ray& ray);
+
+class Tracer {
+ public:
+  // Reads the scene's meshes (throws Error naming the file on a bad one).
+  explicit Tracer(const SceneDesc& scene);
+  ~Tracer();
+  Tracer(const Tracer&) = delete;
+  Tracer& operator=(const Tracer&) = delete;
+
+  Hit intersect(const Ray& ray) const;
+  bool occluded(const Ray& ray) const;
+  // The same for many rays at once: triangles through Embree's ray streams (`coherent`: rays that travel
+  // together, as camera rays do). Each result equals the one-ray query's up to Embree's float rounding.
+  void intersect(const std::vector<Ray>& rays, std::vector<Hit>& hits, bool coherent) const;
+  void occluded(const std::vector<Ray>& rays, std::vector<char>& blocked) const;
+
+ private:
+  struct Sphere {
+    Vec3 center;
+    double radius;
+    int object;
+  };
+  struct Embree;
+  std::vector<Sphere> spheres_;
+  std::unique_ptr<Embree> triangles_;  // null: no triangles in the scene
+};
+
+// Reads a Wavefront OBJ's vertices and faces (fans for polygons); throws Error naming the file and line.
+void read_obj(const std::string& path, std::vector<float>& positions, std::vector<unsigned>& indices);
+
+}  // namespace facetfit
