@@ -14,24 +14,6 @@ std::optional<NdfType> parse_ndf_type(const std::string& name) {
   return std::nullopt;
 }
 
-double Ndf::slope_pdf(double slope_x, double slope_y) const {
-  const double r2 = (slope_x * slope_x) / (alpha_x * alpha_x) + (slope_y * slope_y) / (alpha_y * alpha_y);
-  const double norm = 1.0 / (kPi * alpha_x * alpha_y);
-  if (type == NdfType::ggx) return norm / ((1.0 + r2) * (1.0 + r2));
-  return norm * std::exp(-r2);
-}
-
-double Ndf::D(const Vec3& h) const {
-  if (h.z <= 0.0) return 0.0;
-  const double c2 = h.z * h.z;
-  return slope_pdf(-h.x / h.z, -h.y / h.z) / (c2 * c2);
-}
-
-double Ndf::lambda(const Vec3& w) const {
-  if (w.z <= 0.0) return std::numeric_limits<double>::infinity();
-  return std::max(0.0, sigma(w) / w.z - 1.0);
-}
-
 double Ndf::sigma(const Vec3& w) const {
   // Closed forms of sigma(w) = integral of max(0, w.h) D(h) dw_h, valid for any w (also at and below
   // the horizon, where cos(theta)(1 + Lambda) would be 0 * inf). Both satisfy sigma(w) - sigma(-w) = w.z.

@@ -5,6 +5,9 @@
 // (x~, y~) = (-h_x / h_z, -h_y / h_z) and slope_pdf(x~, y~) = D(h) cos^4(theta_h).
 #pragma once
 
+#include <algorithm>
+#include <cmath>
+#include <limits>
 #include <optional>
 #include <string>
 
@@ -24,11 +27,29 @@ struct Ndf {
 
   static Ndf isotropic(NdfType type, double alpha) { return {type, alpha, alpha}; }
 
-  double slope_pdf(double slope_x, double slope_y) const;
+  // Inline, with D and lambda: the renderer evaluates them several times per sample.
+  double slope_pdf(double slope_x, double slope_y) const {
+    const double r2 = (slope_x * slope_x) / (alpha_x * alpha_x) + (slope_y * slope_y) / (alpha_y * alpha_y);
+    const double norm = 1.0 / (kPi * alpha_x * alpha_y);
+    if (type == NdfType::ggx) return norm / ((1.0 + r2) * (1.0 + r2));
+    return norm * std::exp(-r2);
+  }
   // D(h) per steradian; zero for h below the horizon.
-  double D(const Vec3& h) const;
+  double D(const Vec3& h) const {
+    if (h.z <= 0.0) return 0.0;
+    const double c2 = h.z * h.z;
+    return slope_pdf(-h.x / h.z, -h.y / h.z) / (c2 * c2);
+  }
   // Smith's Lambda for direction w; sigma(w) = cos(theta_w) (1 + Lambda(w)) is the projected area.
-  double lambda(const Vec3& w) const;
+  double lambda(const Vec3& w) const {
+    if (w.z <= 0.0) return std::numeric_limits<double>::infinity();
+    // GGX: sigma / cos - 1 = (sqrt(1 + alpha^2 tan^2) - 1) / 2, alpha^2 sin^2 = w_x^2 alpha_x^2 + w_y^2 alpha_y^2.
+    if (type == NdfType::ggx) {
+      const double a2t2 = (w.x * w.x * alpha_x * alpha_x + w.y * w.y * alpha_y * alpha_y) / (w.z * w.z);
+      return a2t2 > 0.0 ? 0.5 * (std::sqrt(1.0 + a2t2) - 1.0) : 0.0;  // also 0 / 0 at a denormal normal
+    }
+    return std::max(0.0, sigma(w) / w.z - 1.0);
+  }
   double sigma(const Vec3& w) const;
   double g1(const Vec3& w) const { return w.z > 0.0 ? 1.0 / (1.0 + lambda(w)) : 0.0; }
 };
