@@ -20,6 +20,9 @@ class ParametricBrdf final : public Brdf {
       : ndf_(ndf), smith_(smith), f0_(f0), f82_(f82), body_(body), coat_(coat) {}
 
   std::optional<Rgb> eval(const Vec3& o, const Vec3& i) const override;
+  // f(o, i) for o and i above the horizon, from what a caller that also needs the lobe's density has
+  // already computed: h = normalize(i + o), D(h) and Lambda(o).
+  Rgb eval_with(const Vec3& o, const Vec3& i, const Vec3& h, double d, double lambda_o) const;
   const Ndf& ndf() const { return ndf_; }
 
  private:

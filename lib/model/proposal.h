@@ -74,6 +74,13 @@ class GgxProposal final : public Proposal {
     if (i.z <= 0.0 || o.z <= 0.0) return 0.0;
     return parts_.pdf(o, i, ggx_visible_pdf(o, i, alpha_));
   }
+  // pdf() from what a caller evaluating a GGX lobe of the same alpha has already computed: the half
+  // vector h, D(h) and G1(o) (the visible normals' density is G1(o) D(h) / (4 cos(theta_o))).
+  double pdf_with(const Vec3& o, const Vec3& i, const Vec3& h, double d, double g1_o) const {
+    if (i.z <= 0.0 || o.z <= 0.0) return 0.0;
+    return parts_.pdf(o, i, glm::dot(o, h) > 0.0 ? g1_o * d / (4.0 * o.z) : 0.0);
+  }
+  double alpha() const { return alpha_; }
 
  private:
   double alpha_;

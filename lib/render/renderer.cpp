@@ -179,8 +179,8 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
       const Environment::Sample ls = env->sample(u[0], u[1]);
       const Vec3 il = frame.to_local(ls.d);
       if (il.z > 0.0 && ls.pdf > 0.0) {
-        const double w = power_heuristic(ls.pdf, model.pdf(o, il));
-        visible_if_unblocked(ls.d, infinity, model.f(o, il) * ls.radiance * (il.z * w / ls.pdf));
+        const ShadingModel::Evaluation e = model.eval(o, il);
+        visible_if_unblocked(ls.d, infinity, e.f * ls.radiance * (il.z * power_heuristic(ls.pdf, e.pdf) / ls.pdf));
       }
       // BRDF sampling, weighted against the environment's.
       if (const auto bs = model.sample(o, u[2], u[3], u[4])) {

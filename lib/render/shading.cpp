@@ -3,11 +3,18 @@
 #include <cmath>
 
 #include "model/ndf.h"
+#include "model/parametric.h"
 
 namespace facetfit {
 
 ShadingModel::ShadingModel(std::shared_ptr<const Brdf> brdf, std::shared_ptr<const Proposal> proposal)
-    : brdf_(std::move(brdf)), proposal_(std::move(proposal)), lobe_weight_(proposal_ && proposal_->can_sample() ? 0.85 : 0.0) {}
+    : brdf_(std::move(brdf)), proposal_(std::move(proposal)), lobe_weight_(proposal_ && proposal_->can_sample() ? 0.85 : 0.0) {
+  const auto* lobe = dynamic_cast<const ParametricBrdf*>(brdf_.get());
+  const auto* ggx = dynamic_cast<const GgxProposal*>(proposal_.get());
+  if (lobe && ggx && lobe_weight_ > 0.0 && lobe->ndf().type == NdfType::ggx && lobe->ndf().alpha_x == ggx->alpha() &&
+      lobe->ndf().alpha_y == ggx->alpha())
+    ggx_brdf_ = lobe, ggx_proposal_ = ggx;
+}
 
 Rgb ShadingModel::f(const Vec3& o, const Vec3& i) const {
   // Negative values (a measurement's noise around zero) are rendered as they are, as Mitsuba does.
@@ -15,10 +22,22 @@ Rgb ShadingModel::f(const Vec3& o, const Vec3& i) const {
   return v ? *v : Rgb(0.0);
 }
 
+double ShadingModel::mixture(const Vec3& i, double proposal_pdf) const {
+  const double cosine = i.z * kInvPi;
+  return lobe_weight_ > 0.0 ? lobe_weight_ * proposal_pdf + (1.0 - lobe_weight_) * cosine : cosine;
+}
+
 double ShadingModel::pdf(const Vec3& o, const Vec3& i) const {
   if (i.z <= 0.0 || o.z <= 0.0) return 0.0;
-  const double cosine = i.z * kInvPi;
-  return lobe_weight_ > 0.0 ? lobe_weight_ * proposal_->pdf(o, i) + (1.0 - lobe_weight_) * cosine : cosine;
+  return mixture(i, lobe_weight_ > 0.0 ? proposal_->pdf(o, i) : 0.0);
+}
+
+ShadingModel::Evaluation ShadingModel::eval(const Vec3& o, const Vec3& i) const {
+  if (!ggx_brdf_ || i.z <= 0.0 || o.z <= 0.0) return {f(o, i), pdf(o, i)};
+  const Vec3 h = glm::normalize(i + o);
+  const Ndf& ndf = ggx_brdf_->ndf();
+  const double d = ndf.D(h), lambda_o = ndf.lambda(o);
+  return {ggx_brdf_->eval_with(o, i, h, d, lambda_o), mixture(i, ggx_proposal_->pdf_with(o, i, h, d, 1.0 / (1.0 + lambda_o)))};
 }
 
 std::optional<ShadingModel::Sample> ShadingModel::sample(const Vec3& o, double u1, double u2, double u3) const {
@@ -43,9 +62,9 @@ std::optional<ShadingModel::Sample> ShadingModel::sample(const Vec3& o, double u
     const double x = r * std::cos(phi), y = r * std::sin(phi);
     i = Vec3(x, y, std::sqrt(std::max(0.0, 1.0 - x * x - y * y)));
   }
-  const double p = pdf(o, i);
-  if (!(p > 0.0)) return std::nullopt;
-  return Sample{i, f(o, i) * (i.z / p), p};
+  const Evaluation e = eval(o, i);
+  if (!(e.pdf > 0.0)) return std::nullopt;
+  return Sample{i, e.f * (i.z / e.pdf), e.pdf};
 }
 
 }  // namespace facetfit

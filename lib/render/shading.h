@@ -15,6 +15,9 @@
 
 namespace facetfit {
 
+class GgxProposal;
+class ParametricBrdf;
+
 class ShadingModel {
  public:
   // `proposal` may be null: cosine sampling alone (a Lambertian surface).
@@ -22,17 +25,29 @@ class ShadingModel {
 
   // f(o, i) in the local frame (missing measurements count as zero).
   Rgb f(const Vec3& o, const Vec3& i) const;
+  double pdf(const Vec3& o, const Vec3& i) const;
+  // Both at once, for o and i above the horizon: what a light sample weighted against this proposal needs.
+  struct Evaluation {
+    Rgb f;
+    double pdf;
+  };
+  Evaluation eval(const Vec3& o, const Vec3& i) const;
 
   using Sample = BrdfSample;
   std::optional<Sample> sample(const Vec3& o, double u1, double u2, double u3) const;
-  double pdf(const Vec3& o, const Vec3& i) const;
 
   const Brdf& brdf() const { return *brdf_; }
 
  private:
+  double mixture(const Vec3& i, double proposal_pdf) const;
+
   std::shared_ptr<const Brdf> brdf_;
   std::shared_ptr<const Proposal> proposal_;
   double lobe_weight_;  // probability of sampling the microfacet proposal
+  // A GGX lobe sampled by its own visible normals (the ggx material): eval() computes the half vector, D
+  // and Lambda(o) once for f and pdf. Null otherwise.
+  const ParametricBrdf* ggx_brdf_ = nullptr;
+  const GgxProposal* ggx_proposal_ = nullptr;
 };
 
 }  // namespace facetfit
