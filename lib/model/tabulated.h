@@ -95,6 +95,7 @@ class TabulatedMicrofacet final : public Brdf, public Proposal {
     MicrofacetTables tables;
     VisibleNormalTables sampling;
     std::vector<double> cos_nodes;  // cos(theta_j)
+    std::optional<G1Table> g1;      // G1 without an arc cosine and a spline per call
     ProposalParts parts;
   };
   std::shared_ptr<const Shared> shared_;

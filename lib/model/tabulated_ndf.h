@@ -1,6 +1,8 @@
 // An isotropic NDF tabulated on a ThetaGrid, with its projected-area table sigma.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <vector>
 
 #include "model/theta_grid.h"
@@ -29,25 +31,33 @@ struct TabulatedNdf {
   }
 };
 
-// G1 tabulated on a uniform grid of cos(theta) for the inner loops that evaluate it millions of times.
+// G1 tabulated for the inner loops that evaluate it millions of times (the fits' residuals, the
+// renderer). What is tabulated is G1 / cos(theta) = 1 / sigma, which stays finite at the horizon (G1 itself
+// falls to zero over cos(theta) in [0, alpha], linearly, and the fits divide it by cos(theta)), on a grid
+// uniform in sqrt(cos(theta)) that crowds its nodes there. Linear between nodes; at 2048 nodes G1 is
+// within 7.3e-5 of the spline's (relative, at any cos(theta) > 0) for GGX and Beckmann, alpha 0.005 to 1.5.
 class G1Table {
  public:
-  explicit G1Table(const TabulatedNdf& ndf, int size = 1024) : values_(std::size_t(size) + 1) {
-    for (int m = 0; m <= size; ++m) values_[std::size_t(m)] = ndf.g1(double(m) / size);
-    scale_ = size;
+  explicit G1Table(const TabulatedNdf& ndf, int size = 2048) : ratio_(std::size_t(size) + 1), scale_(size) {
+    for (int m = 1; m <= size; ++m) {
+      const double root = double(m) / size, c = root * root;
+      ratio_[std::size_t(m)] = ndf.g1(c) / c;
+    }
+    const double horizon = ndf.sigma_at(0.5 * kPi);  // the limit 1 / sigma(pi/2)
+    ratio_[0] = horizon > 0.0 ? 1.0 / horizon : ratio_[1];
   }
   double operator()(double cos_theta) const {
-    const double x = cos_theta * scale_;
-    if (x <= 0.0) return 0.0;
+    if (!(cos_theta > 0.0)) return 0.0;
+    const double x = std::sqrt(cos_theta) * scale_;
     const int m = int(x);
-    if (m >= int(scale_)) return values_.back();
+    if (m >= int(scale_)) return std::min(1.0, cos_theta * ratio_.back());
     const double t = x - m;
-    return values_[std::size_t(m)] + t * (values_[std::size_t(m) + 1] - values_[std::size_t(m)]);
+    return std::min(1.0, cos_theta * (ratio_[std::size_t(m)] + t * (ratio_[std::size_t(m) + 1] - ratio_[std::size_t(m)])));
   }
 
  private:
-  std::vector<double> values_;
-  double scale_ = 1.0;
+  std::vector<double> ratio_;  // G1 / cos(theta) at cos(theta) = (m / size)^2
+  double scale_;
 };
 
 // An analytic NDF on `grid`: its D and sigma at the nodes.
