@@ -60,6 +60,7 @@ TabulatedMicrofacet::TabulatedMicrofacet(MicrofacetTables tables, VisibleNormalT
   shared->tables = std::move(tables);
   shared->sampling = std::move(sampling);
   for (int j = 0; j < shared->tables.ndf.grid.size(); ++j) shared->cos_nodes.push_back(std::cos(shared->tables.ndf.grid.theta(j)));
+  shared->g1.emplace(shared->tables.ndf);
   shared->parts = ProposalParts(shared->tables.fresnel.value[0], shared->tables.body, shared->tables.coat);
   shared_ = std::move(shared);
 }
@@ -80,8 +81,8 @@ double TabulatedMicrofacet::D(const Vec3& h) const {
 }
 
 double TabulatedMicrofacet::g1(const Vec3& w) const {
-  if (stretch_.identity() || w.z <= 0.0) return shared_->tables.ndf.g1(w.z);
-  return shared_->tables.ndf.g1(stretch_.direction(stretch_.to_frame(w)).z);  // Lambda_s(w) = Lambda(w')
+  if (stretch_.identity() || w.z <= 0.0) return (*shared_->g1)(w.z);
+  return (*shared_->g1)(stretch_.direction(stretch_.to_frame(w)).z);  // Lambda_s(w) = Lambda(w')
 }
 
 Rgb TabulatedMicrofacet::fresnel(double cos_d) const { return shared_->tables.fresnel.eval(std::acos(clamp(cos_d, 0.0, 1.0))); }
@@ -108,31 +109,33 @@ GridPosition locate(const ThetaGrid& grid, double cos_theta) {
   return {j, t};
 }
 
-// phi in (-pi, pi] with density proportional to max(0, a cos(phi) + b), a, b >= 0, from u in [0, 1).
-double sample_phi(double a, double b, double u) {
+// phi in (-pi, pi] with density proportional to max(0, a cos(phi) + b), a, b >= 0, from u in [0, 1);
+// returned as (cos phi, sin phi), which Newton's last step has already computed.
+std::pair<double, double> sample_phi(double a, double b, double u) {
   const double phi_max = a <= b ? kPi : std::acos(-b / a);
   const double sign = u < 0.5 ? -1.0 : 1.0;
   u = u < 0.5 ? 2.0 * u : 2.0 * u - 1.0;
   const double total = a * std::sin(phi_max) + b * phi_max;  // CDF a sin(phi) + b phi on [0, phi_max]
-  if (!(total > 0.0)) return sign * u * kPi;
+  if (!(total > 0.0)) return {std::cos(u * kPi), sign * std::sin(u * kPi)};
   const double target = u * total;
   // Newton on the monotone CDF, kept inside the bracket. Near phi_max the density vanishes and the last
   // digits of f are rounding noise: a tighter stop there costs ~7 more iterations (11 instead of 4).
-  double lo = 0.0, hi = phi_max, phi = u * phi_max;
+  double lo = 0.0, hi = phi_max, phi = u * phi_max, s = 0.0, c = 1.0;
   for (int it = 0; it < 40; ++it) {
-    const double s = std::sin(phi), c = std::cos(phi);  // one sincos
+    s = std::sin(phi), c = std::cos(phi);  // one sincos
     const double f = a * s + b * phi - target;
     if (f > 0.0) hi = phi; else lo = phi;
     const double df = a * c + b;
     double next = df > 0.0 ? phi - f / df : 0.5 * (lo + hi);
     if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
-    if (std::abs(next - phi) < 1e-7) {  // radians: below what a float ray direction resolves
-      phi = next;
-      break;
+    const double step = next - phi;
+    if (std::abs(step) < 1e-7) {  // radians: below what a float ray direction resolves
+      // The rotation by the last step to first order (its square, < 1e-14, is below double rounding).
+      return {c - s * step, sign * (s + c * step)};
     }
     phi = next;
   }
-  return sign * phi;
+  return {std::cos(phi), sign * std::sin(phi)};
 }
 
 }  // namespace
@@ -222,8 +225,12 @@ Vec3 TabulatedMicrofacet::measured_visible_normal(const Vec3& o, double u1, doub
   const double cos_h = shared_->cos_nodes[std::size_t(j)] - frac * (shared_->cos_nodes[std::size_t(j)] - shared_->cos_nodes[std::size_t(j) + 1]);
   const double sin_h = std::sqrt(std::max(0.0, 1.0 - cos_h * cos_h));
   const double sin_o = std::sqrt(std::max(0.0, 1.0 - o.z * o.z));
-  const double phi = sample_phi(sin_o * sin_h, o.z * cos_h, u2) + (sin_o > 0.0 ? std::atan2(o.y, o.x) : 0.0);
-  return {sin_h * std::cos(phi), sin_h * std::sin(phi), cos_h};
+  // phi relative to o's azimuth, then turned to it (no arc tangent: its cosine and sine are o.xy / |o.xy|).
+  const auto [cos_phi, sin_phi] = sample_phi(sin_o * sin_h, o.z * cos_h, u2);
+  const double o_xy = std::sqrt(o.x * o.x + o.y * o.y);
+  if (!(sin_o > 0.0 && o_xy > 0.0)) return {sin_h * cos_phi, sin_h * sin_phi, cos_h};
+  const double cos_az = o.x / o_xy, sin_az = o.y / o_xy;
+  return {sin_h * (cos_phi * cos_az - sin_phi * sin_az), sin_h * (sin_phi * cos_az + cos_phi * sin_az), cos_h};
 }
 
 }  // namespace facetfit
