@@ -141,6 +141,29 @@ def profile(binary, work, material):
     return rows[:14], sorted(libraries.items(), key=lambda kv: -kv[1])[:5]
 
 
+def start_up(binary):
+    """(median process time of `render --help`, shared libraries of the command plugin, share of the time in
+    the dynamic loader as text)."""
+    times = []
+    for _ in range(RUNS):
+        start = time.perf_counter()
+        subprocess.run([binary, "render", "--help"], check=True, capture_output=True)
+        times.append(time.perf_counter() - start)
+    plugin = os.path.join(os.path.dirname(os.path.abspath(binary)), "facetfit-commands.so")
+    libraries = subprocess.run(["ldd", plugin], capture_output=True, text=True).stdout.count("=>")
+    share = "n/a"
+    with tempfile.TemporaryDirectory() as tmp:
+        data = os.path.join(tmp, "perf.data")
+        if subprocess.run(["perf", "record", "-q", "-o", data, binary, "render", "--help"], capture_output=True).returncode == 0:
+            out = subprocess.run(["perf", "report", "-i", data, "--no-children", "--sort", "dso", "--stdio"],
+                                 capture_output=True, text=True).stdout
+            for line in out.splitlines():
+                m = re.match(r"\s*([0-9.]+)%\s+(\S+)", line)
+                if m and m.group(2).startswith("ld-linux"):
+                    share = "%.0f%%" % float(m.group(1))
+    return median(times), libraries, share
+
+
 def main(facetfit, mitsuba_python, dst, rgl=None):
     work = tempfile.mkdtemp()
     env = dict(os.environ)
@@ -182,6 +205,7 @@ def main(facetfit, mitsuba_python, dst, rgl=None):
     if llvm:
         scaling.append(("Mitsuba llvm_ad_rgb", mitsuba_run(mitsuba_python, "llvm_ad_rgb", ggx_mi, 64, env, one_cpu)[0], rows[0][6][0]))
     profiles = [(label, profile(facetfit, work, ff)) for label, ff, _ in cases[:2]]
+    startup = start_up(facetfit)
     report = (0, 0.0)
     if rgl:
         db = os.path.dirname(rgl)
@@ -217,8 +241,12 @@ def main(facetfit, mitsuba_python, dst, rgl=None):
         out.write("| renderer | render, 1 CPU | render, %d CPUs | speed-up |\n|---|---|---|---|\n" % cpus)
         for name, one, all_ in scaling:
             out.write("| %s | %.3f s | %.3f s | %.2f |\n" % (name, one, all_, one / all_))
+        out.write("\n## Start-up\n\nA process that loads the render command and exits at once (`facetfit render --help`), median of %d: "
+                  "%.3f s; the command plugin and the shared libraries it needs: %d (OpenImageIO brings most of them), "
+                  "whose symbol lookups by the dynamic loader take %s of that time (`perf record`). A render's process time "
+                  "is its render time plus this.\n" % (RUNS, startup[0], startup[1], startup[2]))
         out.write("\n## Where the time goes\n\n`perf record` of one facetfit render (64 spp, whole process), self time by\n"
-                  "library and symbol (unnamed addresses in libembree3 are its stripped traversal kernels).\n")
+                  "library and symbol (the sphere is intersected in closed form, render/tracer.h; Embree traces triangles only).\n")
         for label, (rows_, libraries) in profiles:
             out.write("\n%s, by library: %s.\n\n| self | library | symbol |\n|---|---|---|\n" % (
                 label, ", ".join("%s %.0f%%" % (dso, pct) for dso, pct in libraries) or "n/a"))
