@@ -1,4 +1,4 @@
-// An orthonormal shading frame (t, b, n) around a unit normal, and the change of coordinates to it.
+// Orthonormal local frames: the shading frame (t, b, n) around a unit normal, and a frame turned about it.
 #pragma once
 
 #include <cmath>
@@ -26,6 +26,16 @@ struct Frame {
   }
   Vec3 to_local(const Vec3& v) const { return {glm::dot(v, t), glm::dot(v, b), glm::dot(v, n)}; }
   Vec3 to_world(const Vec3& v) const { return v.x * t + v.y * b + v.z * n; }
+};
+
+// A local frame turned about its normal: the x axis at azimuth `angle`. Anisotropic lobes are written in
+// the frame of their axes, which a measurement or a stretch places at some azimuth.
+struct TurnedFrame {
+  double c = 1.0, s = 0.0;  // cosine and sine of the angle, kept: callers turn every direction they evaluate
+  TurnedFrame() = default;
+  explicit TurnedFrame(double angle) : c(std::cos(angle)), s(std::sin(angle)) {}
+  Vec3 to_frame(const Vec3& v) const { return {c * v.x + s * v.y, -s * v.x + c * v.y, v.z}; }    // by -angle
+  Vec3 from_frame(const Vec3& v) const { return {c * v.x - s * v.y, s * v.x + c * v.y, v.z}; }  // by +angle
 };
 
 }  // namespace facetfit

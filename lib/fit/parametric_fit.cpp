@@ -6,6 +6,7 @@
 #include <cmath>
 #include <vector>
 
+#include "core/frame.h"
 #include "model/fresnel.h"
 #include "model/parametric.h"
 #include "model/rotated.h"
@@ -292,9 +293,8 @@ namespace {
 // frame turned by `angle`: the library's own NDF and masking, so what is fitted is what is rendered.
 double anisotropic_lobe(NdfType type, Smith smith, double alpha_x, double alpha_y, double angle, const Vec3& o, const Vec3& i) {
   const Ndf ndf{type, alpha_x, alpha_y};
-  const double c = std::cos(angle), s = std::sin(angle);
-  const auto turn = [&](const Vec3& v) { return Vec3(c * v.x + s * v.y, -s * v.x + c * v.y, v.z); };  // by -angle
-  const Vec3 ti = turn(i), to = turn(o);
+  const TurnedFrame axes(angle);
+  const Vec3 ti = axes.to_frame(i), to = axes.to_frame(o);
   return ndf.D(glm::normalize(ti + to)) * smith_g2(smith, ndf.lambda(ti), ndf.lambda(to)) / (4.0 * i.z * o.z);
 }
 

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 
+#include "core/frame.h"
 #include "core/halfdiff.h"
 
 namespace facetfit {
@@ -27,9 +28,8 @@ double HalfDiffLattice::measure(int h, int d) {
 
 std::pair<Vec3, Vec3> HalfDiffLattice::directions(int h, int ph, int d, int pd) {
   const auto [i, o] = from_half_diff(theta_h(h), theta_d(d), phi_d(pd));
-  const double c = std::cos(phi_h(ph)), s = std::sin(phi_h(ph));
-  const auto turn = [&](const Vec3& v) { return Vec3(c * v.x - s * v.y, s * v.x + c * v.y, v.z); };
-  return {turn(i), turn(o)};
+  const TurnedFrame half(phi_h(ph));  // the pair at phi_h = 0, turned to the half vector's azimuth
+  return {half.from_frame(i), half.from_frame(o)};
 }
 
 HalfDiffLattice HalfDiffLattice::of(const Brdf& source) {

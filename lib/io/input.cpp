@@ -9,6 +9,7 @@
 #include <filesystem>
 
 #include "core/error.h"
+#include "core/frame.h"
 #include "io/rgl.h"
 #include "io/utia.h"
 #include "model/builtin.h"
@@ -65,13 +66,12 @@ class AzimuthalMean final : public Brdf {
  public:
   static constexpr int kTurns = 32;
   explicit AzimuthalMean(const Brdf& source) : source_(source) {
-    for (int k = 0; k < kTurns; ++k) cos_sin_[std::size_t(k)] = {std::cos(2.0 * kPi * k / kTurns), std::sin(2.0 * kPi * k / kTurns)};
+    for (int k = 0; k < kTurns; ++k) turns_[std::size_t(k)] = TurnedFrame(2.0 * kPi * k / kTurns);
   }
   std::optional<Rgb> eval(const Vec3& o, const Vec3& i) const override {
     Rgb sum(0.0);
-    for (const auto& [c, s] : cos_sin_) {
-      const auto turn = [&, c = c, s = s](const Vec3& v) { return Vec3(c * v.x - s * v.y, s * v.x + c * v.y, v.z); };
-      const auto f = source_.eval(turn(o), turn(i));
+    for (const TurnedFrame& turn : turns_) {
+      const auto f = source_.eval(turn.from_frame(o), turn.from_frame(i));
       if (!f) return std::nullopt;
       sum += *f;
     }
@@ -80,7 +80,7 @@ class AzimuthalMean final : public Brdf {
 
  private:
   const Brdf& source_;
-  std::array<std::pair<double, double>, kTurns> cos_sin_;  // of each turn, computed once: eval runs per bin
+  std::array<TurnedFrame, kTurns> turns_;  // computed once: eval runs per bin
 };
 
 }  // namespace

@@ -11,6 +11,7 @@
 
 #include <cmath>
 
+#include "core/frame.h"
 #include "core/vec.h"
 
 namespace facetfit {
@@ -22,7 +23,7 @@ class Stretch {
 
   // Slopes scaled by (x, y) along axes whose x axis lies at azimuth `rotation` (radians).
   Stretch(double along_x = 1.0, double along_y = 1.0, double rotation = 0.0)
-      : x(along_x), y(along_y), rotation_(rotation), cos_(std::cos(rotation)), sin_(std::sin(rotation)) {}
+      : x(along_x), y(along_y), rotation_(rotation), axes_(rotation) {}
 
   double x, y;
   double rotation() const { return rotation_; }
@@ -30,10 +31,9 @@ class Stretch {
   // An isotropic lobe does not change under rotation alone.
   bool identity() const { return x == 1.0 && y == 1.0; }
 
-  // Into and out of the frame whose x axis is the stretch's (the rotation's sine and cosine are kept:
-  // the tabulated model turns every direction it evaluates).
-  Vec3 to_frame(const Vec3& v) const { return {cos_ * v.x + sin_ * v.y, -sin_ * v.x + cos_ * v.y, v.z}; }
-  Vec3 from_frame(const Vec3& v) const { return {cos_ * v.x - sin_ * v.y, sin_ * v.x + cos_ * v.y, v.z}; }
+  // Into and out of the frame whose x axis is the stretch's.
+  Vec3 to_frame(const Vec3& v) const { return axes_.to_frame(v); }
+  Vec3 from_frame(const Vec3& v) const { return axes_.from_frame(v); }
   // A direction as the measured lobe sees it (masking, the view of visible normals); frame coordinates.
   Vec3 direction(const Vec3& w) const { return glm::normalize(Vec3(x * w.x, y * w.y, w.z)); }
   // A normal of the stretched lobe as a normal of the measured one, and back; frame coordinates.
@@ -46,7 +46,8 @@ class Stretch {
   }
 
  private:
-  double rotation_, cos_, sin_;
+  double rotation_;
+  TurnedFrame axes_;
 };
 
 }  // namespace facetfit

@@ -5,6 +5,7 @@
 #include <cstring>
 #include <random>
 
+#include "core/frame.h"
 
 namespace facetfit::test {
 
@@ -60,8 +61,7 @@ std::vector<unsigned char> serialize(const std::vector<TensorField>& fields, uns
 
 std::vector<TensorField> microfacet_tensor_fields(const Ndf& ndf, Smith smith, double angle, int phi_slices,
                                                   int theta_slices, int rgb_nodes) {
-  const double c = std::cos(angle), s = std::sin(angle);
-  const auto turn = [&](const Vec3& v) { return Vec3(c * v.x + s * v.y, -s * v.x + c * v.y, v.z); };  // by -angle
+  const TurnedFrame axes(angle);
   // The format's maps: theta = (pi/2) u^2, phi = (2 u - 1) pi.
   const auto half_vector = [](double u0, double u1) { return spherical_direction(0.5 * kPi * u0 * u0, (2.0 * u1 - 1.0) * kPi); };
 
@@ -69,7 +69,7 @@ std::vector<TensorField> microfacet_tensor_fields(const Ndf& ndf, Smith smith, d
   std::vector<float> ndf_table, sigma_table;
   for (std::uint64_t y = 0; y < kNdfY; ++y)
     for (std::uint64_t x = 0; x < kNdfX; ++x) {
-      const Vec3 h = turn(half_vector(double(x) / double(kNdfX - 1), double(y) / double(kNdfY - 1)));
+      const Vec3 h = axes.to_frame(half_vector(double(x) / double(kNdfX - 1), double(y) / double(kNdfY - 1)));
       ndf_table.push_back(float(ndf.D(h)));
       // At the horizon Smith's projected area is the limit from above.
       sigma_table.push_back(float(ndf.sigma(h.z > 1e-6 ? h : glm::normalize(Vec3(h.x, h.y, 1e-6)))));
@@ -125,8 +125,8 @@ std::vector<TensorField> microfacet_tensor_fields(const Ndf& ndf, Smith smith, d
           // the horizon; beyond it the table holds that line's continuation (-G2 of o mirrored), so
           // that interpolating across the horizon stays exact instead of averaging with zeros.
           const Vec3 mirrored(o.x, o.y, std::max(std::abs(o.z), 1e-9));
-          const double g2 = smith_g2(smith, ndf.lambda(turn(i)), ndf.lambda(turn(mirrored)));
-          plane[y * n + x] = float((o.z >= 0.0 ? g2 : -g2) * ndf.sigma(turn(i)) / std::max(i.z, 1e-9));
+          const double g2 = smith_g2(smith, ndf.lambda(axes.to_frame(i)), ndf.lambda(axes.to_frame(mirrored)));
+          plane[y * n + x] = float((o.z >= 0.0 ? g2 : -g2) * ndf.sigma(axes.to_frame(i)) / std::max(i.z, 1e-9));
         }
       for (int ch = 0; ch < 3; ++ch) rgb.insert(rgb.end(), plane.begin(), plane.end());
       luminance.insert(luminance.end(), plane.begin(), plane.end());
