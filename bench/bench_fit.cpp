@@ -1,5 +1,6 @@
 // Speed of the fit pipeline (Google Benchmark). `make bench` runs this and writes docs/benchmarks.md.
 #include <benchmark/benchmark.h>
+#include <embree3/rtcore.h>
 #include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
 
@@ -7,7 +8,10 @@
 #include <filesystem>
 #include <map>
 #include <memory>
+#include <limits>
 #include <optional>
+#include <random>
+#include <vector>
 
 #include "fit/extract_2d.h"
 #include "fit/fit.h"
@@ -21,6 +25,7 @@
 #include "model/analytic.h"
 #include "model/tabulated.h"
 #include "model/tabulated_anisotropic.h"
+#include "render/tracer.h"
 
 namespace facetfit {
 namespace {
@@ -228,6 +233,53 @@ void BM_TabulatedAnisotropicLobe(benchmark::State& state) {
   lobe_benchmark(state, state.range(1) ? lobe.stretched(Stretch(0.5, 2.0, 0.5)) : lobe);
 }
 BENCHMARK(BM_TabulatedAnisotropicLobe)->ArgNames({"draw", "stretched"})->Args({0, 0})->Args({1, 0})->Args({0, 1})->Args({1, 1})->Unit(benchmark::kNanosecond);
+
+// The renderer's shadow rays on a sphere: leaving a unit sphere 2e-4 above it, toward random directions
+// above its surface. embree:1 (anchor): Embree's sphere primitive, one ray at a time, as the renderer had
+// it; embree:0: the tracer's closed form (render/tracer.h).
+void BM_ShadowRay(benchmark::State& state) {
+  std::vector<Ray> rays;
+  std::mt19937 rng(7);
+  std::normal_distribution<double> normal;
+  for (int k = 0; k < 4096; ++k) {
+    const Vec3 p = glm::normalize(Vec3(normal(rng), normal(rng), normal(rng)));
+    Vec3 d = glm::normalize(Vec3(normal(rng), normal(rng), normal(rng)));
+    if (glm::dot(d, p) < 0.0) d = -d;
+    rays.push_back(Ray{p * (1.0 + 2e-4), d, 2e-4});
+  }
+  if (state.range(0) == 0) {
+    SceneDesc scene;
+    scene.objects.push_back(ObjectDesc{});  // a unit sphere at the origin
+    const Tracer tracer(scene);
+    std::size_t k = 0;
+    for (auto _ : state) benchmark::DoNotOptimize(tracer.occluded(rays[k++ % rays.size()]));
+    return;
+  }
+  RTCDevice device = rtcNewDevice("threads=1");
+  RTCScene rtc_scene = rtcNewScene(device);
+  RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_SPHERE_POINT);
+  auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4, 4 * sizeof(float), 1));
+  v[0] = v[1] = v[2] = 0.0f, v[3] = 1.0f;
+  rtcCommitGeometry(g);
+  rtcAttachGeometry(rtc_scene, g);
+  rtcReleaseGeometry(g);
+  rtcCommitScene(rtc_scene);
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  std::size_t k = 0;
+  for (auto _ : state) {
+    const Ray& r = rays[k++ % rays.size()];
+    RTCRay ray{};
+    ray.org_x = float(r.origin.x), ray.org_y = float(r.origin.y), ray.org_z = float(r.origin.z);
+    ray.dir_x = float(r.dir.x), ray.dir_y = float(r.dir.y), ray.dir_z = float(r.dir.z);
+    ray.tnear = float(r.tnear), ray.tfar = std::numeric_limits<float>::infinity(), ray.mask = 0xFFFFFFFFu;
+    rtcOccluded1(rtc_scene, &context, &ray);
+    benchmark::DoNotOptimize(ray.tfar);
+  }
+  rtcReleaseScene(rtc_scene);
+  rtcReleaseDevice(device);
+}
+BENCHMARK(BM_ShadowRay)->ArgName("embree")->Arg(1)->Arg(0)->Unit(benchmark::kNanosecond);
 
 // A MERL file on disk for the bake benchmarks, written once.
 const std::string& gold_file() {

@@ -21,6 +21,7 @@ NOTES = {
     "BM_FitAnisotropicLobe": "one anisotropic GGX lobe with a body fitted on the UTIA file's half/difference lattice (5.7k nodes solved, 138k measured; central differences), one core",
     "BM_TabulatedLobe": "the isotropic tabulated lobe (anchor of the next): one eval (draw:0) or one draw, sample + pdf + eval (draw:1), plain and stretched (0.5, 2)",
     "BM_TabulatedAnisotropicLobe": "the anisotropic tabulated lobe (GGX 0.4 x 0.15 on 90 x 64 nodes), the same operations",
+    "BM_ShadowRay": "one shadow ray leaving a unit sphere: Embree's sphere primitive (anchor, one ray at a time, as the renderer traced spheres before) and the tracer's closed form",
     "BM_Bake": "bake one MERL file with the default fit: SHA-256, read, fit, sampling tables, EXR, sidecar (hash overlapped with the read)",
     "BM_Sha256File": "SHA-256 of the 35 MB MERL file (OpenSSL; provenance in the LUT, bake cache key)",
     "BM_VisibleNormalTables": "the sampling tables of one material",
