@@ -23,10 +23,12 @@ inline HalfDiff to_half_diff(const Vec3& i, const Vec3& o) {
   HalfDiff hd;
   hd.theta_h = std::acos(clamp(h.z, -1.0, 1.0));
   hd.phi_h = std::atan2(h.y, h.x);
-  // d = R_y(-theta_h) R_z(-phi_h) i
-  const double cp = std::cos(hd.phi_h), sp = std::sin(hd.phi_h);
+  // d = R_y(-theta_h) R_z(-phi_h) i, the rotations' cosines and sines read off h itself (no sincos: this
+  // runs per evaluation of a MERL table).
+  const double r = std::sqrt(h.x * h.x + h.y * h.y);
+  const double cp = r > 0.0 ? h.x / r : 1.0, sp = r > 0.0 ? h.y / r : 0.0;
   const Vec3 t(cp * i.x + sp * i.y, -sp * i.x + cp * i.y, i.z);
-  const double ct = std::cos(hd.theta_h), st = std::sin(hd.theta_h);
+  const double ct = clamp(h.z, -1.0, 1.0), st = r;
   const Vec3 d(ct * t.x - st * t.z, t.y, st * t.x + ct * t.z);
   hd.theta_d = std::acos(clamp(d.z, -1.0, 1.0));
   hd.phi_d = std::atan2(d.y, d.x);
