@@ -34,6 +34,12 @@ struct TurnedFrame {
   double c = 1.0, s = 0.0;  // cosine and sine of the angle, kept: callers turn every direction they evaluate
   TurnedFrame() = default;
   explicit TurnedFrame(double angle) : c(std::cos(angle)), s(std::sin(angle)) {}
+  // From the angle's cosine and sine when a direction gives them (x / r, y / r), without the angle.
+  static TurnedFrame of(double cosine, double sine) {
+    TurnedFrame f;
+    f.c = cosine, f.s = sine;
+    return f;
+  }
   Vec3 to_frame(const Vec3& v) const { return {c * v.x + s * v.y, -s * v.x + c * v.y, v.z}; }    // by -angle
   Vec3 from_frame(const Vec3& v) const { return {c * v.x - s * v.y, s * v.x + c * v.y, v.z}; }  // by +angle
 };

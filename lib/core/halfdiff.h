@@ -8,6 +8,7 @@
 #include <cmath>
 #include <utility>
 
+#include "core/frame.h"
 #include "core/vec.h"
 
 namespace facetfit {
@@ -26,8 +27,7 @@ inline HalfDiff to_half_diff(const Vec3& i, const Vec3& o) {
   // d = R_y(-theta_h) R_z(-phi_h) i, the rotations' cosines and sines read off h itself (no sincos: this
   // runs per evaluation of a MERL table).
   const double r = std::sqrt(h.x * h.x + h.y * h.y);
-  const double cp = r > 0.0 ? h.x / r : 1.0, sp = r > 0.0 ? h.y / r : 0.0;
-  const Vec3 t(cp * i.x + sp * i.y, -sp * i.x + cp * i.y, i.z);
+  const Vec3 t = (r > 0.0 ? TurnedFrame::of(h.x / r, h.y / r) : TurnedFrame()).to_frame(i);
   const double ct = clamp(h.z, -1.0, 1.0), st = r;
   const Vec3 d(ct * t.x - st * t.z, t.y, st * t.x + ct * t.z);
   hd.theta_d = std::acos(clamp(d.z, -1.0, 1.0));

@@ -29,12 +29,17 @@ inline std::optional<Vec3> ggx_visible_direction(const Vec3& o, double alpha, do
   return i;
 }
 
+// The density from its parts, for callers that have them: D(h) and G1(o) for h = normalize(i + o), o and i
+// above the horizon.
+inline double ggx_visible_pdf_of(const Vec3& o, const Vec3& h, double d, double g1_o) {
+  return glm::dot(o, h) > 0.0 ? g1_o * d / (4.0 * o.z) : 0.0;
+}
+
 inline double ggx_visible_pdf(const Vec3& o, const Vec3& i, double alpha) {
   if (o.z <= 0.0 || i.z <= 0.0) return 0.0;
   const Vec3 h = glm::normalize(i + o);
-  if (glm::dot(o, h) <= 0.0) return 0.0;
   const Ndf ndf = Ndf::isotropic(NdfType::ggx, alpha);
-  return ndf.g1(o) * ndf.D(h) / (4.0 * o.z);
+  return ggx_visible_pdf_of(o, h, ndf.D(h), ndf.g1(o));
 }
 
 }  // namespace facetfit

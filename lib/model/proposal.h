@@ -75,10 +75,10 @@ class GgxProposal final : public Proposal {
     return parts_.pdf(o, i, ggx_visible_pdf(o, i, alpha_));
   }
   // pdf() from what a caller evaluating a GGX lobe of the same alpha has already computed: the half
-  // vector h, D(h) and G1(o) (the visible normals' density is G1(o) D(h) / (4 cos(theta_o))).
+  // vector h, D(h) and G1(o).
   double pdf_with(const Vec3& o, const Vec3& i, const Vec3& h, double d, double g1_o) const {
     if (i.z <= 0.0 || o.z <= 0.0) return 0.0;
-    return parts_.pdf(o, i, glm::dot(o, h) > 0.0 ? g1_o * d / (4.0 * o.z) : 0.0);
+    return parts_.pdf(o, i, ggx_visible_pdf_of(o, h, d, g1_o));
   }
   double alpha() const { return alpha_; }
 

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/frame.h"
 #include "core/piecewise_constant.h"
 #include "core/quadrature_rules.h"
 
@@ -227,10 +228,10 @@ Vec3 TabulatedMicrofacet::measured_visible_normal(const Vec3& o, double u1, doub
   const double sin_o = std::sqrt(std::max(0.0, 1.0 - o.z * o.z));
   // phi relative to o's azimuth, then turned to it (no arc tangent: its cosine and sine are o.xy / |o.xy|).
   const auto [cos_phi, sin_phi] = sample_phi(sin_o * sin_h, o.z * cos_h, u2);
+  const Vec3 h(sin_h * cos_phi, sin_h * sin_phi, cos_h);
   const double o_xy = std::sqrt(o.x * o.x + o.y * o.y);
-  if (!(sin_o > 0.0 && o_xy > 0.0)) return {sin_h * cos_phi, sin_h * sin_phi, cos_h};
-  const double cos_az = o.x / o_xy, sin_az = o.y / o_xy;
-  return {sin_h * (cos_phi * cos_az - sin_phi * sin_az), sin_h * (sin_phi * cos_az + cos_phi * sin_az), cos_h};
+  if (!(sin_o > 0.0 && o_xy > 0.0)) return h;
+  return TurnedFrame::of(o.x / o_xy, o.y / o_xy).from_frame(h);
 }
 
 }  // namespace facetfit

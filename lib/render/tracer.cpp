@@ -2,6 +2,7 @@
 
 #include <embree3/rtcore.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <sstream>
@@ -96,29 +97,56 @@ Tracer::Tracer(const SceneDesc& desc) {
 
 Tracer::~Tracer() = default;
 
-Hit Tracer::intersect(const Ray& ray) const {
+// The nearest sphere in (tnear, tfar), and whether any sphere is there: what every query tests first.
+Hit Tracer::nearest_sphere(const Ray& ray) const {
   Hit hit;
   Ray r = ray;
   for (const Sphere& s : spheres_) {
     const double t = intersect_sphere(s.center, s.radius, r);
     if (t < r.tfar) r.tfar = hit.t = t, hit.object = s.object;
   }
+  return hit;
+}
+
+bool Tracer::blocked_by_sphere(const Ray& ray) const {
+  for (const Sphere& s : spheres_)
+    if (std::isfinite(intersect_sphere(s.center, s.radius, ray))) return true;
+  return false;
+}
+
+namespace {
+
+// Embree's query for the triangles nearer than `nearer` (the nearest sphere, or nothing), and its answer.
+RTCRayHit embree_ray_hit(const Ray& ray, const Hit& nearer) {
+  RTCRayHit rh{};
+  Ray bounded = ray;
+  bounded.tfar = std::min(ray.tfar, nearer.t);
+  rh.ray = embree_ray(bounded);
+  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+  return rh;
+}
+
+void take_triangle_hit(const RTCRayHit& rh, const std::vector<int>& object, Hit& hit) {
+  if (rh.hit.geomID != RTC_INVALID_GEOMETRY_ID)
+    hit = Hit{double(rh.ray.tfar), object[rh.hit.geomID], Vec3(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z)};
+}
+
+}  // namespace
+
+Hit Tracer::intersect(const Ray& ray) const {
+  Hit hit = nearest_sphere(ray);
   if (triangles_) {
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
-    RTCRayHit rh{};
-    rh.ray = embree_ray(r);
-    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    RTCRayHit rh = embree_ray_hit(ray, hit);
     rtcIntersect1(triangles_->scene, &ctx, &rh);
-    if (rh.hit.geomID != RTC_INVALID_GEOMETRY_ID)
-      hit = Hit{double(rh.ray.tfar), triangles_->object[rh.hit.geomID], Vec3(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z)};
+    take_triangle_hit(rh, triangles_->object, hit);
   }
   return hit;
 }
 
 bool Tracer::occluded(const Ray& ray) const {
-  for (const Sphere& s : spheres_)
-    if (std::isfinite(intersect_sphere(s.center, s.radius, ray))) return true;
+  if (blocked_by_sphere(ray)) return true;
   if (!triangles_) return false;
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);
@@ -128,39 +156,21 @@ bool Tracer::occluded(const Ray& ray) const {
 }
 
 void Tracer::intersect(const std::vector<Ray>& rays, std::vector<Hit>& hits, bool coherent) const {
-  hits.assign(rays.size(), Hit{});
-  for (std::size_t k = 0; k < rays.size(); ++k) {
-    Ray r = rays[k];
-    for (const Sphere& s : spheres_) {
-      const double t = intersect_sphere(s.center, s.radius, r);
-      if (t < r.tfar) r.tfar = hits[k].t = t, hits[k].object = s.object;
-    }
-  }
+  hits.resize(rays.size());
+  for (std::size_t k = 0; k < rays.size(); ++k) hits[k] = nearest_sphere(rays[k]);
   if (!triangles_ || rays.empty()) return;
   std::vector<RTCRayHit> rh(rays.size());
-  for (std::size_t k = 0; k < rays.size(); ++k) {
-    rh[k] = RTCRayHit{};
-    rh[k].ray = embree_ray(rays[k]);
-    if (hits[k].found()) rh[k].ray.tfar = float(hits[k].t);
-    rh[k].hit.geomID = RTC_INVALID_GEOMETRY_ID;
-  }
+  for (std::size_t k = 0; k < rays.size(); ++k) rh[k] = embree_ray_hit(rays[k], hits[k]);
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);
   if (coherent) ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
   rtcIntersect1M(triangles_->scene, &ctx, rh.data(), unsigned(rh.size()), sizeof(RTCRayHit));
-  for (std::size_t k = 0; k < rays.size(); ++k)
-    if (rh[k].hit.geomID != RTC_INVALID_GEOMETRY_ID)
-      hits[k] = Hit{double(rh[k].ray.tfar), triangles_->object[rh[k].hit.geomID], Vec3(rh[k].hit.Ng_x, rh[k].hit.Ng_y, rh[k].hit.Ng_z)};
+  for (std::size_t k = 0; k < rays.size(); ++k) take_triangle_hit(rh[k], triangles_->object, hits[k]);
 }
 
 void Tracer::occluded(const std::vector<Ray>& rays, std::vector<char>& blocked) const {
-  blocked.assign(rays.size(), 0);
-  for (std::size_t k = 0; k < rays.size(); ++k)
-    for (const Sphere& s : spheres_)
-      if (std::isfinite(intersect_sphere(s.center, s.radius, rays[k]))) {
-        blocked[k] = 1;
-        break;
-      }
+  blocked.resize(rays.size());
+  for (std::size_t k = 0; k < rays.size(); ++k) blocked[k] = blocked_by_sphere(rays[k]);
   if (!triangles_ || rays.empty()) return;
   // Only the rays no sphere blocks go to Embree.
   std::vector<RTCRay> open;

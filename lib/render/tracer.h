@@ -56,6 +56,8 @@ class Tracer {
     int object;
   };
   struct Embree;
+  Hit nearest_sphere(const Ray& ray) const;
+  bool blocked_by_sphere(const Ray& ray) const;
   std::vector<Sphere> spheres_;
   std::unique_ptr<Embree> triangles_;  // null: no triangles in the scene
 };
