@@ -118,6 +118,45 @@ TEST(Refine, LutCarriesBodyCoatAndParametricFits) {
   for (int c = 0; c < 3; ++c) EXPECT_NEAR(f[c], expected[c], 0.02 * expected[c]) << "channel " << c;
 }
 
+// A non-reciprocal source: T(p, q) = f(p, q) cos(theta_q) with f growing with p's elevation, measured
+// only with p within 70 degrees of the normal.
+class SkewedSource final : public OneSidedMeasurement {
+ public:
+  std::optional<Rgb> one_sided(const Vec3& p, const Vec3& q) const override {
+    if (p.z < std::cos(70.0 * kPi / 180.0)) return std::nullopt;
+    return Rgb(0.2, 0.1, 0.05) * (1.0 + p.x * p.x) * q.z;
+  }
+};
+
+// The bins of a source with two one-sided estimates: each bin twice, once per estimate measured, with the
+// estimate's own cosine and lightness (no division by a grazing cosine) and half the bin's weight.
+TEST(MeasuredBinsOneSided, EachBinOncePerMeasuredEstimate) {
+  MerlTable table = MerlTable::tabulate(LambertBrdf(Rgb(0.5)));
+  const MeasuredBins reciprocal = measured_bins(table, 9, 60);
+  const auto source = std::make_shared<SkewedSource>();
+  table.set_source_one_sided(source);
+  const MeasuredBins bins = measured_bins(table, 9, 60);
+  ASSERT_GT(bins.size(), reciprocal.size());
+  std::size_t single = 0;
+  for (std::size_t b = 0; b < bins.size(); ++b) {
+    // Which estimate: the cosine is that of q, the direction not read.
+    const bool view_o = bins.cosine[b] == bins.i[b].z;
+    const Vec3 p = view_o ? bins.o[b] : bins.i[b], q = view_o ? bins.i[b] : bins.o[b];
+    ASSERT_GE(p.z, std::cos(70.0 * kPi / 180.0) - 1e-12);
+    const Rgb t = *source->one_sided(p, q);
+    for (int c = 0; c < 3; ++c) ASSERT_NEAR(bins.lightness[b][c], metric_transform(t[c]), 1e-12);
+    const bool twin = (b + 1 < bins.size() && bins.o[b + 1] == bins.o[b] && bins.i[b + 1] == bins.i[b]) ||
+                      (b > 0 && bins.o[b - 1] == bins.o[b] && bins.i[b - 1] == bins.i[b]);
+    const bool both_measured = std::min(bins.i[b].z, bins.o[b].z) >= std::cos(70.0 * kPi / 180.0);
+    ASSERT_EQ(twin, both_measured) << b;
+    if (!twin) ++single;
+    if (b > 0 && bins.o[b - 1] == bins.o[b] && bins.i[b - 1] == bins.i[b]) {
+      ASSERT_EQ(bins.weight[b - 1], bins.weight[b]);
+    }
+  }
+  EXPECT_GT(single, 0u);
+}
+
 // The refinement must end no farther from the measurement than the paper's fit, on every real file.
 // The distances are recomputed here, from the fits' own models.
 TEST(RefineRgl, NeverWorseThanTheExtraction) {

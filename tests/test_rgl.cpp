@@ -204,6 +204,32 @@ TEST_F(RglSynthetic, ViewSlicesArePickedByTheFirstArgument) {
   EXPECT_GT(std::abs(luminance(*view.eval(o, i)) - luminance(*view.eval(i, o))), 0.01 * luminance(*view.eval(o, i)));
 }
 
+TEST_F(RglSynthetic, OneSidedEstimatesReadTheFirstDirectionsSlicesWhereMeasured) {
+  // The synthetic file's slices lie at 0, 45 and 90 degrees: 45 is the last measured elevation, and
+  // past it an estimate interpolates toward the slice at the horizon, which the fits must not see.
+  const RglBsdf b = RglBsdf::read(write("synthetic.bsdf", serialize(synthetic_fields())));
+  EXPECT_NEAR(b.measured_elevation_limit(), kPi / 4, 1e-6);
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> theta(0.0, 0.49 * kPi), phi(-kPi, kPi);
+  int measured = 0, past = 0;
+  for (int n = 0; n < 400; ++n) {
+    const double theta_p = theta(rng);
+    const Vec3 p = spherical_direction(theta_p, phi(rng)), q = spherical_direction(theta(rng), phi(rng));
+    const std::optional<Rgb> t = b.one_sided(p, q);
+    if (theta_p > kPi / 4 + 1e-6) {
+      EXPECT_FALSE(t.has_value()) << theta_p;
+      ++past;
+      continue;
+    }
+    ASSERT_TRUE(t.has_value()) << theta_p;
+    const Rgb want = synthetic_table(p, q);  // T(p, q), undivided
+    for (int c = 0; c < 3; ++c) ASSERT_NEAR((*t)[c], want[c], 1e-6 * (1.0 + want[c]));
+    ++measured;
+  }
+  EXPECT_GT(measured, 50);
+  EXPECT_GT(past, 50);
+}
+
 TEST_F(RglSynthetic, BelowHorizonIsZeroAndNdfIsNormalized) {
   const RglBsdf b = RglBsdf::read(write("synthetic.bsdf", serialize(synthetic_fields())));
   const Vec3 up(0, 0, 1), down = spherical_direction(0.6 * kPi, 0.3), flat(1, 0, 0);
@@ -487,6 +513,23 @@ TEST(RglReal, Reciprocity) {
     if (std::string(f.name) == "paper_white_rgb.bsdf" || std::string(f.name) == "acrylic_felt_green_rgb.bsdf") {
       EXPECT_LT(asym, 0.05);
     }
+  }
+}
+
+// The database's files end their slices at the horizon, where nothing was measured; the fits read a
+// one-sided estimate only up to the slice before it (RglBsdf::one_sided).
+TEST(RglReal, LastSliceIsAtTheHorizonAndTheLimitBeforeIt) {
+  REQUIRE_RGL_DATA();
+  for (const RealFile& f : kRealFiles) {
+    SCOPED_TRACE(f.name);
+    const RglBsdf b = RglBsdf::read(real_path(f));
+    EXPECT_NEAR(b.slice_elevations().back(), 0.5 * kPi, 1e-6);
+    EXPECT_GT(b.measured_elevation_limit(), 70.0 * kPi / 180.0);
+    EXPECT_LT(b.measured_elevation_limit(), 85.0 * kPi / 180.0);
+    const Vec3 q(0, 0, 1), inside = spherical_direction(b.measured_elevation_limit() - 0.01, 0.3),
+                           past = spherical_direction(b.measured_elevation_limit() + 0.01, 0.3);
+    EXPECT_TRUE(b.one_sided(inside, q).has_value());
+    EXPECT_FALSE(b.one_sided(past, q).has_value());
   }
 }
 

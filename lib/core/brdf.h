@@ -26,4 +26,17 @@ class Brdf {
   virtual std::optional<Rgb> eval(const Vec3& o, const Vec3& i) const = 0;
 };
 
+// A measurement that is not one reciprocal table but two estimates of each direction pair, each read
+// from the data taken with one of the two directions held fixed (an RGL file's slices). A renderer
+// reads the estimate of the viewer's direction (Mitsuba's `measured`); the fits compare a reciprocal
+// model with both, each where it was measured.
+class OneSidedMeasurement {
+ public:
+  virtual ~OneSidedMeasurement() = default;
+
+  // T(p, q) = f(p, q) cos(theta_q) as read from the data of direction p (p, q unit, above the horizon),
+  // RGB; nullopt where p lies past the elevations the data were measured at.
+  virtual std::optional<Rgb> one_sided(const Vec3& p, const Vec3& q) const = 0;
+};
+
 }  // namespace facetfit

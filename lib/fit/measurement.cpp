@@ -1,6 +1,8 @@
 #include "fit/measurement.h"
 
 #include <cmath>
+#include <optional>
+#include <utility>
 
 #include "core/halfdiff.h"
 
@@ -9,29 +11,43 @@ namespace facetfit {
 namespace {
 
 // Appends one bin: its directions, the cell's measure in the parameterization (times cos(theta_i)
-// cos(theta_o) here, see measurement.h) and the measurement, NaN where a channel is missing. Returns the
-// measure it added to the total, 0 for a bin left out (below the horizon, nothing measured).
-double add_bin(MeasuredBins& bins, const Vec3& wi, const Vec3& wo, double cos_h, double cos_d, double measure, const Rgb& measured) {
+// cos(theta_o) here, see measurement.h) and the measured y c for the metric's cosine c, NaN where a
+// channel is missing. Returns the measure it added to the total, 0 for a bin left out (below the
+// horizon, nothing measured).
+double add_bin(MeasuredBins& bins, const Vec3& wi, const Vec3& wo, double cos_h, double cos_d, double measure,
+               const Rgb& reflected, double cosine) {
   if (wi.z <= 1e-6 || wo.z <= 1e-6) return 0.0;
   std::uint8_t valid = 0;
-  Rgb v(0.0);
-  for (int c = 0; c < 3; ++c)
-    if (!std::isnan(measured[c])) valid |= std::uint8_t(1u << c), v[c] = measured[c];
-  if (!valid) return 0.0;
-  const double cos_mean = 0.5 * (wi.z + wo.z);
   Rgb lightness(0.0);
   for (int c = 0; c < 3; ++c)
-    if (valid >> c & 1u) lightness[c] = metric_transform(v[c] * cos_mean);
+    if (!std::isnan(reflected[c])) valid |= std::uint8_t(1u << c), lightness[c] = metric_transform(reflected[c]);
+  if (!valid) return 0.0;
   bins.i.push_back(wi);
   bins.o.push_back(wo);
-  bins.cos_mean.push_back(cos_mean);
+  bins.cosine.push_back(cosine);
   bins.cos_h.push_back(cos_h);
   bins.cos_d.push_back(cos_d);
   bins.lightness.push_back(lightness);
   bins.weight.push_back(measure * wi.z * wo.z);
-  bins.value.push_back(v);
   bins.valid.push_back(valid);
   return measure;
+}
+
+// A reciprocal table's bin: y c with c the mean cosine.
+double add_bin(MeasuredBins& bins, const Vec3& wi, const Vec3& wo, double cos_h, double cos_d, double measure, const Rgb& y) {
+  const double cosine = 0.5 * (wi.z + wo.z);
+  return add_bin(bins, wi, wo, cos_h, cos_d, measure, y * cosine, cosine);
+}
+
+// The bin's two one-sided estimates, each with half its measure; one past the measured elevations is
+// left out.
+double add_one_sided(MeasuredBins& bins, const OneSidedMeasurement& source, const Vec3& wi, const Vec3& wo, double cos_h,
+                     double cos_d, double measure) {
+  if (wi.z <= 1e-6 || wo.z <= 1e-6) return 0.0;
+  double added = 0.0;
+  for (const auto& [p, q] : {std::pair{wo, wi}, std::pair{wi, wo}})
+    if (const std::optional<Rgb> t = source.one_sided(p, q)) added += add_bin(bins, wi, wo, cos_h, cos_d, 0.5 * measure, *t, q.z);
+  return added;
 }
 
 void normalize_weights(MeasuredBins& bins, double total) {
@@ -43,6 +59,7 @@ void normalize_weights(MeasuredBins& bins, double total) {
 
 MeasuredBins measured_bins(const MerlTable& table, int stride_d, int stride_phi) {
   MeasuredBins bins;
+  const OneSidedMeasurement* one_sided = table.source_one_sided().get();
   double total = 0.0;
   for (int i = 0; i < MerlTable::kThetaH; ++i) {
     // The cell's measure, 4 cos(theta_d) sin(theta_d) sin(theta_h) dtheta_h dtheta_d dphi_d (the Jacobian of
@@ -56,9 +73,14 @@ MeasuredBins measured_bins(const MerlTable& table, int stride_d, int stride_phi)
       MeasuredBins::Row row{i, j, bins.size(), bins.size()};
       for (int k = 0; k < MerlTable::kPhiD; k += stride_phi) {
         const auto [wi, wo] = from_half_diff(MerlTable::theta_h(i), MerlTable::theta_d(j), MerlTable::phi_d(k));
+        const double cos_h = std::cos(MerlTable::theta_h(i)), cos_d = std::cos(MerlTable::theta_d(j));
+        if (one_sided) {
+          total += add_one_sided(bins, *one_sided, wi, wo, cos_h, cos_d, measure);
+          continue;
+        }
         Rgb v;
         for (int c = 0; c < 3; ++c) v[c] = table.value(c, i, j, k);  // missing: NaN (MerlTable::missing)
-        total += add_bin(bins, wi, wo, std::cos(MerlTable::theta_h(i)), std::cos(MerlTable::theta_d(j)), measure, v);
+        total += add_bin(bins, wi, wo, cos_h, cos_d, measure, v);
       }
       row.end = bins.size();
       if (row.end > row.begin) bins.rows.push_back(row);
@@ -97,7 +119,7 @@ double measurement_error(const MeasuredBins& bins, const Brdf& model) {
     const Rgb m = f ? *f : Rgb(0.0);
     for (int c = 0; c < 3; ++c) {
       if (!(bins.valid[b] >> c & 1u)) continue;
-      const double r = metric_residual(m[c], bins.cos_mean[b], bins.lightness[b][c]).value;
+      const double r = metric_residual(m[c], bins.cosine[b], bins.lightness[b][c]).value;
       sum += bins.weight[b] * r * r;
       norm += bins.weight[b];
     }

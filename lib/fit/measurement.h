@@ -11,6 +11,12 @@
 // rather than favouring the bins MERL packs near the specular peak, and over the pairs as a rendering
 // sees them (light arrives weighted by cos theta_i, a surface covers pixels in proportion to
 // cos theta_o), so grazing pairs, which plain solid angle favours, do not outweigh what is on screen.
+//
+// A source with two one-sided estimates (OneSidedMeasurement: RGL) gives each bin twice, once per
+// estimate T(p, q) = y(p, q) cos theta_q read from the data of p, with c = cos theta_q and half the
+// bin's weight: the residual L(f cos theta_q) - L(T(p, q)) compares the model with what the file measured,
+// undivided by a grazing cosine, as a renderer reading p's data (Mitsuba's `measured`, p the viewer) shows
+// it. An estimate whose p lies past the measured elevations is left out (RglBsdf::one_sided).
 #pragma once
 
 #include <algorithm>
@@ -32,18 +38,18 @@ struct MeasuredBins {
   };
   std::vector<Row> rows;
   std::vector<Vec3> i, o;           // directions of each bin (MERL bins: phi_h = 0)
-  std::vector<double> cos_mean;     // c = (cos theta_i + cos theta_o) / 2
+  std::vector<double> cosine;       // c: (cos theta_i + cos theta_o) / 2, or cos theta_q of a one-sided estimate
   std::vector<double> cos_h, cos_d; // cos theta_h, cos theta_d (= i . h)
-  std::vector<double> weight;       // measure weight; the weights sum to one
-  std::vector<Rgb> value;           // the measurement
-  std::vector<Rgb> lightness;       // metric_transform(value c): the residuals' fixed half
+  std::vector<double> weight;       // measure weight, over the total measure of the bins taken
+  std::vector<Rgb> lightness;       // metric_transform(y c): the residuals' fixed half
   std::vector<std::uint8_t> valid;  // bit c set: channel c measured
 
   std::size_t size() const { return weight.size(); }
 };
 
 // Every valid bin with both directions above the horizon, theta_d and phi_d taken every `stride_d` and
-// `stride_phi` bins (theta_h: every bin). Empty when the table has no valid bin.
+// `stride_phi` bins (theta_h: every bin); from the table's source_one_sided() where it has one, its two
+// estimates. Empty when the table has no valid bin.
 MeasuredBins measured_bins(const MerlTable& table, int stride_d, int stride_phi);
 
 // The nodes of an anisotropic source's lattice (io/half_diff_lattice.h), every `stride`-th of each
@@ -84,9 +90,9 @@ inline double metric_slope(double x) {
 struct MetricResidual {
   double value = 0.0, slope = 0.0;
 };
-inline MetricResidual metric_residual(double model, double cos_mean, double lightness) {
-  const double r = metric_transform(std::max(model, 0.0) * cos_mean) - lightness;
-  const double slope = model >= 0.0 ? cos_mean * metric_slope(model * cos_mean) : 0.0;
+inline MetricResidual metric_residual(double model, double cosine, double lightness) {
+  const double r = metric_transform(std::max(model, 0.0) * cosine) - lightness;
+  const double slope = model >= 0.0 ? cosine * metric_slope(model * cosine) : 0.0;
   return {r, slope};
 }
 

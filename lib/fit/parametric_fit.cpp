@@ -173,7 +173,7 @@ class RowCost final : public ceres::CostFunction {
         coat_d_log_alpha = fc * (dc.slope * gc.value + dc.value * gc.slope) * inv4 * coat_alpha;
         coat_d_f0 = s_mu * dc.value * gc.value * inv4;
       }
-      const double w = std::sqrt(bins_.weight[k]), c = bins_.cos_mean[k];
+      const double w = std::sqrt(bins_.weight[k]), c = bins_.cosine[k];
       for (int e = 0; e < 3; ++e) {
         const std::size_t r = 3 * q + std::size_t(e);
         if (!(bins_.valid[k] >> e & 1u)) {
@@ -330,7 +330,7 @@ class AnisotropicRowCost final : public ceres::CostFunction {
           plus[e] += kStep, minus[e] -= kStep;
           lobe_slope[e] = (lobe_at(plus, k) - lobe_at(minus, k)) / (2.0 * kStep);
         }
-      const double w = std::sqrt(bins_.weight[k]), c = bins_.cos_mean[k];
+      const double w = std::sqrt(bins_.weight[k]), c = bins_.cosine[k];
       for (int e = 0; e < 3; ++e) {
         const std::size_t r = 3 * q + std::size_t(e);
         if (!(bins_.valid[k] >> e & 1u)) {

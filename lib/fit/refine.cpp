@@ -53,7 +53,7 @@ class RowCost final : public ceres::CostFunction {
     const std::size_t n = row_.end - row_.begin;
     for (std::size_t b = 0; b < n; ++b) {
       const std::size_t k = row_.begin + b;
-      const double s = std::sqrt(bins_.weight[k]), c = bins_.cos_mean[k], g = g_[k];
+      const double s = std::sqrt(bins_.weight[k]), c = bins_.cosine[k], g = g_[k];
       for (int ch = 0; ch < 3; ++ch) {
         const std::size_t r = 3 * b + std::size_t(ch);
         const bool valid = bins_.valid[k] >> ch & 1u;

@@ -102,7 +102,11 @@ MerlTable table_of(const Brdf& source) {
     table.set_source_half_diff(HalfDiffLattice::of(*rgl));
     return table;
   }
-  return MerlTable::tabulate(source);
+  MerlTable table = MerlTable::tabulate(source);
+  // RGL: the table holds the reciprocal blend of the two one-sided estimates; the fits' distances read
+  // each where it was measured (fit/measurement.h). Copies of the file share its tables.
+  if (const auto* rgl = dynamic_cast<const RglBsdf*>(&source)) table.set_source_one_sided(std::make_shared<RglBsdf>(*rgl));
+  return table;
 }
 
 MerlTable load_table(const std::string& source, MerlTable::BinPoint merl_bins) {

@@ -84,6 +84,11 @@ class MerlTable final : public Brdf {
   // anisotropic fits are measured against. Empty for every other source; carried like source_backscatter.
   const HalfDiffLattice& source_half_diff() const { return source_half_diff_; }
   void set_source_half_diff(HalfDiffLattice lattice) { source_half_diff_ = std::move(lattice); }
+  // A source that holds two one-sided estimates of each pair (an RGL file): the table holds their
+  // reciprocal blend, the fits' distances read both (fit/measurement.h). Null for every other source;
+  // carried like source_backscatter.
+  const std::shared_ptr<const OneSidedMeasurement>& source_one_sided() const { return source_one_sided_; }
+  void set_source_one_sided(std::shared_ptr<const OneSidedMeasurement> source) { source_one_sided_ = std::move(source); }
 
  private:
   std::optional<Rgb> eval_nearest(double x_h, double x_d, double x_p) const;
@@ -112,6 +117,7 @@ class MerlTable final : public Brdf {
   std::vector<float, UninitializedAllocator<float>> data_;  // 3 * kBins, channel-planar as in the file
   BackscatterLattice source_backscatter_;
   HalfDiffLattice source_half_diff_;
+  std::shared_ptr<const OneSidedMeasurement> source_one_sided_;
   Lookup lookup_ = Lookup::linear;
 };
 

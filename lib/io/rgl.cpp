@@ -677,6 +677,20 @@ std::optional<Rgb> RglBsdf::eval(const Vec3& o_in, const Vec3& i_in) const {
   return (table_value(i, o) + table_value(o, i)) / (i.z + o.z);
 }
 
+std::optional<Rgb> RglBsdf::one_sided(const Vec3& p_in, const Vec3& q_in) const {
+  if (!(p_in.z > 0.0) || !(q_in.z > 0.0)) return Rgb(0.0);
+  const Vec3 p = glm::normalize(p_in), q = glm::normalize(q_in);
+  if (elevation(p) > measured_elevation_limit() + 1e-9) return std::nullopt;
+  return table_value(p, q);
+}
+
+double RglBsdf::measured_elevation_limit() const {
+  double limit = 0.0;
+  for (double theta : t_->theta_i)
+    if (theta < 0.5 * kPi - 1e-6) limit = std::max(limit, theta);
+  return limit;
+}
+
 std::optional<RglBsdf::Slices> parse_slices(const std::string& name) {
   if (name == "view") return RglBsdf::Slices::view;
   if (name == "symmetric") return RglBsdf::Slices::symmetric;
