@@ -30,6 +30,7 @@ std::string bake_cache_key(const std::string& sha256, const BakeOptions& o) {
   k["facetfit_version"] = FACETFIT_VERSION;
   k["lut_format_version"] = kLutFormatVersion;
   k["record_version"] = kRecordVersion;
+  k["fit_revision"] = kFitRevision;
   k["source_sha256"] = sha256;
   k["resolution"] = o.fit.resolution;
   k["smith"] = to_string(o.fit.smith);
