@@ -4,7 +4,10 @@
 
 #include <filesystem>
 
+#include <ceres/cost_function.h>
+
 #include "fit/fit.h"
+#include "fit/small_problem.h"
 #include "io/input.h"
 #include "lut/lut.h"
 #include "model/analytic.h"
@@ -116,6 +119,56 @@ TEST(Refine, LutCarriesBodyCoatAndParametricFits) {
   const Vec3 i = glm::normalize(Vec3(0.3, 0.1, 0.9)), o = glm::normalize(Vec3(-0.2, 0.0, 0.8));
   const Rgb f = *model.eval(o, i), expected = *truth.eval(o, i);
   for (int c = 0; c < 3; ++c) EXPECT_NEAR(f[c], expected[c], 0.02 * expected[c]) << "channel " << c;
+}
+
+// The parametric fits' solver (fit/small_problem.h) on problems whose minima are known.
+// r = (10 (x1 - x0^2), 1 - x0), minimum 0 at (1, 1), and r = x - (2, -1, 5), with their Jacobians.
+class Rosenbrock final : public ceres::CostFunction {
+ public:
+  Rosenbrock() { set_num_residuals(2), mutable_parameter_block_sizes()->push_back(2); }
+  bool Evaluate(double const* const* p, double* r, double** j) const override {
+    const double* x = p[0];
+    r[0] = 10.0 * (x[1] - x[0] * x[0]), r[1] = 1.0 - x[0];
+    if (j && j[0]) j[0][0] = -20.0 * x[0], j[0][1] = 10.0, j[0][2] = -1.0, j[0][3] = 0.0;
+    return true;
+  }
+};
+class Offsets final : public ceres::CostFunction {
+ public:
+  Offsets() { set_num_residuals(3), mutable_parameter_block_sizes()->push_back(3); }
+  bool Evaluate(double const* const* p, double* r, double** j) const override {
+    r[0] = p[0][0] - 2.0, r[1] = p[0][1] + 1.0, r[2] = p[0][2] - 5.0;
+    if (j && j[0])
+      for (int k = 0; k < 9; ++k) j[0][k] = k % 4 == 0 ? 1.0 : 0.0;
+    return true;
+  }
+};
+
+TEST(SmallProblem, ReachesTheRosenbrockValleysEnd) {
+  double x[2] = {-1.2, 1.0};
+  SmallProblem problem;
+  problem.AddResidualBlock(new Rosenbrock, nullptr, x);
+  const SmallProblem::Summary s = problem.Solve(200, 1e-14);
+  EXPECT_NEAR(x[0], 1.0, 1e-5);
+  EXPECT_NEAR(x[1], 1.0, 1e-5);
+  EXPECT_LT(s.final_cost, 1e-10);
+  EXPECT_GT(s.iterations, 5);
+}
+
+TEST(SmallProblem, StopsAtTheBoundsAndKeepsConstantBlocks) {
+  double x[3] = {0.0, 0.5, 0.0}, fixed[3] = {7.0, 8.0, 9.0};
+  SmallProblem problem;
+  problem.AddResidualBlock(new Offsets, nullptr, x);
+  problem.AddResidualBlock(new Offsets, nullptr, fixed);
+  problem.SetParameterUpperBound(x, 0, 1.0);  // the minimum, 2, is past it
+  problem.SetParameterLowerBound(x, 1, 0.0);  // -1 is below it
+  problem.SetParameterBlockConstant(fixed);
+  problem.Solve(50);
+  EXPECT_NEAR(x[0], 1.0, 1e-12);
+  EXPECT_NEAR(x[1], 0.0, 1e-12);
+  EXPECT_NEAR(x[2], 5.0, 1e-6);
+  EXPECT_EQ(fixed[0], 7.0);
+  EXPECT_EQ(fixed[2], 9.0);
 }
 
 // A non-reciprocal source: T(p, q) = f(p, q) cos(theta_q) with f growing with p's elevation, measured

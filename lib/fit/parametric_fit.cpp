@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "core/frame.h"
+#include "fit/small_problem.h"
 #include "model/fresnel.h"
 #include "model/parametric.h"
 #include "model/rotated.h"
@@ -17,7 +18,7 @@ namespace {
 
 // The parametric fits' bounds: the first `alphas` entries of `log_alpha` within log [1e-3, 4], a nonnegative
 // body, reflectances f0 and f82 in [0, 1] (the starts are clamped there by the callers).
-void bound_lobe(ceres::Problem& problem, double* log_alpha, int alphas, double* body, double* f0, double* f82) {
+void bound_lobe(SmallProblem& problem, double* log_alpha, int alphas, double* body, double* f0, double* f82) {
   for (int a = 0; a < alphas; ++a) {
     problem.SetParameterLowerBound(log_alpha, a, std::log(1e-3));
     problem.SetParameterUpperBound(log_alpha, a, std::log(4.0));
@@ -28,17 +29,8 @@ void bound_lobe(ceres::Problem& problem, double* log_alpha, int alphas, double* 
     for (int c = 0; c < 3; ++c) problem.SetParameterUpperBound(p, c, 1.0);
 }
 
-// The parametric fits' solve: a dense problem of 8 to 13 unknowns.
-void solve(ceres::Problem& problem, int max_iterations) {
-  if (max_iterations <= 0) return;
-  ceres::Solver::Options options;
-  options.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
-  options.max_num_iterations = max_iterations;
-  options.function_tolerance = 1e-6;
-  options.logging_type = ceres::SILENT;
-  ceres::Solver::Summary summary;
-  ceres::Solve(options, &problem, &summary);
-}
+// The parametric fits' solve: a dense problem of 8 to 14 unknowns (fit/small_problem.h).
+void solve(SmallProblem& problem, int max_iterations) { problem.Solve(max_iterations, 1e-6); }
 
 // A value and its derivative with respect to alpha.
 struct WithSlope {
@@ -259,7 +251,7 @@ ParametricFit fit_parametric(const MeasuredBins& bins, const MeasuredBins& error
   double f82[3] = {start.f82.r, start.f82.g, start.f82.b};
   const bool with_coat = start.coat.present();
   double coat[2] = {std::log(with_coat ? start.coat.alpha : 0.1), start.coat.f0};
-  ceres::Problem problem;
+  SmallProblem problem;
   for (const MeasuredBins::Row& row : bins.rows) {
     problem.AddResidualBlock(new RowCost(bins, row, start.type, smith, start.fresnel, with_coat), nullptr, body, log_alpha, f0, f82, coat);
   }
@@ -381,7 +373,7 @@ AnisotropicParametricFit fit_parametric_anisotropic(const MeasuredBins& bins, co
   double f0[3] = {start.f0.r, start.f0.g, start.f0.b};
   double f82[3] = {start.f82.r, start.f82.g, start.f82.b};
   if (bins.rows.empty()) return fit;
-  ceres::Problem problem;
+  SmallProblem problem;
   for (const MeasuredBins::Row& row : bins.rows) {
     problem.AddResidualBlock(new AnisotropicRowCost(bins, row, start.type, smith), nullptr, body, shape, f0, f82);
   }

@@ -1,0 +1,167 @@
+#include "fit/small_problem.h"
+
+#include <ceres/cost_function.h>
+
+#include <Eigen/Dense>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace facetfit {
+
+SmallProblem::SmallProblem() = default;
+SmallProblem::~SmallProblem() = default;
+
+SmallProblem::Block& SmallProblem::block_of(double* values, int size) {
+  for (Block& b : blocks_)
+    if (b.values == values) return b;
+  const double inf = std::numeric_limits<double>::infinity();
+  blocks_.push_back(Block{values, size, false, std::vector<double>(std::size_t(size), -inf), std::vector<double>(std::size_t(size), inf)});
+  return blocks_.back();
+}
+
+void SmallProblem::AddResidualBlock(ceres::CostFunction* cost, std::nullptr_t, std::vector<double*> blocks) {
+  Residuals r{std::unique_ptr<ceres::CostFunction>(cost), {}};
+  const std::vector<int32_t>& sizes = cost->parameter_block_sizes();
+  for (std::size_t k = 0; k < blocks.size(); ++k) {
+    block_of(blocks[k], sizes[k]);
+    for (std::size_t b = 0; b < blocks_.size(); ++b)
+      if (blocks_[b].values == blocks[k]) r.blocks.push_back(int(b));
+  }
+  residuals_.push_back(std::move(r));
+}
+
+void SmallProblem::SetParameterLowerBound(double* block, int index, double bound) { block_of(block).lower[std::size_t(index)] = bound; }
+void SmallProblem::SetParameterUpperBound(double* block, int index, double bound) { block_of(block).upper[std::size_t(index)] = bound; }
+void SmallProblem::SetParameterBlockConstant(double* block) { block_of(block).constant = true; }
+
+SmallProblem::Summary SmallProblem::Solve(int max_iterations, double function_tolerance) {
+  Summary summary;
+  int n = 0;
+  for (Block& b : blocks_) b.offset = b.constant ? -1 : (n += b.size) - b.size;
+  if (n == 0 || residuals_.empty() || max_iterations <= 0) return summary;
+
+  using Vector = Eigen::VectorXd;
+  using Matrix = Eigen::MatrixXd;
+  Vector x(n), lower(n), upper(n);
+  for (const Block& b : blocks_)
+    for (int j = 0; j < b.size && b.offset >= 0; ++j) {
+      lower[b.offset + j] = b.lower[std::size_t(j)], upper[b.offset + j] = b.upper[std::size_t(j)];
+      x[b.offset + j] = std::clamp(b.values[j], lower[b.offset + j], upper[b.offset + j]);
+    }
+  const auto scatter = [&](const Vector& v) {
+    for (const Block& b : blocks_)
+      for (int j = 0; j < b.size && b.offset >= 0; ++j) b.values[j] = v[b.offset + j];
+  };
+
+  // 1/2 sum r^2 at v, and J^T J, J^T r when asked; NaN when a cost function fails or yields a non-finite value.
+  std::vector<double> residual, jacobian_buffer;
+  std::vector<double*> jacobians;
+  std::vector<const double*> parameters;
+  std::vector<int> columns;
+  Matrix rows, local;
+  Vector local_r;
+  const auto evaluate = [&](const Vector& v, Matrix* jtj, Vector* jtr) {
+    scatter(v);
+    ++summary.evaluations;
+    if (jtj) jtj->setZero(n, n), jtr->setZero(n);
+    double cost = 0.0;
+    for (const Residuals& r : residuals_) {
+      const int m = r.cost->num_residuals();
+      residual.resize(std::size_t(m));
+      parameters.clear();
+      jacobians.clear();
+      std::size_t used = 0;
+      for (int b : r.blocks) used += std::size_t(m) * std::size_t(blocks_[std::size_t(b)].size);
+      jacobian_buffer.resize(used);
+      used = 0;
+      for (int b : r.blocks) {
+        const Block& block = blocks_[std::size_t(b)];
+        parameters.push_back(block.values);
+        jacobians.push_back(jtj && !block.constant ? jacobian_buffer.data() + used : nullptr);
+        used += std::size_t(m) * std::size_t(block.size);
+      }
+      if (!r.cost->Evaluate(parameters.data(), residual.data(), jtj ? jacobians.data() : nullptr))
+        return std::numeric_limits<double>::quiet_NaN();
+      for (double e : residual) cost += 0.5 * e * e;
+      if (!jtj) continue;
+      // This block's rows of J over the unknowns it touches (a few of the n: the scatter keeps the
+      // accumulation sparse), added into J^T J and J^T r.
+      columns.clear();
+      for (std::size_t k = 0; k < r.blocks.size(); ++k)
+        if (jacobians[k]) {
+          const Block& block = blocks_[std::size_t(r.blocks[k])];
+          for (int j = 0; j < block.size; ++j) columns.push_back(block.offset + j);
+        }
+      rows.resize(m, Eigen::Index(columns.size()));
+      Eigen::Index column = 0;
+      for (std::size_t k = 0; k < r.blocks.size(); ++k) {
+        if (!jacobians[k]) continue;
+        const int size = blocks_[std::size_t(r.blocks[k])].size;
+        for (int i = 0; i < m; ++i)
+          for (int j = 0; j < size; ++j) rows(i, column + j) = jacobians[k][std::size_t(i * size + j)];
+        column += size;
+      }
+      local.noalias() = rows.transpose() * rows;
+      local_r.noalias() = rows.transpose() * Eigen::Map<const Vector>(residual.data(), m);
+      for (std::size_t a = 0; a < columns.size(); ++a) {
+        (*jtr)[columns[a]] += local_r[Eigen::Index(a)];
+        for (std::size_t b = 0; b < columns.size(); ++b) (*jtj)(columns[a], columns[b]) += local(Eigen::Index(a), Eigen::Index(b));
+      }
+    }
+    return std::isfinite(cost) ? cost : std::numeric_limits<double>::quiet_NaN();
+  };
+
+  Matrix jtj;
+  Vector jtr;
+  double cost = evaluate(x, &jtj, &jtr);
+  summary.initial_cost = summary.final_cost = cost;
+  if (!std::isfinite(cost)) {
+    scatter(x);
+    return summary;
+  }
+  double mu = 1e-4, nu = 2.0;  // Ceres's start: a trust region of radius 1e4
+  for (int iteration = 0; iteration < max_iterations; ++iteration) {
+    bool accepted = false, converged = false;
+    // Marquardt's scaling, its diagonal clamped as Ceres clamps it, so that an unknown the data do not
+    // see still gets a finite step.
+    const Vector d = jtj.diagonal().cwiseMax(1e-6).cwiseMin(1e32);
+    // Unknowns on a bound that the gradient pushes outward stay there this iteration (an active set):
+    // left in the system, the step would spend itself against the bound and its projection could
+    // even raise the cost the quadratic model predicts.
+    Vector rhs = -jtr;
+    std::vector<bool> active(static_cast<std::size_t>(n), false);
+    for (int k = 0; k < n; ++k)
+      active[std::size_t(k)] = (x[k] <= lower[k] && jtr[k] > 0.0) || (x[k] >= upper[k] && jtr[k] < 0.0);
+    for (int attempt = 0; attempt < 20 && !accepted; ++attempt) {
+      Matrix m = jtj;
+      m.diagonal() += mu * d;
+      for (int k = 0; k < n; ++k)
+        if (active[std::size_t(k)]) m.row(k).setZero(), m.col(k).setZero(), m(k, k) = 1.0, rhs[k] = 0.0;
+      const Vector step = (m.ldlt().solve(rhs) + x).cwiseMax(lower).cwiseMin(upper) - x;
+      const double predicted = -(jtr.dot(step) + 0.5 * step.dot(jtj * step));
+      const Vector trial = x + step;
+      const double trial_cost = evaluate(trial, nullptr, nullptr);
+      if (std::isfinite(trial_cost) && trial_cost < cost && predicted > 0.0) {
+        const double rho = (cost - trial_cost) / predicted;
+        mu *= std::max(1.0 / 3.0, 1.0 - std::pow(2.0 * rho - 1.0, 3));
+        nu = 2.0;
+        converged = cost - trial_cost <= function_tolerance * cost;
+        x = trial;
+        cost = evaluate(x, &jtj, &jtr);
+        accepted = std::isfinite(cost);
+        ++summary.iterations;
+      } else {
+        mu *= nu;
+        nu *= 2.0;
+      }
+    }
+    if (!accepted || converged) break;
+  }
+  scatter(x);
+  summary.final_cost = cost;
+  return summary;
+}
+
+}  // namespace facetfit
