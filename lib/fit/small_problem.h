@@ -1,13 +1,18 @@
-// Bounded nonlinear least squares for the parametric fits' problems: 8 to 14 unknowns in a few parameter
-// blocks over ~10^4 residuals, given as Ceres cost functions with analytic Jacobians.
+// Bounded nonlinear least squares for the fits' problems of a few unknowns over many residuals, given as
+// Ceres cost functions with analytic Jacobians: the parametric fits (8 to 14 unknowns, ~10^4 residuals;
+// it also solves the tabulated lobe's refinement, ~140 unknowns each residual touching ~10, to
+// convergence: docs/extraction.md says why that one stays with Ceres for now).
 //
-// Ceres solves them too, but spends three quarters of such a solve on its per-entry Jacobian bookkeeping
-// (each block's Jacobian invalidated, written, validated and copied into the dense matrix: docs/extraction.md,
-// "Time"). Here the same cost functions are evaluated into one buffer per residual block and J^T J, J^T r
-// accumulated at once (n x n, n <= 14), and the step is Levenberg-Marquardt's,
+// Ceres solved them before, and spent three quarters of a parametric solve on its per-entry Jacobian
+// bookkeeping (each block's Jacobian invalidated, written, validated and copied: docs/extraction.md,
+// "Time"). Here the cost functions are evaluated into one buffer per residual block, whose J^T J and
+// J^T r are added into the n x n normal equations over the block's own unknowns, and the step is
+// Levenberg-Marquardt's,
 //   (J^T J + mu diag(J^T J)) delta = -J^T r,
-// projected onto the bounds, mu updated by the gain ratio (Nielsen's rule), stopping when the cost moves by
-// less than `function_tolerance` of itself, as Ceres's function tolerance does.
+// with the unknowns that sit on a bound the gradient pushes against held there (an active set), the rest
+// projected onto the bounds; mu follows the gain ratio (Nielsen's rule), and the solve stops when an
+// accepted step moves the cost by less than `function_tolerance` of itself, as Ceres's function
+// tolerance does. Dense: meant for n up to a few hundred.
 #pragma once
 
 #include <cstddef>
