@@ -92,6 +92,10 @@ TEST(CubeRoot, AgreesWithTheLibraryOverEveryExponent) {
   for (const double x : {1.0, 8.0, 27.0, 0.125, 6.0 / 29.0 * 6.0 / 29.0 * 6.0 / 29.0, 1e-300, 1e300})
     worst = std::max(worst, std::abs(cube_root(x) - std::cbrt(x)) / std::cbrt(x));
   EXPECT_LT(worst, 1e-15);
+  EXPECT_EQ(cube_root(0.0), 0.0);
+  EXPECT_DOUBLE_EQ(cube_root(-8.0), -2.0);
+  EXPECT_EQ(cube_root(HUGE_VAL), HUGE_VAL);
+  EXPECT_TRUE(std::isnan(cube_root(std::nan(""))));
 }
 
 TEST(HalfDiff, RoundTrip) {
