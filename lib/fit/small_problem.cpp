@@ -13,28 +13,24 @@ namespace facetfit {
 SmallProblem::SmallProblem() = default;
 SmallProblem::~SmallProblem() = default;
 
-SmallProblem::Block& SmallProblem::block_of(double* values, int size) {
-  for (Block& b : blocks_)
-    if (b.values == values) return b;
+std::size_t SmallProblem::block_of(double* values, int size) {
+  for (std::size_t b = 0; b < blocks_.size(); ++b)
+    if (blocks_[b].values == values) return b;
   const double inf = std::numeric_limits<double>::infinity();
   blocks_.push_back(Block{values, size, false, std::vector<double>(std::size_t(size), -inf), std::vector<double>(std::size_t(size), inf)});
-  return blocks_.back();
+  return blocks_.size() - 1;
 }
 
 void SmallProblem::AddResidualBlock(ceres::CostFunction* cost, std::nullptr_t, std::vector<double*> blocks) {
   Residuals r{std::unique_ptr<ceres::CostFunction>(cost), {}};
   const std::vector<int32_t>& sizes = cost->parameter_block_sizes();
-  for (std::size_t k = 0; k < blocks.size(); ++k) {
-    block_of(blocks[k], sizes[k]);
-    for (std::size_t b = 0; b < blocks_.size(); ++b)
-      if (blocks_[b].values == blocks[k]) r.blocks.push_back(int(b));
-  }
+  for (std::size_t k = 0; k < blocks.size(); ++k) r.blocks.push_back(int(block_of(blocks[k], sizes[k])));
   residuals_.push_back(std::move(r));
 }
 
-void SmallProblem::SetParameterLowerBound(double* block, int index, double bound) { block_of(block).lower[std::size_t(index)] = bound; }
-void SmallProblem::SetParameterUpperBound(double* block, int index, double bound) { block_of(block).upper[std::size_t(index)] = bound; }
-void SmallProblem::SetParameterBlockConstant(double* block) { block_of(block).constant = true; }
+void SmallProblem::SetParameterLowerBound(double* block, int index, double bound) { blocks_[block_of(block)].lower[std::size_t(index)] = bound; }
+void SmallProblem::SetParameterUpperBound(double* block, int index, double bound) { blocks_[block_of(block)].upper[std::size_t(index)] = bound; }
+void SmallProblem::SetParameterBlockConstant(double* block) { blocks_[block_of(block)].constant = true; }
 
 SmallProblem::Summary SmallProblem::Solve(int max_iterations, double function_tolerance) {
   Summary summary;
@@ -64,7 +60,6 @@ SmallProblem::Summary SmallProblem::Solve(int max_iterations, double function_to
   Vector local_r;
   const auto evaluate = [&](const Vector& v, Matrix* jtj, Vector* jtr) {
     scatter(v);
-    ++summary.evaluations;
     if (jtj) jtj->setZero(n, n), jtr->setZero(n);
     double cost = 0.0;
     for (const Residuals& r : residuals_) {
@@ -116,7 +111,7 @@ SmallProblem::Summary SmallProblem::Solve(int max_iterations, double function_to
   Matrix jtj;
   Vector jtr;
   double cost = evaluate(x, &jtj, &jtr);
-  summary.initial_cost = summary.final_cost = cost;
+  summary.final_cost = cost;
   if (!std::isfinite(cost)) {
     scatter(x);
     return summary;
@@ -132,13 +127,15 @@ SmallProblem::Summary SmallProblem::Solve(int max_iterations, double function_to
     // even raise the cost the quadratic model predicts.
     Vector rhs = -jtr;
     std::vector<bool> active(static_cast<std::size_t>(n), false);
-    for (int k = 0; k < n; ++k)
+    for (int k = 0; k < n; ++k) {
       active[std::size_t(k)] = (x[k] <= lower[k] && jtr[k] > 0.0) || (x[k] >= upper[k] && jtr[k] < 0.0);
+      if (active[std::size_t(k)]) rhs[k] = 0.0;
+    }
     for (int attempt = 0; attempt < 20 && !accepted; ++attempt) {
       Matrix m = jtj;
       m.diagonal() += mu * d;
       for (int k = 0; k < n; ++k)
-        if (active[std::size_t(k)]) m.row(k).setZero(), m.col(k).setZero(), m(k, k) = 1.0, rhs[k] = 0.0;
+        if (active[std::size_t(k)]) m.row(k).setZero(), m.col(k).setZero(), m(k, k) = 1.0;
       const Vector step = (m.ldlt().solve(rhs) + x).cwiseMax(lower).cwiseMin(upper) - x;
       const double predicted = -(jtr.dot(step) + 0.5 * step.dot(jtj * step));
       const Vector trial = x + step;

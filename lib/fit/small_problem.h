@@ -44,10 +44,8 @@ class SmallProblem {
   void SetParameterBlockConstant(double* block);
 
   struct Summary {
-    int iterations = 0;         // accepted steps
-    int evaluations = 0;        // of the residuals, with or without the Jacobian
-    double initial_cost = 0.0;  // 1/2 sum r^2
-    double final_cost = 0.0;
+    int iterations = 0;       // accepted steps
+    double final_cost = 0.0;  // 1/2 sum r^2
   };
   // Moves the blocks' values (clamped into their bounds first) toward a minimum of 1/2 sum r^2.
   Summary Solve(int max_iterations, double function_tolerance = 1e-6);
@@ -64,7 +62,8 @@ class SmallProblem {
     std::unique_ptr<ceres::CostFunction> cost;
     std::vector<int> blocks;  // indices into blocks_
   };
-  Block& block_of(double* values, int size = -1);
+  // The index of the block at `values`, added (of `size`) at its first use.
+  std::size_t block_of(double* values, int size = -1);
 
   std::vector<Block> blocks_;
   std::vector<Residuals> residuals_;

@@ -365,6 +365,7 @@ struct RglBsdf::Tables {
   std::string description;
   bool jacobian = true;
   std::vector<double> theta_i;  // incident elevations of the slices, strictly increasing
+  double measured_limit = 0.0;  // the largest of them below pi/2 (RglBsdf::measured_elevation_limit)
   std::vector<double> phi_i;    // incident azimuths of the slices, strictly increasing
   // Mitsuba's reading of phi_i: more than two entries make the file anisotropic, its half-vector
   // azimuth absolute rather than measured from the slice direction's plane. phi_i spanning 2 pi / r
@@ -456,6 +457,7 @@ RglBsdf RglBsdf::read(const std::string& path) {
   t->theta_i = in.floats("theta_i", theta_i);
   for (std::size_t k = 0; k < t->theta_i.size(); ++k) {
     const double v = t->theta_i[k];
+    if (v < 0.5 * kPi - 1e-6) t->measured_limit = std::max(t->measured_limit, v);
     in.check(v >= 0.0 && v <= 0.5 * kPi + 1e-4, "field 'theta_i' has " + std::to_string(v) + " at element " +
                                                     std::to_string(k) + ", outside [0, pi/2]");
     in.check(k == 0 || v > t->theta_i[k - 1], "field 'theta_i' is not strictly increasing at element " + std::to_string(k));
@@ -684,12 +686,7 @@ std::optional<Rgb> RglBsdf::one_sided(const Vec3& p_in, const Vec3& q_in) const 
   return table_value(p, q);
 }
 
-double RglBsdf::measured_elevation_limit() const {
-  double limit = 0.0;
-  for (double theta : t_->theta_i)
-    if (theta < 0.5 * kPi - 1e-6) limit = std::max(limit, theta);
-  return limit;
-}
+double RglBsdf::measured_elevation_limit() const { return t_->measured_limit; }
 
 std::optional<RglBsdf::Slices> parse_slices(const std::string& name) {
   if (name == "view") return RglBsdf::Slices::view;
