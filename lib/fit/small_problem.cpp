@@ -108,8 +108,8 @@ SmallProblem::Summary SmallProblem::Solve(int max_iterations, double function_to
     return std::isfinite(cost) ? cost : std::numeric_limits<double>::quiet_NaN();
   };
 
-  Matrix jtj;
-  Vector jtr;
+  Matrix jtj, trial_jtj;
+  Vector jtr, trial_jtr;
   double cost = evaluate(x, &jtj, &jtr);
   summary.final_cost = cost;
   if (!std::isfinite(cost)) {
@@ -139,15 +139,18 @@ SmallProblem::Summary SmallProblem::Solve(int max_iterations, double function_to
       const Vector step = (m.ldlt().solve(rhs) + x).cwiseMax(lower).cwiseMin(upper) - x;
       const double predicted = -(jtr.dot(step) + 0.5 * step.dot(jtj * step));
       const Vector trial = x + step;
-      const double trial_cost = evaluate(trial, nullptr, nullptr);
+      // The trial's J^T J and J^T r with its cost: most steps are accepted, and the residuals are then
+      // evaluated once rather than twice.
+      const double trial_cost = evaluate(trial, &trial_jtj, &trial_jtr);
       if (std::isfinite(trial_cost) && trial_cost < cost && predicted > 0.0) {
         const double rho = (cost - trial_cost) / predicted;
         mu *= std::max(1.0 / 3.0, 1.0 - std::pow(2.0 * rho - 1.0, 3));
         nu = 2.0;
         converged = cost - trial_cost <= function_tolerance * cost;
         x = trial;
-        cost = evaluate(x, &jtj, &jtr);
-        accepted = std::isfinite(cost);
+        cost = trial_cost;
+        jtj.swap(trial_jtj), jtr.swap(trial_jtr);
+        accepted = true;
         ++summary.iterations;
       } else {
         mu *= nu;
