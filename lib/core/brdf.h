@@ -39,4 +39,12 @@ class OneSidedMeasurement {
   virtual std::optional<Rgb> one_sided(const Vec3& p, const Vec3& q) const = 0;
 };
 
+// One direction pair a source was measured at, with its value, as the source holds it (a UTIA file's
+// nodes): the fits compare a model there rather than with a table resampled between the nodes.
+struct MeasuredSample {
+  Vec3 o, i;
+  Rgb f;           // 1/sr
+  double measure;  // d(omega_o) d(omega_i) of the cell the sample stands for
+};
+
 }  // namespace facetfit

@@ -24,8 +24,9 @@ namespace facetfit {
 // The fit's revision: part of the bake cache's key, so that a LUT baked by an earlier revision of the
 // same options is baked again rather than served (lut/bake.h). Bump when the same input and options give
 // a different fit. 2: an RGL file's refinement reads its two one-sided estimates (fit/measurement.h);
-// 3: the parametric fits solved by fit/small_problem.h.
-constexpr int kFitRevision = 3;
+// 3: the parametric fits solved by fit/small_problem.h; 4: the refinement solved to convergence in two
+// passes, a UTIA file's fits on its own nodes.
+constexpr int kFitRevision = 4;
 
 struct FitOptions {
   int resolution = 90;  // intervals of the u grid; R + 1 nodes

@@ -55,9 +55,25 @@ void normalize_weights(MeasuredBins& bins, double total) {
     for (double& w : bins.weight) w /= total;
 }
 
+// A source's own nodes, one row each (their half/difference angles are all different).
+MeasuredBins sample_bins(const std::vector<MeasuredSample>& samples) {
+  MeasuredBins bins;
+  double total = 0.0;
+  for (const MeasuredSample& s : samples) {
+    const HalfDiff hd = to_half_diff(s.i, s.o);
+    MeasuredBins::Row row{hd.theta_h, hd.theta_d, bins.size(), bins.size()};
+    total += add_bin(bins, s.i, s.o, std::cos(hd.theta_h), std::cos(hd.theta_d), s.measure, s.f);
+    row.end = bins.size();
+    if (row.end > row.begin) bins.rows.push_back(row);
+  }
+  normalize_weights(bins, total);
+  return bins;
+}
+
 }  // namespace
 
 MeasuredBins measured_bins(const MerlTable& table, int stride_d, int stride_phi) {
+  if (table.source_samples()) return sample_bins(*table.source_samples());
   MeasuredBins bins;
   const OneSidedMeasurement* one_sided = table.source_one_sided().get();
   double total = 0.0;
@@ -70,7 +86,7 @@ MeasuredBins measured_bins(const MerlTable& table, int stride_d, int stride_phi)
     for (int j = 0; j < MerlTable::kThetaD; j += stride_d) {
       const double theta_d_mid = (j + 0.5) / MerlTable::kThetaD * 0.5 * kPi;
       const double measure = 4.0 * std::cos(theta_d_mid) * std::sin(theta_d_mid) * h_measure;
-      MeasuredBins::Row row{i, j, bins.size(), bins.size()};
+      MeasuredBins::Row row{MerlTable::theta_h(i), MerlTable::theta_d(j), bins.size(), bins.size()};
       for (int k = 0; k < MerlTable::kPhiD; k += stride_phi) {
         const auto [wi, wo] = from_half_diff(MerlTable::theta_h(i), MerlTable::theta_d(j), MerlTable::phi_d(k));
         const double cos_h = std::cos(MerlTable::theta_h(i)), cos_d = std::cos(MerlTable::theta_d(j));
@@ -97,7 +113,7 @@ MeasuredBins measured_bins(const HalfDiffLattice& lattice, int stride) {
   double total = 0.0;
   for (int h = 0; h < L::kThetaH; ++h)
     for (int d = 0; d < L::kThetaD; ++d) {
-      MeasuredBins::Row row{h, d, bins.size(), bins.size()};
+      MeasuredBins::Row row{L::theta_h(h), L::theta_d(d), bins.size(), bins.size()};
       // Strided over the whole (phi_h, phi_d) square, so every azimuth of the half vector is kept.
       for (int a = (h + d) % stride; a < L::kPhiH * L::kPhiD; a += stride) {
         const int ph = a / L::kPhiD, pd = a % L::kPhiD;

@@ -33,7 +33,7 @@ namespace facetfit {
 struct MeasuredBins {
   // Bins of one (theta_h, theta_d) row of the table: entries [begin, end) of the arrays below.
   struct Row {
-    int theta_h = 0, theta_d = 0;  // MERL bin indices (a half/difference lattice's, for its bins)
+    double theta_h = 0.0, theta_d = 0.0;  // radians, shared by the row's bins
     std::size_t begin = 0, end = 0;
   };
   std::vector<Row> rows;
@@ -49,7 +49,9 @@ struct MeasuredBins {
 
 // Every valid bin with both directions above the horizon, theta_d and phi_d taken every `stride_d` and
 // `stride_phi` bins (theta_h: every bin); from the table's source_one_sided() where it has one, its two
-// estimates. Empty when the table has no valid bin.
+// estimates. A table whose source measured at nodes of its own (source_samples(): a UTIA file) gives
+// those nodes instead, every one, one row each: the table resamples between them, and a fit of the
+// resampled table fits the interpolation (docs/extraction.md). Empty when there is no valid bin.
 MeasuredBins measured_bins(const MerlTable& table, int stride_d, int stride_phi);
 
 // The nodes of an anisotropic source's lattice (io/half_diff_lattice.h), every `stride`-th of each

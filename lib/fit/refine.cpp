@@ -8,48 +8,71 @@
 #include <map>
 #include <memory>
 
+#include "fit/small_problem.h"
+
 namespace facetfit {
 
 namespace {
 
-// The D nodes whose weighted sum is D at one theta (the spline's stencil, duplicates merged).
+// Unknowns whose weighted sum is a tabulated value at one angle (duplicates merged, zero weights left out).
 struct NodeWeights {
   std::vector<int> node;
   std::vector<double> weight;
 };
 
-NodeWeights node_weights(const ThetaGrid& grid, double theta) {
-  int j;
-  double t;
-  grid.locate(theta, &j, &t);
-  const ThetaGrid::Stencil s = grid.stencil(j, t);
-  std::map<int, double> merged;
-  for (int q = 0; q < 4; ++q)
-    if (s.weight[q] != 0.0) merged[s.index[q]] += s.weight[q];
+NodeWeights merged(const int* index, const double* weight, int n) {
+  std::map<int, double> sum;
+  for (int q = 0; q < n; ++q)
+    if (weight[q] != 0.0) sum[index[q]] += weight[q];
   NodeWeights w;
-  for (const auto& [n, x] : merged)
-    if (std::abs(x) > 1e-12) w.node.push_back(n), w.weight.push_back(x);
+  for (const auto& [k, x] : sum)
+    if (std::abs(x) > 1e-12) w.node.push_back(k), w.weight.push_back(x);
   return w;
 }
 
-// The residuals of one (theta_h, theta_d) row: 3 per bin. Parameter blocks: body (3), the row's
-// Fresnel entry (3), then its D nodes (1 each). `g` holds G2 / (4 cos_i cos_o) per bin for this pass.
+// The D nodes of the spline's stencil at theta_h.
+NodeWeights ndf_nodes(const ThetaGrid& grid, double theta_h) {
+  int j;
+  double t;
+  grid.locate(theta_h, &j, &t);
+  const ThetaGrid::Stencil s = grid.stencil(j, t);
+  return merged(s.index, s.weight, 4);
+}
+
+// The Fresnel entries at theta_d, linear between them (FresnelCurve::eval's interpolation): one entry
+// on a MERL row, whose theta_d is an entry's, two between them (a UTIA node's).
+NodeWeights fresnel_entries(double theta_d) {
+  const double step = FresnelCurve::theta_d(1);
+  double x = clamp(theta_d / step, 0.0, double(FresnelCurve::kSize - 1));
+  if (std::abs(x - std::round(x)) < 1e-9) x = std::round(x);
+  const int j = std::min(int(x), FresnelCurve::kSize - 2);
+  const int index[2] = {j, j + 1};
+  const double weight[2] = {j + 1 - x, x - j};
+  return merged(index, weight, 2);
+}
+
+// The residuals of one row (bins sharing theta_h and theta_d): 3 per bin. Parameter blocks: body (3),
+// the row's Fresnel entries (3 each), then its D nodes (1 each). `g` holds G2 / (4 cos_i cos_o) per bin
+// for this pass.
 class RowCost final : public ceres::CostFunction {
  public:
   RowCost(const MeasuredBins& bins, const MeasuredBins::Row& row, const std::vector<double>& g,
-          const std::vector<double>& coat, NodeWeights nodes)
-      : bins_(bins), row_(row), g_(g), coat_(coat), nodes_(std::move(nodes)) {
+          const std::vector<double>& coat, NodeWeights fresnel, NodeWeights nodes)
+      : bins_(bins), row_(row), g_(g), coat_(coat), fresnel_(std::move(fresnel)), nodes_(std::move(nodes)) {
     set_num_residuals(int(3 * (row.end - row.begin)));
     mutable_parameter_block_sizes()->push_back(3);
-    mutable_parameter_block_sizes()->push_back(3);
+    for (std::size_t e = 0; e < fresnel_.node.size(); ++e) mutable_parameter_block_sizes()->push_back(3);
     for (std::size_t q = 0; q < nodes_.node.size(); ++q) mutable_parameter_block_sizes()->push_back(1);
   }
 
   bool Evaluate(double const* const* p, double* residuals, double** jacobians) const override {
     const double* body = p[0];
-    const double* fresnel = p[1];
+    const std::size_t nf = fresnel_.node.size(), first_node = 1 + nf;
+    double fresnel[3] = {0.0, 0.0, 0.0};
+    for (std::size_t e = 0; e < nf; ++e)
+      for (int ch = 0; ch < 3; ++ch) fresnel[ch] += fresnel_.weight[e] * p[1 + e][ch];
     double d = 0.0;
-    for (std::size_t q = 0; q < nodes_.node.size(); ++q) d += nodes_.weight[q] * p[2 + q][0];
+    for (std::size_t q = 0; q < nodes_.node.size(); ++q) d += nodes_.weight[q] * p[first_node + q][0];
     const std::size_t n = row_.end - row_.begin;
     for (std::size_t b = 0; b < n; ++b) {
       const std::size_t k = row_.begin + b;
@@ -64,10 +87,11 @@ class RowCost final : public ceres::CostFunction {
         const double dm = s * res.slope;  // d/dm of the residual: the chain rule for every parameter below
         if (jacobians[0])
           for (int e = 0; e < 3; ++e) jacobians[0][3 * r + std::size_t(e)] = e == ch ? dm * kInvPi : 0.0;
-        if (jacobians[1])
-          for (int e = 0; e < 3; ++e) jacobians[1][3 * r + std::size_t(e)] = e == ch ? dm * d * g : 0.0;
+        for (std::size_t f = 0; f < nf; ++f)
+          if (jacobians[1 + f])
+            for (int e = 0; e < 3; ++e) jacobians[1 + f][3 * r + std::size_t(e)] = e == ch ? dm * fresnel_.weight[f] * d * g : 0.0;
         for (std::size_t q = 0; q < nodes_.node.size(); ++q)
-          if (jacobians[2 + q]) jacobians[2 + q][r] = dm * fresnel[ch] * g * nodes_.weight[q];
+          if (jacobians[first_node + q]) jacobians[first_node + q][r] = dm * fresnel[ch] * g * nodes_.weight[q];
       }
     }
     return true;
@@ -78,7 +102,7 @@ class RowCost final : public ceres::CostFunction {
   const MeasuredBins::Row& row_;
   const std::vector<double>& g_;
   const std::vector<double>& coat_;
-  NodeWeights nodes_;
+  NodeWeights fresnel_, nodes_;
 };
 
 // weight (sum_j area_j D_j - 1): keeps the NDF normalized, which fixes the scale shared by D and F.
@@ -146,14 +170,16 @@ LobeFit refine_lobe(const MeasuredBins& bins, const Quadrature& quad, Smith smit
     for (int c = 0; c < 3; ++c) fresnel[std::size_t(j)][std::size_t(c)] = clamp(fit.fresnel.value[std::size_t(j)][c], 0.0, 1.0);
   std::vector<double> g(bins.size()), coat(bins.size());
   for (std::size_t k = 0; k < bins.size(); ++k) coat[k] = start.coat.eval(bins.o[k], bins.i[k]);
-  std::vector<NodeWeights> row_nodes;
+  std::vector<NodeWeights> row_nodes, row_entries;
   row_nodes.reserve(bins.rows.size());
-  for (const MeasuredBins::Row& row : bins.rows) row_nodes.push_back(node_weights(grid, MerlTable::theta_h(row.theta_h)));
-  // The Fresnel unknowns are the entries at the theta_d the bins sample (the knots); the entries between
+  row_entries.reserve(bins.rows.size());
+  for (const MeasuredBins::Row& row : bins.rows)
+    row_nodes.push_back(ndf_nodes(grid, row.theta_h)), row_entries.push_back(fresnel_entries(row.theta_d));
+  // The Fresnel unknowns are the entries the bins' theta_d reach (the knots); the entries between
   // them are linear in between, those past the last knot equal it. The entries no bin sees carry no
   // information of their own, and fewer unknowns make a faster solve.
   std::vector<int> knots;
-  for (const MeasuredBins::Row& row : bins.rows) knots.push_back(row.theta_d);
+  for (const NodeWeights& e : row_entries) knots.insert(knots.end(), e.node.begin(), e.node.end());
   std::sort(knots.begin(), knots.end());
   knots.erase(std::unique(knots.begin(), knots.end()), knots.end());
   // The two knots bracketing entry position x and their weights.
@@ -175,14 +201,12 @@ LobeFit refine_lobe(const MeasuredBins& bins, const Quadrature& quad, Smith smit
       const double mi = bins.i[k].z, mo = bins.o[k].z;
       g[k] = smith_g2_from_g1(smith, g1(mi), g1(mo)) / (4.0 * mi * mo);
     }
-    ceres::Problem::Options problem_options;
-    problem_options.cost_function_ownership = ceres::TAKE_OWNERSHIP;
-    ceres::Problem problem(problem_options);
+    SmallProblem problem;
     for (std::size_t r = 0; r < bins.rows.size(); ++r) {
-      const MeasuredBins::Row& row = bins.rows[r];
-      std::vector<double*> blocks{body.data(), fresnel[std::size_t(row.theta_d)].data()};
+      std::vector<double*> blocks{body.data()};
+      for (int e : row_entries[r].node) blocks.push_back(fresnel[std::size_t(e)].data());
       for (int n : row_nodes[r].node) blocks.push_back(&d[std::size_t(n)]);
-      problem.AddResidualBlock(new RowCost(bins, row, g, coat, row_nodes[r]), nullptr, blocks);
+      problem.AddResidualBlock(new RowCost(bins, bins.rows[r], g, coat, row_entries[r], row_nodes[r]), nullptr, blocks);
     }
     std::vector<double*> all_nodes;
     for (double& v : d) all_nodes.push_back(&v);
@@ -205,14 +229,7 @@ LobeFit refine_lobe(const MeasuredBins& bins, const Quadrature& quad, Smith smit
         problem.SetParameterLowerBound(fresnel[std::size_t(j)].data(), c, 0.0), problem.SetParameterUpperBound(fresnel[std::size_t(j)].data(), c, 1.0);
     for (double& v : d) problem.SetParameterLowerBound(&v, 0, 0.0);
 
-    ceres::Solver::Options solver;
-    solver.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
-    solver.max_num_iterations = options.max_iterations;
-    solver.num_threads = options.threads;
-    solver.function_tolerance = 1e-7;
-    solver.logging_type = ceres::SILENT;
-    ceres::Solver::Summary summary;
-    ceres::Solve(solver, &problem, &summary);
+    problem.Solve(options.max_iterations, options.function_tolerance);
 
     fit.ndf.ndf = d;
     const double area = normalize_ndf(fit.ndf, quad);  // F D stays what the solve found

@@ -1,7 +1,6 @@
 // Bounded nonlinear least squares for the fits' problems of a few unknowns over many residuals, given as
-// Ceres cost functions with analytic Jacobians: the parametric fits (8 to 14 unknowns, ~10^4 residuals;
-// it also solves the tabulated lobe's refinement, ~140 unknowns each residual touching ~10, to
-// convergence: docs/extraction.md says why that one stays with Ceres for now).
+// Ceres cost functions: the parametric fits (8 to 14 unknowns, ~10^4 residuals) and the tabulated
+// lobe's refinement (~100 to 400 unknowns, each residual touching ~10 of them).
 //
 // Ceres solved them before, and spent three quarters of a parametric solve on its per-entry Jacobian
 // bookkeeping (each block's Jacobian invalidated, written, validated and copied: docs/extraction.md,

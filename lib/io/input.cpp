@@ -90,7 +90,9 @@ MerlTable table_of(const Brdf& source) {
   // UTIA: anisotropic, tabulated as its azimuthal mean (the isotropic fits see that; fit/extract_2d.h
   // fits the file itself).
   if (const auto* utia = dynamic_cast<const UtiaBrdf*>(&source)) {
-    MerlTable table = MerlTable::tabulate(utia->azimuthal_mean());
+    const UtiaBrdf mean = utia->azimuthal_mean();
+    MerlTable table = MerlTable::tabulate(mean);
+    table.set_source_samples(std::make_shared<const std::vector<MeasuredSample>>(mean.samples_at_first_azimuth()));
     table.set_source_backscatter(utia->backscatter());
     table.set_source_half_diff(HalfDiffLattice::of(*utia));
     return table;

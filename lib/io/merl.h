@@ -89,6 +89,11 @@ class MerlTable final : public Brdf {
   // carried like source_backscatter.
   const std::shared_ptr<const OneSidedMeasurement>& source_one_sided() const { return source_one_sided_; }
   void set_source_one_sided(std::shared_ptr<const OneSidedMeasurement> source) { source_one_sided_ = std::move(source); }
+  // The pairs a source was measured at, where they are few and far between (a UTIA file: 15 degrees
+  // apart): the fits' distances read them instead of the table (fit/measurement.h). Null for every
+  // other source; carried like source_backscatter.
+  const std::shared_ptr<const std::vector<MeasuredSample>>& source_samples() const { return source_samples_; }
+  void set_source_samples(std::shared_ptr<const std::vector<MeasuredSample>> samples) { source_samples_ = std::move(samples); }
 
  private:
   std::optional<Rgb> eval_nearest(double x_h, double x_d, double x_p) const;
@@ -118,6 +123,7 @@ class MerlTable final : public Brdf {
   BackscatterLattice source_backscatter_;
   HalfDiffLattice source_half_diff_;
   std::shared_ptr<const OneSidedMeasurement> source_one_sided_;
+  std::shared_ptr<const std::vector<MeasuredSample>> source_samples_;
   Lookup lookup_ = Lookup::linear;
 };
 

@@ -2,6 +2,7 @@
 
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -120,6 +121,22 @@ UtiaBrdf UtiaBrdf::azimuthal_mean() const {
         }
   }
   return UtiaBrdf(std::move(f));
+}
+
+std::vector<MeasuredSample> UtiaBrdf::samples_at_first_azimuth() const {
+  // The cell of polar node t spans theta +- half a step (the pole's: a cap of half a step) and one
+  // azimuth step; the pole's 48 nodes are one direction and share the cap.
+  const auto solid_angle = [](int t) {
+    const double half = 0.5 * kThetaStep * kPi / 180.0, theta = t * kThetaStep * kPi / 180.0;
+    return (std::cos(std::max(theta - half, 0.0)) - std::cos(theta + half)) * (2.0 * kPi / kPhi);
+  };
+  std::vector<MeasuredSample> samples;
+  samples.reserve(std::size_t(kTheta) * kTheta * kPhi);
+  for (int ti = 0; ti < kTheta; ++ti)
+    for (int tv = 0; tv < kTheta; ++tv)
+      for (int pv = 0; pv < kPhi; ++pv)
+        samples.push_back({node_direction(tv, pv), node_direction(ti, 0), node(ti, 0, tv, pv), solid_angle(ti) * solid_angle(tv)});
+  return samples;
 }
 
 void UtiaBrdf::write(const std::string& path) const {

@@ -43,6 +43,9 @@ class UtiaBrdf final : public Brdf {
   // is the mean of eval() over those 48 turns, at the cost of one: what an isotropic fit sees of an
   // anisotropic material.
   UtiaBrdf azimuthal_mean() const;
+  // The nodes with phi_i = 0, each with the solid angles of the two nodes' cells (a polar cap at
+  // theta = 0): every node an isotropic file (azimuthal_mean()) holds, up to a turn about the normal.
+  std::vector<MeasuredSample> samples_at_first_azimuth() const;
   // Writes the file through a temporary; throws Error naming the file.
   void write(const std::string& path) const;
 
