@@ -3,10 +3,14 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <random>
 
 #include "fit/fit.h"
+#include "io/input.h"
+#include "io/utia.h"
 #include "model/analytic.h"
+#include "test_util.h"
 
 namespace facetfit {
 namespace {
@@ -103,6 +107,35 @@ TEST(Stress, MultiplicativeNoise) {
   expect_all_finite(r);
   EXPECT_NEAR(r.alpha_ggx, 0.25, 0.25 * 0.03);
   EXPECT_NEAR(r.f0.r, 0.9 * std::exp(0.005), 0.02);  // E[lognormal(0, 0.1)] = exp(0.005)
+}
+
+// The default fit (refinement and the anisotropic fits) of UTIA files read at their own nodes, at both
+// ends of the roughness range, with additive noise that makes the dark channel's entries negative.
+TEST(Stress, NoisyUtiaFilesAtExtremeRoughness) {
+  for (double alpha : {0.005, 1.5}) {
+    const SumBrdf truth({std::make_shared<LambertBrdf>(Rgb(0.3, 0.1, 0.002)),
+                         std::make_shared<MicrofacetBrdf>(Ndf::isotropic(NdfType::ggx, alpha), Smith::correlated, Fresnel::schlick(Rgb(0.04)))});
+    const std::string path = testing::TempDir() + "/noisy_utia.bin";
+    UtiaBrdf::tabulate(truth).write(path);
+    std::string bytes = test::read_bytes(path);
+    std::vector<double> v(bytes.size() / sizeof(double));
+    std::memcpy(v.data(), bytes.data(), bytes.size());
+    std::mt19937 rng(7);
+    std::normal_distribution<double> noise(0.0, 2e-4);  // file units: about 0.002 / sr near zero
+    for (double& x : v) x += noise(rng);
+    std::memcpy(bytes.data(), v.data(), bytes.size());
+    test::write_bytes(path, bytes);
+    FitOptions options;
+    options.refine = FitOptions::Refine::full;
+    const FitResult r = Fitter(options).fit(load_table(path));
+    SCOPED_TRACE("alpha " + std::to_string(alpha));
+    ASSERT_TRUE(r.ok()) << r.problem;
+    expect_all_finite(r);
+    EXPECT_TRUE(finite(r.body()) && finite(r.error) && finite(r.ggx.alpha) && finite(r.ggx.body) && finite(r.lsq.alpha));
+    EXPECT_LE(r.error, r.error_extraction);
+    ASSERT_TRUE(r.anisotropic);
+    EXPECT_TRUE(finite(r.anisotropic->ggx.alpha.alpha_x) && finite(r.anisotropic->ggx.alpha.alpha_y) && finite(r.anisotropic->ggx.error));
+  }
 }
 
 TEST(Stress, AllZeroInputIsMeaningless) {
