@@ -96,6 +96,29 @@ TEST(Refine, ParametricJacobianMatchesCentralDifferences) {
           }
 }
 
+TEST(Refine, RefinementJacobianMatchesCentralDifferences) {
+  // The refinement's derivatives, by hand too: on a MERL table's rows (one Fresnel entry each) and a UTIA
+  // file's nodes (two entries, interpolated), with and without a coat, on a smooth and a sharp lobe.
+  const SumBrdf truth({std::make_shared<LambertBrdf>(Rgb(0.4, 0.2, 0.1)),
+                       std::make_shared<MicrofacetBrdf>(Ndf::isotropic(NdfType::ggx, 0.2), Smith::correlated, Fresnel::schlick(Rgb(0.05)))});
+  const fs::path file = fs::path(::testing::TempDir()) / "jacobian.bin";
+  UtiaBrdf::tabulate(truth).write(file.string());
+  const MeasuredBins merl = measured_bins(MerlTable::tabulate(truth), 15, 45), utia = measured_bins(load_table(file.string()), 1, 1);
+  const Quadrature quad(90);
+  for (const double alpha : {0.05, 0.6})
+    for (const bool coat : {false, true}) {
+      LobeFit at;
+      at.ndf = tabulate_ndf(Ndf::isotropic(NdfType::ggx, alpha), quad.grid());
+      normalize_ndf(at.ndf, quad);
+      for (int j = 0; j < FresnelCurve::kSize; ++j) at.fresnel.value[std::size_t(j)] = Rgb(0.9, 0.5, 0.04) * (1.0 + 0.001 * j);
+      at.body = Rgb(0.3, 0.15, 0.05);
+      if (coat) at.coat = Coat{0.05, 0.04};
+      for (const MeasuredBins* bins : {&merl, &utia})
+        EXPECT_LT(refine_jacobian_error(*bins, quad, Smith::correlated, at), 1e-4)
+            << (bins == &merl ? "merl" : "utia") << " alpha " << alpha << " coat " << coat;
+    }
+}
+
 TEST(Refine, LutCarriesBodyCoatAndParametricFits) {
   const SumBrdf truth({ggx(0.05, Fresnel::schlick(Rgb(0.04))), std::make_shared<LambertBrdf>(Rgb(0.4, 0.2, 0.1)),
                        ggx(0.3, Fresnel::schlick(Rgb(0.3)))});

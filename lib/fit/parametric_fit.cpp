@@ -203,38 +203,9 @@ double parametric_jacobian_error(const MeasuredBins& bins, Smith smith, const Pa
   double coat[2] = {std::log(fit.coat.present() ? fit.coat.alpha : 0.1), fit.coat.f0};
   double* blocks[5] = {body, log_alpha, f0, f82, coat};
   double worst = 0.0;
-  for (const MeasuredBins::Row& row : bins.rows) {
-    const RowCost cost(bins, row, fit.type, smith, fit.fresnel, fit.coat.present());
-    const std::size_t n = std::size_t(cost.num_residuals());
-    std::vector<std::vector<double>> jacobian(5);
-    std::vector<double*> jacobian_ptrs(5);
-    for (std::size_t b = 0; b < 5; ++b) {
-      jacobian[b].resize(n * std::size_t(cost.parameter_block_sizes()[b]));
-      jacobian_ptrs[b] = jacobian[b].data();
-    }
-    std::vector<double> r(n), plus(n), minus(n);
-    cost.Evaluate(blocks, r.data(), jacobian_ptrs.data());
-    double scale = 0.0;
-    for (const std::vector<double>& j : jacobian)
-      for (double v : j) scale = std::max(scale, std::abs(v));
-    for (std::size_t b = 0; b < 5; ++b) {
-      const std::size_t size = std::size_t(cost.parameter_block_sizes()[b]);
-      for (std::size_t e = 0; e < size; ++e) {
-        double& x = blocks[b][e];
-        const double x0 = x, h = 1e-6 * std::max(1.0, std::abs(x0));
-        x = x0 + h;
-        cost.Evaluate(blocks, plus.data(), nullptr);
-        x = x0 - h;
-        cost.Evaluate(blocks, minus.data(), nullptr);
-        x = x0;
-        for (std::size_t k = 0; k < n; ++k) {
-          const double numeric = (plus[k] - minus[k]) / (2.0 * h), analytic = jacobian[b][k * size + e];
-          // Relative, with a floor below which central differences are rounding noise.
-          worst = std::max(worst, std::abs(analytic - numeric) / (std::abs(numeric) + 1e-3 * scale + 1e-8));
-        }
-      }
-    }
-  }
+  for (const MeasuredBins::Row& row : bins.rows)
+    worst = std::max(worst, jacobian_error(RowCost(bins, row, fit.type, smith, fit.fresnel, fit.coat.present()),
+                                           std::vector<double*>(blocks, blocks + 5)));
   return worst;
 }
 

@@ -127,17 +127,38 @@ class NormalizationCost final : public ceres::CostFunction {
   double weight_;
 };
 
-// weight (x_{j-1} - 2 x_j + x_{j+1}) per component of N: the Fresnel curve's channels (N = 3), or an
-// NDF node (N = 1, the weight already divided by the node's scale: a relative second difference).
+// a x_0 + b x_1 + c x_2 per component of N: a second difference, of the Fresnel curve's channels
+// (N = 3) or of an NDF node (N = 1).
 template <int N>
 struct SecondDifference {
-  double weight;
+  double a, b, c;
   template <class T>
-  bool operator()(const T* a, const T* b, const T* c, T* r) const {
-    for (int k = 0; k < N; ++k) r[k] = weight * (a[k] - 2.0 * b[k] + c[k]);
+  bool operator()(const T* x0, const T* x1, const T* x2, T* r) const {
+    for (int k = 0; k < N; ++k) r[k] = a * x0[k] + b * x1[k] + c * x2[k];
     return true;
   }
 };
+
+// The Fresnel curve's smoothness term over three consecutive knots at entry positions e0 < e1 < e2:
+// sqrt((h0 + h1) / 2) F'' with F'' the divided second difference, so that the sum over knots
+// approximates the integral of F''^2 whatever the knots' spacing (MERL rows: every 6th entry; a UTIA
+// file's nodes: nearly every entry); scaled to weight (x0 - 2 x1 + x2) at a spacing of 6 entries.
+SecondDifference<3> fresnel_smoothness(double weight, int e0, int e1, int e2) {
+  const double h0 = e1 - e0, h1 = e2 - e1;
+  const double k = weight * (36.0 / std::sqrt(6.0)) * std::sqrt(0.5 * (h0 + h1)) * 2.0 / (h0 + h1);
+  return {k / h0, -k * (1.0 / h0 + 1.0 / h1), k / h1};
+}
+
+// G2 / (4 cos_i cos_o) of `ndf` and the coat's f per bin: what a pass holds fixed.
+void pass_terms(const MeasuredBins& bins, Smith smith, const LobeFit& lobe, std::vector<double>& g, std::vector<double>& coat) {
+  const G1Table g1(lobe.ndf);
+  g.resize(bins.size()), coat.resize(bins.size());
+  for (std::size_t k = 0; k < bins.size(); ++k) {
+    const double mi = bins.i[k].z, mo = bins.o[k].z;
+    g[k] = smith_g2_from_g1(smith, g1(mi), g1(mo)) / (4.0 * mi * mo);
+    coat[k] = lobe.coat.eval(bins.o[k], bins.i[k]);
+  }
+}
 
 }  // namespace
 
@@ -168,8 +189,7 @@ LobeFit refine_lobe(const MeasuredBins& bins, const Quadrature& quad, Smith smit
   std::vector<std::array<double, 3>> fresnel(FresnelCurve::kSize);
   for (int j = 0; j < FresnelCurve::kSize; ++j)
     for (int c = 0; c < 3; ++c) fresnel[std::size_t(j)][std::size_t(c)] = clamp(fit.fresnel.value[std::size_t(j)][c], 0.0, 1.0);
-  std::vector<double> g(bins.size()), coat(bins.size());
-  for (std::size_t k = 0; k < bins.size(); ++k) coat[k] = start.coat.eval(bins.o[k], bins.i[k]);
+  std::vector<double> g, coat;
   std::vector<NodeWeights> row_nodes, row_entries;
   row_nodes.reserve(bins.rows.size());
   row_entries.reserve(bins.rows.size());
@@ -195,12 +215,7 @@ LobeFit refine_lobe(const MeasuredBins& bins, const Quadrature& quad, Smith smit
   };
 
   for (int pass = 0; pass < options.passes; ++pass) {
-    // G2 / (4 cos_i cos_o) of the current NDF, held for this pass.
-    const G1Table g1(fit.ndf);
-    for (std::size_t k = 0; k < bins.size(); ++k) {
-      const double mi = bins.i[k].z, mo = bins.o[k].z;
-      g[k] = smith_g2_from_g1(smith, g1(mi), g1(mo)) / (4.0 * mi * mo);
-    }
+    pass_terms(bins, smith, fit, g, coat);  // G2 of the current NDF (the coat is held: the same every pass)
     SmallProblem problem;
     for (std::size_t r = 0; r < bins.rows.size(); ++r) {
       std::vector<double*> blocks{body.data()};
@@ -213,12 +228,14 @@ LobeFit refine_lobe(const MeasuredBins& bins, const Quadrature& quad, Smith smit
     problem.AddResidualBlock(new NormalizationCost(quad.projected_area(), 10.0), nullptr, all_nodes);
     for (std::size_t k = 1; k + 1 < knots.size(); ++k)
       problem.AddResidualBlock(
-          new ceres::AutoDiffCostFunction<SecondDifference<3>, 3, 3, 3, 3>(new SecondDifference<3>{options.fresnel_smoothness}),
+          new ceres::AutoDiffCostFunction<SecondDifference<3>, 3, 3, 3, 3>(
+              new SecondDifference<3>(fresnel_smoothness(options.fresnel_smoothness, knots[k - 1], knots[k], knots[k + 1]))),
           nullptr, fresnel[std::size_t(knots[k - 1])].data(), fresnel[std::size_t(knots[k])].data(), fresnel[std::size_t(knots[k + 1])].data());
     for (std::size_t j = 1; j + 1 < d.size(); ++j) {
       const double scale = std::max(d[j], 1e-3 * d[0] + 1e-6);
       problem.AddResidualBlock(new ceres::AutoDiffCostFunction<SecondDifference<1>, 1, 1, 1, 1>(
-                                   new SecondDifference<1>{options.ndf_smoothness / scale}),
+                                   new SecondDifference<1>{options.ndf_smoothness / scale, -2.0 * options.ndf_smoothness / scale,
+                                                           options.ndf_smoothness / scale}),
                                nullptr, &d[j - 1], &d[j], &d[j + 1]);
     }
     // Bounds, not a clamp afterwards: left free, the solve trades negative nodes against each other.
@@ -246,6 +263,24 @@ LobeFit refine_lobe(const MeasuredBins& bins, const Quadrature& quad, Smith smit
       fit.fresnel.value[std::size_t(j)][c] = w[0] * fresnel[std::size_t(e[0])][std::size_t(c)] + w[1] * fresnel[std::size_t(e[1])][std::size_t(c)];
   }
   return fit;
+}
+
+double refine_jacobian_error(const MeasuredBins& bins, const Quadrature& quad, Smith smith, const LobeFit& at) {
+  std::vector<double> g, coat;
+  pass_terms(bins, smith, at, g, coat);
+  std::vector<double> d = at.ndf.ndf, body = {at.body.r, at.body.g, at.body.b};
+  std::vector<std::array<double, 3>> fresnel(FresnelCurve::kSize);
+  for (int j = 0; j < FresnelCurve::kSize; ++j)
+    for (int c = 0; c < 3; ++c) fresnel[std::size_t(j)][std::size_t(c)] = at.fresnel.value[std::size_t(j)][c];
+  double worst = 0.0;
+  for (const MeasuredBins::Row& row : bins.rows) {
+    NodeWeights entries = fresnel_entries(row.theta_d), nodes = ndf_nodes(quad.grid(), row.theta_h);
+    std::vector<double*> blocks{body.data()};
+    for (int e : entries.node) blocks.push_back(fresnel[std::size_t(e)].data());
+    for (int n : nodes.node) blocks.push_back(&d[std::size_t(n)]);
+    worst = std::max(worst, jacobian_error(RowCost(bins, row, g, coat, std::move(entries), std::move(nodes)), blocks));
+  }
+  return worst;
 }
 
 }  // namespace facetfit

@@ -8,8 +8,9 @@
 //
 // with the NDF nodes D, the RGB Fresnel curve F and the RGB body albedo as unknowns, bounded below by
 // zero. G2 depends on every D node through sigma, densely, so it is held fixed within a pass (each bin
-// then depends on a few D nodes, one or two Fresnel entries and the body: ~150 unknowns, solved by
-// fit/small_problem.h's Levenberg-Marquardt), recomputed between passes. The
+// then depends on a few D nodes, one or two Fresnel entries and the body: ~140 unknowns on an RGL file,
+// ~320 on a UTIA file's nodes, solved by fit/small_problem.h's dense Levenberg-Marquardt, whose n x n
+// normal equations grow with --resolution as the quadrature does), recomputed between passes. The
 // result is not the joint optimum (docs/extraction.md): the caller keeps the start where it ends farther from the
 // measurement. The NDF keeps its normalization through a stiff residual, the Fresnel curve is kept
 // smooth by a small second-difference penalty.
@@ -34,8 +35,8 @@ struct LobeFit {
 
 struct RefineOptions {
   // G2 recomputed from D between passes. Each pass is solved to convergence (6 to 15 steps on the RGL
-  // files; the cap is a guard): one pass lets D drift away from the G2 it holds, a second brings the
-  // fit nearer on five of the six RGL files (docs/extraction.md).
+  // files; the cap is a guard): one pass lets D drift away from the G2 it holds (acrylic_felt 0.0113
+  // after one pass, 0.0104 after two: docs/extraction.md).
   int passes = 2;
   int max_iterations = 50;  // Levenberg-Marquardt steps per pass
   double function_tolerance = 1e-7;
@@ -49,6 +50,10 @@ struct RefineOptions {
 // sigma(theta_j) of the NDF nodes (the projected-area integral), and the NDF renormalized to unit
 // projected area. Returns the area before renormalization.
 double normalize_ndf(TabulatedNdf& ndf, const Quadrature& quadrature);
+
+// The largest relative difference, over `bins`, between the refinement's hand-written derivatives and
+// central differences at `at` (its ndf on `quadrature`'s grid): tests/test_refine.cpp's check.
+double refine_jacobian_error(const MeasuredBins& bins, const Quadrature& quadrature, Smith smith, const LobeFit& at);
 
 // Refines `start` (its ndf on `quadrature`'s grid) on `bins`; its coat, if any, is held.
 LobeFit refine_lobe(const MeasuredBins& bins, const Quadrature& quadrature, Smith smith, const LobeFit& start,

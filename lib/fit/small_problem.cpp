@@ -10,6 +10,40 @@
 
 namespace facetfit {
 
+double jacobian_error(const ceres::CostFunction& cost, const std::vector<double*>& blocks) {
+  const std::size_t n = std::size_t(cost.num_residuals()), count = blocks.size();
+  const std::vector<int32_t>& sizes = cost.parameter_block_sizes();
+  std::vector<std::vector<double>> jacobian(count);
+  std::vector<double*> jacobian_ptrs(count);
+  for (std::size_t b = 0; b < count; ++b) {
+    jacobian[b].resize(n * std::size_t(sizes[b]));
+    jacobian_ptrs[b] = jacobian[b].data();
+  }
+  std::vector<double> r(n), plus(n), minus(n);
+  cost.Evaluate(blocks.data(), r.data(), jacobian_ptrs.data());
+  double scale = 0.0, worst = 0.0;
+  for (const std::vector<double>& j : jacobian)
+    for (double v : j) scale = std::max(scale, std::abs(v));
+  for (std::size_t b = 0; b < count; ++b) {
+    const std::size_t size = std::size_t(sizes[b]);
+    for (std::size_t e = 0; e < size; ++e) {
+      double& x = blocks[b][e];
+      const double x0 = x, h = 1e-6 * std::max(1.0, std::abs(x0));
+      x = x0 + h;
+      cost.Evaluate(blocks.data(), plus.data(), nullptr);
+      x = x0 - h;
+      cost.Evaluate(blocks.data(), minus.data(), nullptr);
+      x = x0;
+      for (std::size_t k = 0; k < n; ++k) {
+        const double numeric = (plus[k] - minus[k]) / (2.0 * h), analytic = jacobian[b][k * size + e];
+        // Relative, with a floor below which central differences are rounding noise.
+        worst = std::max(worst, std::abs(analytic - numeric) / (std::abs(numeric) + 1e-3 * scale + 1e-8));
+      }
+    }
+  }
+  return worst;
+}
+
 SmallProblem::SmallProblem() = default;
 SmallProblem::~SmallProblem() = default;
 
