@@ -25,7 +25,7 @@ namespace facetfit {
 // same options is baked again rather than served (lut/bake.h). Bump when the same input and options give
 // a different fit. 2: an RGL file's refinement reads its two one-sided estimates (fit/measurement.h);
 // 3: the parametric fits solved by fit/small_problem.h; 4: the refinement solved to convergence in two
-// passes, a UTIA file's fits on its own nodes.
+// passes, a UTIA file's isotropic fits on its own nodes.
 constexpr int kFitRevision = 4;
 
 struct FitOptions {

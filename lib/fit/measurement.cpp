@@ -55,7 +55,8 @@ void normalize_weights(MeasuredBins& bins, double total) {
     for (double& w : bins.weight) w /= total;
 }
 
-// A source's own nodes, one row each (their half/difference angles are all different).
+// A source's own nodes, one row each (rows only group bins: a node and its mirror (i, o swapped) share
+// their half/difference angles, and so do the pole's nodes).
 MeasuredBins sample_bins(const std::vector<MeasuredSample>& samples) {
   MeasuredBins bins;
   double total = 0.0;

@@ -56,7 +56,7 @@ MeasuredBins measured_bins(const MerlTable& table, int stride_d, int stride_phi)
 
 // The nodes of an anisotropic source's lattice (io/half_diff_lattice.h), every `stride`-th of each
 // (theta_h, theta_d) row's phi_h x phi_d nodes (the start staggered from row to row); a row is one
-// (theta_h, theta_d) pair of lattice indices. Empty for an empty lattice.
+// (theta_h, theta_d) pair of the lattice. Empty for an empty lattice.
 MeasuredBins measured_bins(const HalfDiffLattice& lattice, int stride);
 
 // The bin sets of the fits: the tabulated lobe's refinement solves on the sparse one (6.4k bins: the
@@ -64,7 +64,9 @@ MeasuredBins measured_bins(const HalfDiffLattice& lattice, int stride);
 // a sparser one (2.1k bins: their distances move by < 0.5% from the 6.4k set, at 40% of the time),
 // and every distance is measured on the densest, mostly disjoint one (31k bins; of a source with two
 // one-sided estimates every other phi_d of those, 15.5k bins and 31k estimates: the six RGL files'
-// distances move by < 2% and no choice between fits changes, at 15% less of the fit's time).
+// distances move by < 2% and no choice between fits changes, at 15% less of the fit's time). A source
+// measured at nodes of its own (a UTIA file) has no other measurement: the three sets are its 1,728
+// nodes, so its distances are measured on what was fitted.
 inline MeasuredBins solve_bins(const MerlTable& table) { return measured_bins(table, 6, 30); }
 inline MeasuredBins parametric_bins(const MerlTable& table) { return measured_bins(table, 9, 60); }
 inline MeasuredBins error_bins(const MerlTable& table) { return measured_bins(table, 3, table.source_one_sided() ? 24 : 12); }

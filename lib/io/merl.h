@@ -91,7 +91,8 @@ class MerlTable final : public Brdf {
   void set_source_one_sided(std::shared_ptr<const OneSidedMeasurement> source) { source_one_sided_ = std::move(source); }
   // The pairs a source was measured at, where they are few and far between (a UTIA file: 15 degrees
   // apart): the fits' distances read them instead of the table (fit/measurement.h). Null for every
-  // other source; carried like source_backscatter.
+  // other source; carried like source_backscatter (so a table edited after it is set still fits the
+  // samples: set it last, or clear it).
   const std::shared_ptr<const std::vector<MeasuredSample>>& source_samples() const { return source_samples_; }
   void set_source_samples(std::shared_ptr<const std::vector<MeasuredSample>> samples) { source_samples_ = std::move(samples); }
 
