@@ -149,7 +149,7 @@ SecondDifference<3> fresnel_smoothness(double weight, int e0, int e1, int e2) {
   return {k / h0, -k * (1.0 / h0 + 1.0 / h1), k / h1};
 }
 
-// G2 / (4 cos_i cos_o) of `ndf` and the coat's f per bin: what a pass holds fixed.
+// G2 / (4 cos_i cos_o) of the lobe's NDF and its coat's f, per bin: what a pass holds fixed.
 void pass_terms(const MeasuredBins& bins, Smith smith, const LobeFit& lobe, std::vector<double>& g, std::vector<double>& coat) {
   const G1Table g1(lobe.ndf);
   g.resize(bins.size()), coat.resize(bins.size());
