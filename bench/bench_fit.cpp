@@ -25,6 +25,7 @@
 #include "model/analytic.h"
 #include "model/tabulated.h"
 #include "model/tabulated_anisotropic.h"
+#include "render/renderer.h"
 #include "render/tracer.h"
 
 namespace facetfit {
@@ -280,6 +281,26 @@ void BM_ShadowRay(benchmark::State& state) {
   rtcReleaseDevice(device);
 }
 BENCHMARK(BM_ShadowRay)->ArgName("embree")->Arg(1)->Arg(0)->Unit(benchmark::kNanosecond);
+
+// One render of the scene of ../shared/data/realref (bench/render_compare.py's), 96 x 96 at 16 spp on one
+// thread: the renderer's cost per sample without start-up or thread scheduling. material:0 (anchor) a
+// Lambertian sphere, 1 GGX 0.3 with F = 1 and separable masking (the scene Mitsuba renders in make bench).
+void BM_RenderSphere(benchmark::State& state) {
+  const tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
+  const char* material = state.range(0) == 0 ? R"({"type": "lambert", "albedo": [0.5, 0.5, 0.5]})"
+                                              : R"({"type": "ggx", "alpha": 0.3, "f0": [1, 1, 1], "f82": [1, 1, 1], "smith": "separable"})";
+  const SceneDesc scene = parse_scene_text(std::string(R"({
+    "camera": {"position": [0, 0.6, 4], "look_at": [0, 0, 0], "up": [0, 1, 0], "fov": 30, "width": 96, "height": 96},
+    "render": {"spp": 16, "seed": 1},
+    "environment": {"constant": [0.3, 0.3, 0.3]},
+    "lights": [{"type": "directional", "direction": [0.3, 1, 0.5], "irradiance": [3, 3, 3]}],
+    "materials": {"m": )") + material + R"(},
+    "objects": [{"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "m"}]})",
+                                            "bench", ".");
+  for (auto _ : state) benchmark::DoNotOptimize(render(scene).rgba.data());
+  state.counters["ns_per_sample"] = benchmark::Counter(96.0 * 96.0 * 16.0, benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+}
+BENCHMARK(BM_RenderSphere)->ArgName("material")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 
 // A MERL file on disk for the bake benchmarks, written once.
 const std::string& gold_file() {

@@ -48,7 +48,9 @@ int main(int argc, char** argv) {
   std::string errors;
   for (const std::filesystem::path& path : plugin_candidates()) {
     if (!std::filesystem::exists(path)) continue;
-    void* plugin = ::dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
+    // Lazy: of the plugin's libraries' functions a command calls few; binding them all first cost ~10% of
+    // the start-up (docs/render-speed.md, "Start-up").
+    void* plugin = ::dlopen(path.c_str(), RTLD_LAZY | RTLD_LOCAL);
     if (!plugin) {
       errors = ::dlerror();
       break;

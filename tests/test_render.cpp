@@ -132,6 +132,10 @@ TEST(Tracer, SphereRootsStayAccurateFarAwayAndAtGrazingAngles) {
   EXPECT_NEAR(intersect_sphere(c, 1.0, Ray{graze.origin, graze.dir, 5.0}), 5.0 + half_chord, 1e-12);
   // Beyond tfar: nothing.
   EXPECT_TRUE(std::isinf(intersect_sphere(c, 1.0, Ray{Vec3(0, 0, 5), Vec3(0, 0, -1), 0.0, 3.9})));
+  // Outside and moving away (the early exit): nothing ahead; with tnear behind the origin, the roots
+  // behind it are still found.
+  EXPECT_TRUE(std::isinf(intersect_sphere(c, 1.0, Ray{Vec3(0, 0, 5), Vec3(0, 0.6, 0.8)})));
+  EXPECT_NEAR(intersect_sphere(c, 1.0, Ray{Vec3(0, 0, 5), Vec3(0, 0, 1), -10.0}), -6.0, 1e-12);
 }
 
 TEST(Tracer, SpheresAndTrianglesTogether) {

@@ -17,12 +17,15 @@ double intersect_sphere(const Vec3& center, double radius, const Ray& ray) {
   const double inf = std::numeric_limits<double>::infinity();
   const Vec3 f = ray.origin - center;
   const double a = glm::dot(ray.dir, ray.dir), b = -glm::dot(f, ray.dir);  // half of the usual b, negated
+  const double c = glm::dot(f, f) - radius * radius;
+  // Starting outside and moving away, both roots are negative: every shadow ray leaving a sphere's lit
+  // side ends here, without the square root.
+  if (c > 0.0 && b <= 0.0 && ray.tnear >= 0.0) return inf;
   // r^2 - |f + (b/a) d|^2 = discriminant / a: the squared half-chord, from the point of the line nearest
   // the centre, instead of b^2 - ac, which cancels catastrophically far from the sphere.
   const Vec3 nearest = f + (b / a) * ray.dir;
   const double chord2 = radius * radius - glm::dot(nearest, nearest);
   if (!(chord2 >= 0.0)) return inf;
-  const double c = glm::dot(f, f) - radius * radius;
   const double q = b + std::copysign(std::sqrt(a * chord2), b);
   double t0 = q / a, t1 = q != 0.0 ? c / q : t0;  // the roots; the second from their product c / a
   if (t0 > t1) std::swap(t0, t1);
