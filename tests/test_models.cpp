@@ -48,6 +48,19 @@ TEST_P(NdfTest, SigmaMatchesItsIntegral) {
   }
 }
 
+// D is the slope density over cos^4 (ndf.h), however it is computed (GGX's is multiplied out).
+TEST_P(NdfTest, DIsTheSlopeDensityOverCosineToTheFourth) {
+  const auto [type, ax, ay] = GetParam();
+  const Ndf ndf{type, ax, ay};
+  for (double theta : {0.0, 0.3, 1.0, 1.5, 1.5707})
+    for (double phi : {0.0, 0.8, 2.5}) {
+      const Vec3 h = spherical_direction(theta, phi);
+      const double c4 = h.z * h.z * h.z * h.z;
+      EXPECT_NEAR(ndf.D(h), ndf.slope_pdf(-h.x / h.z, -h.y / h.z) / c4, 1e-12 * ndf.D(h)) << theta << " " << phi;
+    }
+  EXPECT_EQ(ndf.D(Vec3(0.6, 0.0, -0.8)), 0.0);
+}
+
 INSTANTIATE_TEST_SUITE_P(Shapes, NdfTest,
                          testing::Values(std::make_tuple(NdfType::ggx, 0.3, 0.3), std::make_tuple(NdfType::ggx, 0.8, 0.2),
                                          std::make_tuple(NdfType::beckmann, 0.3, 0.3),

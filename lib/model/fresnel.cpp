@@ -45,18 +45,24 @@ double fresnel_dielectric(double eta, double cos_d) {
   return 0.5 * (r_parl * r_parl + r_perp * r_perp);
 }
 
-Rgb fresnel_f82_tint(const Rgb& f0, const Rgb& f82, double cos_d) {
-  // F(mu) = Schlick(f0, mu) - a mu (1 - mu)^6, with a chosen so that F(1/7) = f82.
-  // The sixth powers multiplied out: std::pow was 3% of a render.
-  const auto basis = [](double mu) {
-    const double m2 = (1.0 - mu) * (1.0 - mu);
-    return mu * m2 * m2 * m2;
-  };
+namespace {
+
+// mu (1 - mu)^6, the sixth power multiplied out: std::pow was 3% of a render.
+double f82_basis(double mu) {
+  const double m2 = (1.0 - mu) * (1.0 - mu);
+  return mu * m2 * m2 * m2;
+}
+
+}  // namespace
+
+F82Tint::F82Tint(const Rgb& f0_, const Rgb& f82) : f0(f0_) {
   constexpr double mu82 = 1.0 / 7.0;
-  const Rgb a = (fresnel_schlick(f0, mu82) - f82) / basis(mu82);
+  a = (fresnel_schlick(f0, mu82) - f82) / f82_basis(mu82);
+}
+
+Rgb F82Tint::eval(double cos_d) const {
   const double mu = clamp(cos_d, 0.0, 1.0);
-  const Rgb f = fresnel_schlick(f0, mu) - a * basis(mu);
-  return glm::max(f, Rgb(0.0));
+  return glm::max(fresnel_schlick(f0, mu) - a * f82_basis(mu), Rgb(0.0));
 }
 
 Rgb Fresnel::eval(double cos_d) const {

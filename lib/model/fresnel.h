@@ -13,8 +13,15 @@ Rgb fresnel_schlick(const Rgb& f0, double cos_d);
 Rgb fresnel_conductor(const Rgb& eta, const Rgb& k, double cos_d);
 // Dielectric with real relative index eta (unpolarized, exact; total internal reflection gives 1).
 double fresnel_dielectric(double eta, double cos_d);
-// Hoffman's F82-tint model: Schlick plus a correction term that makes F(acos(1/7)) = f82 exactly.
-Rgb fresnel_f82_tint(const Rgb& f0, const Rgb& f82, double cos_d);
+// Hoffman's F82-tint model: Schlick plus a correction term that makes F(acos(1/7)) = f82 exactly,
+// F(mu) = Schlick(f0, mu) - a mu (1 - mu)^6. The term's scale `a` is the material's: computed once.
+struct F82Tint {
+  Rgb f0{0.0}, a{0.0};
+  F82Tint() = default;
+  F82Tint(const Rgb& f0, const Rgb& f82);
+  Rgb eval(double cos_d) const;
+};
+inline Rgb fresnel_f82_tint(const Rgb& f0, const Rgb& f82, double cos_d) { return F82Tint(f0, f82).eval(cos_d); }
 
 // The angle at which the F82-tint model is pinned: acos(1/7), about 81.79 degrees.
 inline double f82_theta() { return std::acos(1.0 / 7.0); }

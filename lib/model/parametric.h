@@ -6,6 +6,7 @@
 #include "core/brdf.h"
 #include "model/fresnel_curve.h"
 #include "model/coat.h"
+#include "model/fresnel.h"
 #include "model/ndf.h"
 #include "model/smith.h"
 
@@ -17,7 +18,7 @@ class ParametricBrdf final : public Brdf {
   ParametricBrdf(const Ndf& ndf, Smith smith, const FresnelCurve& curve, const Rgb& body = Rgb(0.0), const Coat& coat = {})
       : ndf_(ndf), smith_(smith), curve_(curve), body_(body), coat_(coat), use_curve_(true) {}
   ParametricBrdf(const Ndf& ndf, Smith smith, const Rgb& f0, const Rgb& f82, const Rgb& body = Rgb(0.0), const Coat& coat = {})
-      : ndf_(ndf), smith_(smith), f0_(f0), f82_(f82), body_(body), coat_(coat) {}
+      : ndf_(ndf), smith_(smith), f82_tint_(f0, f82), body_(body), coat_(coat) {}
 
   std::optional<Rgb> eval(const Vec3& o, const Vec3& i) const override;
   // f(o, i) for o and i above the horizon, from what a caller that also needs the lobe's density has
@@ -29,7 +30,7 @@ class ParametricBrdf final : public Brdf {
   Ndf ndf_;
   Smith smith_;
   FresnelCurve curve_;
-  Rgb f0_{0.0}, f82_{0.0};
+  F82Tint f82_tint_;
   Rgb body_{0.0};
   Coat coat_;
   bool use_curve_ = false;

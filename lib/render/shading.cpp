@@ -18,7 +18,7 @@ ShadingModel::ShadingModel(std::shared_ptr<const Brdf> brdf, std::shared_ptr<con
 
 Rgb ShadingModel::f(const Vec3& o, const Vec3& i) const {
   // Negative values (a measurement's noise around zero) are rendered as they are, as Mitsuba does.
-  const auto v = brdf_->eval(o, i);
+  const auto v = ggx_brdf_ ? ggx_brdf_->eval(o, i) : brdf_->eval(o, i);  // the first a direct call (final class)
   return v ? *v : Rgb(0.0);
 }
 
