@@ -164,8 +164,8 @@ void anisotropic_lobe_section(std::ostringstream& md, const std::string& scratch
         "The default fit (`--refine full`) of anisotropic materials written by facetfit's UTIA writer and the tests' RGL "
         "tensor writer (F = 1, no body: the format stores a microfacet lobe): the 2D extraction's moment estimates "
         "(no body: a body broadens them) and the anisotropic GGX lobe with a body and F82-tint Fresnel fitted on the "
-        "file's half/difference lattice (docs/conventions.md). Height-correlated Smith. The UTIA file's 15-degree "
-        "nodes, between which the lobe is interpolated linearly, limit its rows (tests/test_refine.cpp).\n\n"
+        "file: a UTIA file at its node pairs, an RGL file on a half/difference lattice read through its evaluation "
+        "(docs/conventions.md). Height-correlated Smith (tests/test_refine.cpp).\n\n"
         "| file | written: GGX alpha_x, alpha_y, angle; body; f0 | moments: alpha_x, alpha_y, angle | fitted: alpha_x, alpha_y, angle | body | f0 | distance |\n"
         "|---|---|---|---|---|---|---|\n";
   FitOptions options;

@@ -178,12 +178,12 @@ void BM_FitUtia(benchmark::State& state) {
 }
 BENCHMARK(BM_FitUtia)->ArgName("refine")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 
-// The anisotropic GGX lobe with a body fitted on that file's half/difference lattice, one core: the part of
+// The anisotropic GGX lobe with a body fitted on that file's node pairs, one core: the part of
 // BM_FitUtia/refine:1 the anisotropic input adds (twice: GGX and Beckmann).
 void BM_FitAnisotropicLobe(benchmark::State& state) {
   const auto limit = limit_threads(state);
   const MerlTable table = load_table(utia_file());
-  const MeasuredBins solve = measured_bins(table.source_half_diff(), 24), all = measured_bins(table.source_half_diff(), 1);
+  const MeasuredBins solve = anisotropic_bins(table, 24), all = anisotropic_bins(table, 1);
   AnisotropicParametricFit start;
   start.alpha = {0.5, 0.3, 0.2};
   start.body = Rgb(0.05);

@@ -17,11 +17,12 @@ NOTES = {
     "BM_RefineAlpha": "optional least-squares refinement of one alpha (`--refine`)",
     "BM_TabulateAnalytic": "tabulate an analytic BRDF into MERL layout (tests, `convert builtin:`)",
     "BM_LoadUtia": "a UTIA file (anisotropic GGX) to the fits' table: read, azimuthal mean, tabulation in MERL layout (against BM_TabulateAnalytic)",
-    "BM_FitUtia": "the fit of that table, the paper's method (refine:0) and the default (refine:1, with the anisotropic GGX and Beckmann lobes fitted on the file's lattice), each with the 2D extraction of the file's back-scattering",
-    "BM_FitAnisotropicLobe": "one anisotropic GGX lobe with a body fitted on the UTIA file's half/difference lattice (5.7k nodes solved, 138k measured; central differences), one core",
+    "BM_FitUtia": "the fit of that table, the paper's method (refine:0) and the default (refine:1, with the anisotropic GGX and Beckmann lobes fitted at the file's node pairs), each with the 2D extraction of the file's back-scattering",
+    "BM_FitAnisotropicLobe": "one anisotropic GGX lobe with a body fitted at the UTIA file's node pairs (3.5k solved, 83k measured; central differences), one core",
     "BM_TabulatedLobe": "the isotropic tabulated lobe (anchor of the next): one eval (draw:0) or one draw, sample + pdf + eval (draw:1), plain and stretched (0.5, 2)",
     "BM_TabulatedAnisotropicLobe": "the anisotropic tabulated lobe (GGX 0.4 x 0.15 on 90 x 64 nodes), the same operations",
     "BM_ShadowRay": "one shadow ray leaving a unit sphere: Embree's sphere primitive (anchor, one ray at a time, as the renderer traced spheres before) and the tracer's closed form",
+    "BM_RenderSphere": "one render of the realref scene's sphere (bench/render_compare.py's scene) at 96 x 96, 16 spp, one thread, no start-up: a Lambertian sphere (anchor) and GGX 0.3 (the sphere Mitsuba renders in docs/render-speed.md)",
     "BM_Bake": "bake one MERL file with the default fit: SHA-256, read, fit, sampling tables, EXR, sidecar (hash overlapped with the read)",
     "BM_Sha256File": "SHA-256 of the 35 MB MERL file (OpenSSL; provenance in the LUT, bake cache key)",
     "BM_VisibleNormalTables": "the sampling tables of one material",
@@ -58,6 +59,9 @@ def main(src, dst, startup_md=None):
         memory = ", ".join(f"{k[:-4]} {v:.1f} MiB" for k, v in med.items() if k.endswith("_MiB"))
         if memory:
             note += f" ({memory})"
+        # Cost per sample (counters named ns_per_sample), likewise.
+        if "ns_per_sample" in med:
+            note += f" ({med['ns_per_sample'] * 1e9:.0f} ns per sample)"
         lines.append(f"| `{name}` | {med['real_time']:.3g} {unit} | {sd.get('real_time', 0):.2g} {unit} | {note} |")
     lines += [
         "",
@@ -69,7 +73,7 @@ def main(src, dst, startup_md=None):
         "method (`--refine none`): read, fit, sampling tables and EXR write add up to about 30 ms, and a batch uses",
         "both cores (`BM_BakeBatch`, materials_per_second). The default fit on the whole measurement (issue 10)",
         "adds the solves of `BM_FitRgl` (felt and metallic against the paper's fit of the same table; `BM_Bake`",
-        "bakes with it): the issue's 300 ms per material on one core is not met (where the time goes:",
+        "bakes with it; the issue's budget: 300 ms per material on one core; where the time goes:",
         "docs/extraction.md, \"Refinement\").",
         "",
         "Anisotropic extraction (issue 12): <= 100 ms and <= 50 MB at 90 x 128 (`BM_Extraction2D`); the reference",

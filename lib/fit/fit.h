@@ -25,8 +25,8 @@ namespace facetfit {
 // same options is baked again rather than served (lut/bake.h). Bump when the same input and options give
 // a different fit. 2: an RGL file's refinement reads its two one-sided estimates (fit/measurement.h);
 // 3: the parametric fits solved by fit/small_problem.h; 4: the refinement solved to convergence in two
-// passes, a UTIA file's isotropic fits on its own nodes.
-constexpr int kFitRevision = 4;
+// passes, a UTIA file's isotropic fits on its own nodes; 5: its anisotropic lobes on its node pairs.
+constexpr int kFitRevision = 5;
 
 struct FitOptions {
   int resolution = 90;  // intervals of the u grid; R + 1 nodes
@@ -57,8 +57,8 @@ std::optional<FitOptions::Refine> parse_refine(const std::string& name);
 struct AnisotropicFit {
   AnisotropicAlpha alpha_ggx, alpha_beckmann;  // moment estimates of the 2D NDF (fit/extract_2d.h)
   // Anisotropic GGX and Beckmann lobes with a body (fit/parametric_fit.h): with Refine::full, fitted on the
-  // source's half/difference lattice (MerlTable::source_half_diff) from the moment estimates and the
-  // isotropic fit's body and Fresnel; with Refine::none, or with no lattice, the moment estimates with the
+  // source's measured pairs or half/difference lattice (fit/measurement.h, anisotropic_bins) from the moment
+  // estimates and the isotropic fit's body and Fresnel; with Refine::none, or with neither, the moment estimates with the
   // paper's Fresnel at 0 and 82 degrees, no body (error 0: nothing measured).
   AnisotropicParametricFit ggx, beckmann;
   bool refined = false;

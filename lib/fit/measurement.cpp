@@ -57,10 +57,15 @@ void normalize_weights(MeasuredBins& bins, double total) {
 
 // A source's own nodes, one row each (rows only group bins: a node and its mirror (i, o swapped) share
 // their half/difference angles, and so do the pole's nodes).
-MeasuredBins sample_bins(const std::vector<MeasuredSample>& samples) {
+// One sample in `stride`, one row each. Picked by a hash of the index, not every stride-th: a source's
+// samples come in nested loops over its nodes (a UTIA file's 48 azimuths innermost), whose periods
+// every-stride-th would alias with (a stride of 24 would keep two azimuths of 48).
+MeasuredBins sample_bins(const std::vector<MeasuredSample>& samples, std::uint64_t stride = 1) {
   MeasuredBins bins;
   double total = 0.0;
-  for (const MeasuredSample& s : samples) {
+  for (std::size_t k = 0; k < samples.size(); ++k) {
+    if (stride > 1 && ((std::uint64_t(k) * 0x9E3779B97F4A7C15ull) >> 32) % stride != 0) continue;
+    const MeasuredSample& s = samples[k];
     const HalfDiff hd = to_half_diff(s.i, s.o);
     MeasuredBins::Row row{hd.theta_h, hd.theta_d, bins.size(), bins.size()};
     total += add_bin(bins, s.i, s.o, std::cos(hd.theta_h), std::cos(hd.theta_d), s.measure, s.f);
@@ -105,6 +110,11 @@ MeasuredBins measured_bins(const MerlTable& table, int stride_d, int stride_phi)
   }
   normalize_weights(bins, total);
   return bins;
+}
+
+MeasuredBins anisotropic_bins(const MerlTable& table, int stride) {
+  if (table.source_anisotropic_samples()) return sample_bins(*table.source_anisotropic_samples(), std::uint64_t(std::max(stride, 1)));
+  return measured_bins(table.source_half_diff(), stride);
 }
 
 MeasuredBins measured_bins(const HalfDiffLattice& lattice, int stride) {

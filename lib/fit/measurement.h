@@ -59,6 +59,11 @@ MeasuredBins measured_bins(const MerlTable& table, int stride_d, int stride_phi)
 // (theta_h, theta_d) pair of the lattice. Empty for an empty lattice.
 MeasuredBins measured_bins(const HalfDiffLattice& lattice, int stride);
 
+// What an anisotropic fit of the table's source reads: the pairs it was measured at
+// (MerlTable::source_anisotropic_samples: a UTIA file's, every `stride`-th) or else its lattice
+// (source_half_diff, as above). Empty when the source has neither.
+MeasuredBins anisotropic_bins(const MerlTable& table, int stride);
+
 // The bin sets of the fits: the tabulated lobe's refinement solves on the sparse one (6.4k bins: the
 // fitted distances move by < 1% between 93k bins and this), the parametric fits (8 to 12 unknowns) on
 // a sparser one (2.1k bins: their distances move by < 0.5% from the 6.4k set, at 40% of the time),

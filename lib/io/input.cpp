@@ -94,7 +94,7 @@ MerlTable table_of(const Brdf& source) {
     MerlTable table = MerlTable::tabulate(mean);
     table.set_source_samples(std::make_shared<const std::vector<MeasuredSample>>(mean.samples_at_first_azimuth()));
     table.set_source_backscatter(utia->backscatter());
-    table.set_source_half_diff(HalfDiffLattice::of(*utia));
+    table.set_source_anisotropic_samples(std::make_shared<const std::vector<MeasuredSample>>(utia->samples()));
     return table;
   }
   // Anisotropic RGL: the same, the lattice read through the file's evaluation (90 polar angles, 64 azimuths).

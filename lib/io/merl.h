@@ -95,6 +95,12 @@ class MerlTable final : public Brdf {
   // samples: set it last, or clear it).
   const std::shared_ptr<const std::vector<MeasuredSample>>& source_samples() const { return source_samples_; }
   void set_source_samples(std::shared_ptr<const std::vector<MeasuredSample>> samples) { source_samples_ = std::move(samples); }
+  // The same for an anisotropic source's every pair (a UTIA file's, over both azimuths): its anisotropic
+  // fits read them instead of source_half_diff, a resampling between them. Null for every other source.
+  const std::shared_ptr<const std::vector<MeasuredSample>>& source_anisotropic_samples() const { return source_anisotropic_samples_; }
+  void set_source_anisotropic_samples(std::shared_ptr<const std::vector<MeasuredSample>> samples) {
+    source_anisotropic_samples_ = std::move(samples);
+  }
 
  private:
   std::optional<Rgb> eval_nearest(double x_h, double x_d, double x_p) const;
@@ -124,7 +130,7 @@ class MerlTable final : public Brdf {
   BackscatterLattice source_backscatter_;
   HalfDiffLattice source_half_diff_;
   std::shared_ptr<const OneSidedMeasurement> source_one_sided_;
-  std::shared_ptr<const std::vector<MeasuredSample>> source_samples_;
+  std::shared_ptr<const std::vector<MeasuredSample>> source_samples_, source_anisotropic_samples_;
   Lookup lookup_ = Lookup::linear;
 };
 

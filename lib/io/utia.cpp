@@ -123,19 +123,35 @@ UtiaBrdf UtiaBrdf::azimuthal_mean() const {
   return UtiaBrdf(std::move(f));
 }
 
+namespace {
+
+// The cell of polar node t spans theta +- half a step (the pole's: a cap of half a step) and one azimuth
+// step; the pole's 48 nodes are one direction and share the cap.
+double node_solid_angle(int t) {
+  const double half = 0.5 * UtiaBrdf::kThetaStep * kPi / 180.0, theta = t * UtiaBrdf::kThetaStep * kPi / 180.0;
+  return (std::cos(std::max(theta - half, 0.0)) - std::cos(theta + half)) * (2.0 * kPi / UtiaBrdf::kPhi);
+}
+
+}  // namespace
+
 std::vector<MeasuredSample> UtiaBrdf::samples_at_first_azimuth() const {
-  // The cell of polar node t spans theta +- half a step (the pole's: a cap of half a step) and one
-  // azimuth step; the pole's 48 nodes are one direction and share the cap.
-  const auto solid_angle = [](int t) {
-    const double half = 0.5 * kThetaStep * kPi / 180.0, theta = t * kThetaStep * kPi / 180.0;
-    return (std::cos(std::max(theta - half, 0.0)) - std::cos(theta + half)) * (2.0 * kPi / kPhi);
-  };
   std::vector<MeasuredSample> samples;
   samples.reserve(std::size_t(kTheta) * kTheta * kPhi);
   for (int ti = 0; ti < kTheta; ++ti)
     for (int tv = 0; tv < kTheta; ++tv)
       for (int pv = 0; pv < kPhi; ++pv)
-        samples.push_back({node_direction(tv, pv), node_direction(ti, 0), node(ti, 0, tv, pv), solid_angle(ti) * solid_angle(tv)});
+        samples.push_back({node_direction(tv, pv), node_direction(ti, 0), node(ti, 0, tv, pv), node_solid_angle(ti) * node_solid_angle(tv)});
+  return samples;
+}
+
+std::vector<MeasuredSample> UtiaBrdf::samples() const {
+  std::vector<MeasuredSample> samples;
+  samples.reserve(kPerPlane);
+  for (int ti = 0; ti < kTheta; ++ti)
+    for (int pi = 0; pi < kPhi; ++pi)
+      for (int tv = 0; tv < kTheta; ++tv)
+        for (int pv = 0; pv < kPhi; ++pv)
+          samples.push_back({node_direction(tv, pv), node_direction(ti, pi), node(ti, pi, tv, pv), node_solid_angle(ti) * node_solid_angle(tv)});
   return samples;
 }
 

@@ -46,6 +46,8 @@ class UtiaBrdf final : public Brdf {
   // The nodes with phi_i = 0, each with the solid angles of the two nodes' cells (a polar cap at
   // theta = 0): every node an isotropic file (azimuthal_mean()) holds, up to a turn about the normal.
   std::vector<MeasuredSample> samples_at_first_azimuth() const;
+  // Every node pair (82,944), weighted the same way: what the file measured, for anisotropic fits.
+  std::vector<MeasuredSample> samples() const;
   // Writes the file through a temporary; throws Error naming the file.
   void write(const std::string& path) const;
 
