@@ -1,6 +1,7 @@
 // An anisotropic source's BRDF at nodes of the half/difference parameterization with the half vector's
 // azimuth kept: what the fits of its anisotropic representations measure themselves against
-// (fit/measurement.h). A MERL-layout table holds a BRDF's dependence on (theta_h, theta_d, phi_d) alone;
+// (fit/measurement.h; an anisotropic RGL file read through its evaluation: a UTIA file is fitted at its
+// own node pairs instead). A MERL-layout table holds a BRDF's dependence on (theta_h, theta_d, phi_d) alone;
 // an anisotropic material depends on phi_h as well.
 //
 // Nodes at cell centres: theta_h spaced as MERL's bins (theta_h = (pi/2) u^2, finer near the specular
