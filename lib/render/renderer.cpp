@@ -266,9 +266,12 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
     std::vector<Ray> rays;
     std::vector<Rgb> values;
     std::vector<char> blocked;
+    // Each pixel's coordinates once per tile, not two integer divisions per sample.
+    std::vector<int> xs(n), ys(n);
+    for (int k = 0; k < count; ++k) xs[std::size_t(k)] = tile.cols().begin() + k % tw, ys[std::size_t(k)] = tile.rows().begin() + k / tw;
     for (int s = first; s < last; ++s) {
       for (int k = 0; k < count; ++k) {
-        const int x = tile.cols().begin() + k % tw, y = tile.rows().begin() + k / tw;
+        const int x = xs[std::size_t(k)], y = ys[std::size_t(k)];
         double* u = numbers.data() + std::size_t(k) * 7;
         sample_numbers(x, y, s, u);
         cameras[std::size_t(k)] = camera_ray(x, y, u);
@@ -284,7 +287,7 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
       tracer.occluded(rays, blocked);
       for (int k = 0; k < count; ++k) {
         add_unblocked(blocked, values, owned[std::size_t(k)], owned[std::size_t(k) + 1], radiance[std::size_t(k)]);
-        accumulate(pixel_accum(tile.cols().begin() + k % tw, tile.rows().begin() + k / tw), radiance[std::size_t(k)],
+        accumulate(pixel_accum(xs[std::size_t(k)], ys[std::size_t(k)]), radiance[std::size_t(k)],
                    alpha[std::size_t(k)]);
       }
     }
