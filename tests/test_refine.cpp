@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <map>
 
 #include <ceres/cost_function.h>
 
@@ -328,7 +329,7 @@ TEST(RefineAnisotropic, BodyAndTurnedLobeFromTheLattice) {
   }
 }
 
-// Through the whole fit: a UTIA file (15-degree nodes, interpolated between them) of the same material.
+// Through the whole fit: a UTIA file (15-degree nodes) of the same material, fitted at its node pairs.
 TEST(RefineAnisotropic, ThroughAUtiaFile) {
   const Rgb albedo(0.4, 0.25, 0.1), f0(0.9, 0.6, 0.3);
   const auto lobe = std::make_shared<MicrofacetBrdf>(Ndf{NdfType::ggx, 0.45, 0.2}, Smith::correlated, Fresnel::schlick(f0));
@@ -368,6 +369,25 @@ TEST(RefineAnisotropic, ThroughAUtiaFile) {
   std::printf("[ utia resampled ] %.4f x %.4f, body %.4f %.4f %.4f\n", resampled.alpha.alpha_x, resampled.alpha.alpha_y,
               resampled.body.r, resampled.body.g, resampled.body.b);
   EXPECT_GT(std::abs(resampled.alpha.alpha_y - 0.2), 10.0 * std::abs(a.ggx.alpha.alpha_y - 0.2));
+
+  // The solve's one pair in 24 covers the file: every off-pole view and light direction (5 polar angles x
+  // 48 azimuths each) is in it, each a few times (the measurement.cpp comment says why not every 24th).
+  const MeasuredBins solve = anisotropic_bins(load_table(file.string()), 24);
+  std::map<std::pair<int, int>, int> views, lights;
+  const auto node = [](const Vec3& w) {
+    const int t = int(std::lround(std::acos(std::min(w.z, 1.0)) * 180.0 / kPi / 15.0));
+    return std::pair<int, int>(t, int(std::lround(std::atan2(w.y, w.x) * 180.0 / kPi / 7.5) + 48) % 48);
+  };
+  for (std::size_t k = 0; k < solve.size(); ++k) {
+    const auto v = node(solve.o[k]), l = node(solve.i[k]);
+    if (v.first > 0) ++views[v];
+    if (l.first > 0) ++lights[l];
+  }
+  EXPECT_NEAR(double(solve.size()), 82944.0 / 24.0, 0.05 * 82944.0 / 24.0);
+  EXPECT_EQ(views.size(), 240u);
+  EXPECT_EQ(lights.size(), 240u);
+  for (const auto* seen : {&views, &lights})
+    for (const auto& [direction, count] : *seen) EXPECT_GE(count, 3) << direction.first << " " << direction.second;
 }
 
 }  // namespace

@@ -60,8 +60,9 @@ MeasuredBins measured_bins(const MerlTable& table, int stride_d, int stride_phi)
 MeasuredBins measured_bins(const HalfDiffLattice& lattice, int stride);
 
 // What an anisotropic fit of the table's source reads: the pairs it was measured at
-// (MerlTable::source_anisotropic_samples: a UTIA file's, every `stride`-th) or else its lattice
-// (source_half_diff, as above). Empty when the source has neither.
+// (MerlTable::source_anisotropic_samples: a UTIA file's, one in `stride` spread over them by a hash of
+// the index) or else its lattice (source_half_diff, every `stride`-th as above). Empty when the source
+// has neither.
 MeasuredBins anisotropic_bins(const MerlTable& table, int stride);
 
 // The bin sets of the fits: the tabulated lobe's refinement solves on the sparse one (6.4k bins: the

@@ -42,7 +42,8 @@ double parametric_jacobian_error(const MeasuredBins& bins, Smith smith, const Pa
 // The fit's distance from the measurement (measurement_error of its BRDF).
 double parametric_error(const MeasuredBins& bins, Smith smith, const ParametricFit& fit);
 
-// An anisotropic lobe with a body, fitted on an anisotropic source's lattice (io/half_diff_lattice.h):
+// An anisotropic lobe with a body, fitted on an anisotropic source's measured pairs or lattice
+// (fit/measurement.h, anisotropic_bins; io/half_diff_lattice.h):
 //   f(o, i) = body / pi + F(theta_d) D(h') G2(o', i') / (4 cos theta_i cos theta_o),
 // primes the directions in the frame whose x axis lies at `alpha.angle`, D the family's (alpha_x, alpha_y)
 // distribution, F the F82-tint model (the form an anisotropic closure takes).

@@ -38,8 +38,9 @@ struct Ndf {
   double D(const Vec3& h) const {
     if (h.z <= 0.0) return 0.0;
     if (type == NdfType::ggx) {
-      // slope_pdf / cos^4 with the slopes multiplied out, for a unit h: one division instead of four,
-      // 1 / (pi ax ay (hx^2 / ax^2 + hy^2 / ay^2 + hz^2)^2) = ax^3 ay^3 / (pi e^2).
+      // slope_pdf / cos^4 with the slopes multiplied out: one division instead of four,
+      // 1 / (pi ax ay (hx^2 / ax^2 + hy^2 / ay^2 + hz^2)^2) = ax^3 ay^3 / (pi e^2) (both homogeneous of
+      // degree -4 in h; this one stays finite where hz^4 underflows).
       const double ax2 = alpha_x * alpha_x, ay2 = alpha_y * alpha_y;
       const double e = h.x * h.x * ay2 + h.y * h.y * ax2 + h.z * h.z * ax2 * ay2;
       return ax2 * alpha_x * ay2 * alpha_y / (kPi * e * e);
