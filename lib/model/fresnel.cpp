@@ -55,7 +55,7 @@ double f82_basis(double mu) {
 
 }  // namespace
 
-F82Tint::F82Tint(const Rgb& f0_, const Rgb& f82) : f0(f0_) {
+F82Tint::F82Tint(const Rgb& normal_incidence, const Rgb& f82) : f0(normal_incidence) {
   constexpr double mu82 = 1.0 / 7.0;
   a = (fresnel_schlick(f0, mu82) - f82) / f82_basis(mu82);
 }
