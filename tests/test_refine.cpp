@@ -338,7 +338,8 @@ TEST(RefineAnisotropic, ThroughAUtiaFile) {
   UtiaBrdf::tabulate(RotatedBrdf(material, 0.6)).write(file.string());
   FitOptions options;
   options.refine = FitOptions::Refine::full;
-  const FitResult r = Fitter(options).fit(load_table(file.string()));
+  const MerlTable table = load_table(file.string());
+  const FitResult r = Fitter(options).fit(table);
   ASSERT_TRUE(r.ok() && r.anisotropic) << r.problem;
   const AnisotropicFit& a = *r.anisotropic;
   ASSERT_TRUE(a.refined);
@@ -352,7 +353,7 @@ TEST(RefineAnisotropic, ThroughAUtiaFile) {
   // it returns the material, to issue 10's ground-truth bars.
   AnisotropicParametricFit moments = a.ggx;
   moments.alpha = a.alpha_ggx;
-  const MeasuredBins all = anisotropic_bins(load_table(file.string()), 1);
+  const MeasuredBins all = anisotropic_bins(table, 1);
   EXPECT_LT(a.ggx.error, 0.5 * parametric_error(all, Smith::correlated, moments));
   EXPECT_NEAR(a.ggx.alpha.alpha_x, 0.45, 0.01 * 0.45);
   EXPECT_NEAR(a.ggx.alpha.alpha_y, 0.2, 0.01 * 0.2);
@@ -372,7 +373,7 @@ TEST(RefineAnisotropic, ThroughAUtiaFile) {
 
   // The solve's one pair in 24 covers the file: every off-pole view and light direction (5 polar angles x
   // 48 azimuths each) is in it, each a few times (the measurement.cpp comment says why not every 24th).
-  const MeasuredBins solve = anisotropic_bins(load_table(file.string()), 24);
+  const MeasuredBins solve = anisotropic_bins(table, 24);
   std::map<std::pair<int, int>, int> views, lights;
   const auto node = [](const Vec3& w) {
     const int t = int(std::lround(std::acos(std::min(w.z, 1.0)) * 180.0 / kPi / 15.0));

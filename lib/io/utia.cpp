@@ -132,6 +132,11 @@ double node_solid_angle(int t) {
   return (std::cos(std::max(theta - half, 0.0)) - std::cos(theta + half)) * (2.0 * kPi / UtiaBrdf::kPhi);
 }
 
+// Node pair (ti, pi, tv, pv) as a measurement, weighted by its two cells' solid angles.
+MeasuredSample node_sample(const UtiaBrdf& file, int ti, int pi, int tv, int pv) {
+  return {node_direction(tv, pv), node_direction(ti, pi), file.node(ti, pi, tv, pv), node_solid_angle(ti) * node_solid_angle(tv)};
+}
+
 }  // namespace
 
 std::vector<MeasuredSample> UtiaBrdf::samples_at_first_azimuth() const {
@@ -140,7 +145,7 @@ std::vector<MeasuredSample> UtiaBrdf::samples_at_first_azimuth() const {
   for (int ti = 0; ti < kTheta; ++ti)
     for (int tv = 0; tv < kTheta; ++tv)
       for (int pv = 0; pv < kPhi; ++pv)
-        samples.push_back({node_direction(tv, pv), node_direction(ti, 0), node(ti, 0, tv, pv), node_solid_angle(ti) * node_solid_angle(tv)});
+        samples.push_back(node_sample(*this, ti, 0, tv, pv));
   return samples;
 }
 
@@ -151,7 +156,7 @@ std::vector<MeasuredSample> UtiaBrdf::samples() const {
     for (int pi = 0; pi < kPhi; ++pi)
       for (int tv = 0; tv < kTheta; ++tv)
         for (int pv = 0; pv < kPhi; ++pv)
-          samples.push_back({node_direction(tv, pv), node_direction(ti, pi), node(ti, pi, tv, pv), node_solid_angle(ti) * node_solid_angle(tv)});
+          samples.push_back(node_sample(*this, ti, pi, tv, pv));
   return samples;
 }
 
