@@ -242,7 +242,8 @@ def main(facetfit, mitsuba_python, dst, rgl=None):
         for name, one, all_ in scaling:
             out.write("| %s | %.3f s | %.3f s | %.2f |\n" % (name, one, all_, one / all_))
         out.write("\n## Start-up\n\nA process that loads the render command and exits at once (`facetfit render --help`), median of %d: "
-                  "%.3f s; the command plugin and the shared libraries it needs: %d (OpenImageIO brings most of them), "
+                  "%.3f s; the command plugin and the shared libraries it needs: %d (OpenImageIO, ~260 more, is a module of its own, "
+                  "loaded only for images other than OpenEXR: io/image_file.h), "
                   "whose symbol lookups by the dynamic loader take %s of that time (`perf record`). A render's process time "
                   "is its render time plus this.\n" % (RUNS, startup[0], startup[1], startup[2]))
         out.write("\n## Where the time goes\n\n`perf record` of one facetfit render (64 spp, whole process), self time by\n"

@@ -6,6 +6,7 @@ usage: startup.py FACETFIT OUT.md [RUNS]
 Each command runs RUNS times under /usr/bin/time; the table gives the median wall time (by the clock,
 around the whole run) and the median of the peak resident set sizes. The MERL file is written by facetfit itself (builtin:red-plastic).
 """
+import json
 import os
 import statistics
 import subprocess
@@ -31,11 +32,25 @@ def main(facetfit, dst, runs=10):
     with tempfile.TemporaryDirectory() as tmp:
         merl = os.path.join(tmp, "red-plastic.binary")
         subprocess.run([facetfit, "convert", "builtin:red-plastic", "-o", merl], check=True, stdout=subprocess.DEVNULL)
+        subprocess.run([facetfit, "-q", "bake", "builtin:red-plastic", "-o", tmp], check=True, stdout=subprocess.DEVNULL)
+        lut = os.path.join(tmp, "red-plastic.exr")
+        # bench/render_compare.py's scene (GGX 0.3 sphere, constant environment, one light) at 8 x 8, 1 spp.
+        scene = os.path.join(tmp, "scene.json")
+        with open(scene, "w") as f:
+            json.dump({"camera": {"position": [0, 0.6, 4], "look_at": [0, 0, 0], "up": [0, 1, 0], "fov": 30, "width": 8, "height": 8},
+                       "render": {"spp": 1, "seed": 1}, "environment": {"constant": [0.3, 0.3, 0.3]},
+                       "lights": [{"type": "directional", "direction": [0.3, 1, 0.5], "irradiance": [3, 3, 3]}],
+                       "materials": {"m": {"type": "ggx", "alpha": 0.3, "f0": [1, 1, 1], "f82": [1, 1, 1], "smith": "separable"}},
+                       "objects": [{"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "m"}]}, f)
+        render = [facetfit, "-q", "render", scene, "-o", os.path.join(tmp, "x.exr")]
         cases = [
             ("`facetfit fit FILE --refine none` (the paper's method: the reference program's job)", [facetfit, "fit", merl, "--refine", "none"]),
             ("`facetfit fit FILE` (default: refinement and parametric fits)", [facetfit, "fit", merl]),
             ("`facetfit --version`", [facetfit, "--version"]),
-            ("`facetfit bake --help` (loads the command plugin: OpenImageIO, OpenColorIO, Embree)", [facetfit, "bake", "--help"]),
+            ("`facetfit bake --help` (loads the command plugin: OpenEXR, OpenColorIO, Embree)", [facetfit, "bake", "--help"]),
+            ("`facetfit info LUT.exr` (the plugin; the LUT through OpenEXR)", [facetfit, "info", lut]),
+            ("`facetfit render SCENE -o X.exr`: bench/render_compare.py's GGX sphere at 8 x 8, 1 spp (start-up alone)", render),
+            ("the same render `--png X.png` (also loads facetfit-oiio.so: OpenImageIO)", render + ["--png", os.path.join(tmp, "x.png")]),
         ]
         lines = ["| command | wall (median) | peak memory (median) |", "|---|---|---|"]
         for what, cmd in cases:

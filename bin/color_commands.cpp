@@ -1,6 +1,5 @@
 // facetfit deltae : CIEDE2000 of Lab pairs read on stdin.
 // facetfit diff A.exr B.exr : mean and max ΔE00 between two renders through the display chain, and a heatmap.
-#include <OpenImageIO/imageio.h>
 
 #include <algorithm>
 #include <array>
@@ -62,27 +61,27 @@ struct Image {
 std::string size_text(int width, int height) { return std::to_string(width) + " x " + std::to_string(height); }
 
 // Every channel of the first subimage as float, with its spec.
-std::vector<float> read_all(const std::string& path, OIIO::ImageSpec& spec) {
-  auto in = open_image(path);
-  spec = in->spec();
-  return read_pixels(*in, path);
+std::vector<float> read_all(const std::string& path, ImageSpec& spec) {
+  ImageReader in = ImageReader::open(path);
+  spec = in.spec();
+  return in.read_pixels();
 }
 
 // Channels by name, never by position: EXR stores them sorted by name (A, B, G, R).
 Image read_image(const std::string& path) {
-  OIIO::ImageSpec spec;
+  ImageSpec spec;
   const std::vector<float> all = read_all(path, spec);
-  const int a = spec.channelindex("A");
+  const int a = spec.channel_index("A");
   Image image;
   image.width = spec.width;
   image.height = spec.height;
-  // OIIO reports 8- and 16-bit PNG, JPEG and the like as "sRGB": their values are already display
-  // code values and skip the display transform. Everything else (EXR: "Linear") is scene-linear.
-  image.display_referred = spec.get_string_attribute("oiio:ColorSpace") == "sRGB";
+  // 8- and 16-bit PNG, JPEG and the like hold display code values already and skip the display
+  // transform. Everything else (EXR) is scene-linear.
+  image.display_referred = spec.display_referred;
   // A NaN or infinite pixel has no colour difference: refused, not averaged into a score.
   image.rgb = rgb_of(all, spec, path, OneChannel::refused);
   if (a >= 0) {
-    const std::size_t n = image.pixels(), nch = std::size_t(spec.nchannels);
+    const std::size_t n = image.pixels(), nch = spec.channels.size();
     image.alpha.resize(n);
     for (std::size_t p = 0; p < n; ++p) image.alpha[p] = all[p * nch + std::size_t(a)];
   }
@@ -91,12 +90,12 @@ Image read_image(const std::string& path) {
 
 // The --mask image: a pixel counts where its first channel is > 0.5.
 std::vector<bool> read_mask(const std::string& path, int width, int height) {
-  OIIO::ImageSpec spec;
+  ImageSpec spec;
   const std::vector<float> all = read_all(path, spec);
   if (spec.width != width || spec.height != height)
     fail(path, "mask is " + size_text(spec.width, spec.height) + ", the images are " + size_text(width, height));
   std::vector<bool> mask(std::size_t(width) * std::size_t(height));
-  for (std::size_t p = 0; p < mask.size(); ++p) mask[p] = all[p * std::size_t(spec.nchannels)] > 0.5f;
+  for (std::size_t p = 0; p < mask.size(); ++p) mask[p] = all[p * spec.channels.size()] > 0.5f;
   return mask;
 }
 

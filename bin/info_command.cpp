@@ -100,7 +100,7 @@ void add_info_command(CLI::App& app, Context& ctx) {
   cmd->add_flag("--json", *json, "As one JSON object");
   cmd->callback([path, json, &ctx] {
     try {
-      // A measurement named where a LUT is expected: say what to run instead of OpenImageIO's complaint.
+      // A measurement named where a LUT is expected: say what to run instead of the image reader's complaint.
       const std::string ext = std::filesystem::path(*path).extension().string();
       if (is_builtin(*path) || ext == ".binary" || ext == ".bsdf")
         throw Error(*path + ": a measurement, not a LUT: `facetfit fit` it, or `facetfit bake` it and run info on the LUT");

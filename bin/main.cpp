@@ -2,8 +2,8 @@
 //
 // The commands that only read measurements and fit (fit, convert, list-builtins) run in this executable, which
 // links the core library alone, and so does --version. Every other command (bake, info, render, diff,
-// deltae, report) and the help listing them all run in the plugin facetfit-commands.so, loaded on demand: it brings OpenImageIO, OpenColorIO
-// and Embree, whose loading costs more than a fit (docs/benchmarks.md, "Start-up").
+// deltae, report) and the help listing them all run in the plugin facetfit-commands.so, loaded on demand: it brings OpenEXR, OpenColorIO
+// and Embree (OpenImageIO only in facetfit-oiio.so, for images other than EXR: io/image_file.h).
 #include <dlfcn.h>
 #include <unistd.h>
 

@@ -17,7 +17,8 @@ find_path(FFTW3_INCLUDE_DIR fftw3.h REQUIRED)
 find_library(FFTW3_LIBRARY fftw3 REQUIRED)
 find_package(OpenSSL REQUIRED)  # SHA-256 of sources (LUT metadata, bake cache)
 find_package(Imath CONFIG REQUIRED)
-find_package(OpenImageIO CONFIG REQUIRED)
+find_package(OpenEXR CONFIG REQUIRED)  # LUTs, renders and environment maps, read and written directly
+find_package(OpenImageIO CONFIG REQUIRED)  # every other image format, in the module facetfit-oiio.so
 find_package(embree 3 CONFIG REQUIRED)
 # Debian installs OpenColorIO's CMake config under /usr/share/cmake.
 find_package(OpenColorIO CONFIG REQUIRED PATHS /usr/share/cmake)

@@ -1,4 +1,4 @@
-// Environment maps (any format OpenImageIO reads), under a 256 MiB memory budget, then a sample.
+// Environment maps (EXR through OpenEXR, any other format through OpenImageIO), under a 256 MiB memory budget, then a sample.
 #include "fuzz_input.h"
 #include "render/environment.h"
 

@@ -1,4 +1,4 @@
-// LUT textures (OpenEXR through OpenImageIO, then facetfit's metadata and table checks), then an
+// LUT textures (OpenEXR, then facetfit's metadata and table checks), then an
 // evaluation and a sample of the model it accepted.
 #include "core/vec.h"
 #include "fuzz_input.h"

@@ -1,7 +1,5 @@
 // write_seeds OUT: the seeds of fuzz_lut and fuzz_env that only the library can write: LUTs of a
 // built-in material (with and without sampling tables), and small environment maps (EXR, HDR).
-#include <OpenImageIO/imageio.h>
-
 #include <cstdio>
 #include <filesystem>
 #include <string>
@@ -28,7 +26,7 @@ int main(int argc, char** argv) {
     write_lut((out / "lut" / (sampling ? "gold.exr" : "gold-eval-only.exr")).string(),
               make_lut(fit, fitter.quadrature(), "builtin:gold-ggx-0.15", "seed", 0.02, sampling));
   const Environment sky = Environment::sky(16);
-  const OIIO::ImageSpec spec(sky.width(), sky.height(), 3, OIIO::TypeDesc::FLOAT);
+  const ImageSpec spec(sky.width(), sky.height(), {"R", "G", "B"});
   for (const char* name : {"sky.exr", "sky.hdr"}) write_image_atomic((out / "env" / name).string(), spec, sky.pixels().data());
   return 0;
 }

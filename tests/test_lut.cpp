@@ -182,6 +182,46 @@ TEST(Lut, AnisotropicLobeRoundTrip) {
             std::string::npos);
 }
 
+// LUTs are written and read through OpenEXR itself (io/image_file.h); OpenImageIO, an independent reader
+// and writer, must see the same file: the same pixels and attributes of the same types, and a LUT it
+// writes back must read as the same LUT.
+TEST(Lut, OpenImageIoReadsAndWritesTheSameFile) {
+  TempDir dir;
+  const Baked b = fit_of(MicrofacetBrdf(Ndf::isotropic(NdfType::ggx, 0.2), Smith::correlated, Fresnel::schlick(Rgb(0.9, 0.6, 0.3))));
+  Lut lut = make_lut(b.fit, b.fitter.quadrature(), "x", "", 0.02, true);
+  lut.meta.warnings = {"first warning", "second warning"};
+  write_lut(dir.file("ours.exr"), lut);
+  const Lut ours = read_lut(dir.file("ours.exr"));
+
+  auto in = OIIO::ImageInput::open(dir.file("ours.exr"));
+  ASSERT_TRUE(in) << OIIO::geterror();
+  const OIIO::ImageSpec spec = in->spec();
+  EXPECT_EQ(spec.channelnames, (std::vector<std::string>{"R", "G", "B"}));
+  EXPECT_EQ(spec.get_int_attribute("facetfit:format_version", -1), ours.meta.format_version);
+  EXPECT_EQ(spec.get_string_attribute("facetfit:smith"), "correlated");
+  EXPECT_EQ(spec.get_string_attribute("facetfit:warnings"), "first warning\nsecond warning");
+  EXPECT_FLOAT_EQ(spec.get_float_attribute("facetfit:ggx_alpha"), float(ours.meta.ggx.alpha));
+  const OIIO::ParamValue* f0 = spec.find_attribute("facetfit:f0");
+  ASSERT_TRUE(f0 && f0->type().basetype == OIIO::TypeDesc::FLOAT && f0->type().basevalues() == 3);
+  for (int c = 0; c < 3; ++c) EXPECT_FLOAT_EQ(static_cast<const float*>(f0->data())[c], float(ours.meta.f0[c]));
+  std::vector<float> px(std::size_t(spec.width) * std::size_t(spec.height) * std::size_t(spec.nchannels));
+  ASSERT_TRUE(in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, px.data()));
+  EXPECT_FLOAT_EQ(px[0], float(ours.tables.ndf.ndf[0]));  // row 0, column 0: D at theta_h = 0
+
+  auto out = OIIO::ImageOutput::create(dir.file("theirs.exr"));
+  ASSERT_TRUE(out->open(dir.file("theirs.exr"), spec) && out->write_image(OIIO::TypeDesc::FLOAT, px.data()) && out->close());
+  const Lut theirs = read_lut(dir.file("theirs.exr"));
+  EXPECT_EQ(theirs.meta.warnings, ours.meta.warnings);
+  EXPECT_EQ(theirs.meta.smith, ours.meta.smith);
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_EQ(theirs.meta.f0[c], ours.meta.f0[c]);
+    EXPECT_EQ(theirs.meta.ggx.body[c], ours.meta.ggx.body[c]);
+  }
+  EXPECT_EQ(theirs.tables.ndf.ndf, ours.tables.ndf.ndf);
+  EXPECT_EQ(theirs.tables.ndf.sigma, ours.tables.ndf.sigma);
+  EXPECT_EQ(theirs.sampling.cdf, ours.sampling.cdf);
+}
+
 TEST(Lut, BadFilesGetOneClearLine) {
   TempDir dir;
   test::write_bytes(dir.file("garbage.exr"), "not an image at all");

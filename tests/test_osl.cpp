@@ -65,13 +65,12 @@ struct Image {
 };
 
 Image read_image(const std::string& path) {
-  auto in = open_image(path);
+  ImageReader in = ImageReader::open(path);
   Image img;
-  img.width = in->spec().width;
-  img.height = in->spec().height;
-  img.channels = in->spec().nchannels;
-  img.pixels.resize(std::size_t(img.width) * std::size_t(img.height) * std::size_t(img.channels));
-  if (!in->read_image(0, 0, 0, img.channels, OIIO::TypeDesc::FLOAT, img.pixels.data())) throw Error(path + ": cannot read");
+  img.width = in.spec().width;
+  img.height = in.spec().height;
+  img.channels = int(in.spec().channels.size());
+  img.pixels = in.read_pixels();
   return img;
 }
 
@@ -79,7 +78,7 @@ Image read_image(const std::string& path) {
 void write_vectors(const std::string& path, int size, const std::vector<Vec3>& v) {
   std::vector<float> rgb;
   for (const Vec3& d : v) rgb.insert(rgb.end(), {float(d.x), float(d.y), float(d.z)});
-  write_image_atomic(path, OIIO::ImageSpec(size, size, 3, OIIO::TypeDesc::FLOAT), rgb.data());
+  write_image_atomic(path, ImageSpec(size, size, {"R", "G", "B"}), rgb.data());
 }
 
 Vec3 as_float(const Vec3& v) { return {double(float(v.x)), double(float(v.y)), double(float(v.z))}; }
@@ -462,7 +461,7 @@ void write_test_environment(const std::string& path) {
       c += Rgb(6.0, 4.5, 2.5) * lobe(d, {1.0, 0.7, 0.6}, 24.0) + Rgb(0.8, 1.4, 2.2) * lobe(d, {-1.0, 0.2, -0.4}, 8.0);
       rgb.insert(rgb.end(), {float(c.r), float(c.g), float(c.b)});
     }
-  write_image_atomic(path, OIIO::ImageSpec(kWidth, kHeight, 3, OIIO::TypeDesc::FLOAT), rgb.data());
+  write_image_atomic(path, ImageSpec(kWidth, kHeight, {"R", "G", "B"}), rgb.data());
 }
 
 // Where pictures and figures go (make osl-docs), or "" in a plain test run.
@@ -615,7 +614,7 @@ std::string write_roughness_texture(const TempDir& dir) {
                            float(std::exp(-0.7 * std::cos(2.0 * kPi * u) * band * band)), 0.0f});
     }
   const std::string path = dir.file("roughness.exr");
-  write_image_atomic(path, OIIO::ImageSpec(kWidth, kHeight, 3, OIIO::TypeDesc::FLOAT), px.data());
+  write_image_atomic(path, ImageSpec(kWidth, kHeight, {"R", "G", "B"}), px.data());
   return path;
 }
 

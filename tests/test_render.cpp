@@ -34,7 +34,7 @@ void write_texture(const std::string& path, int width, int height, const std::fu
       const Rgb v = value(x, y);
       px.insert(px.end(), {float(v.r), float(v.g), float(v.b)});
     }
-  write_image_atomic(path, OIIO::ImageSpec(width, height, 3, OIIO::TypeDesc::FLOAT), px.data());
+  write_image_atomic(path, ImageSpec(width, height, {"R", "G", "B"}), px.data());
 }
 
 // A sphere of `m` filling most of a small image, under a uniform environment of radiance 1.

@@ -1,6 +1,5 @@
 #include "color/image_diff.h"
 
-#include <OpenImageIO/imageio.h>
 
 #include <algorithm>
 #include <cmath>
@@ -57,9 +56,8 @@ constexpr std::uint8_t kViridis[256][3] = {
 
 // An 8-bit RGB image to `path` through a temporary file.
 void write_png8(const std::string& path, int width, int height, const std::vector<std::uint8_t>& pixels) {
-  OIIO::ImageSpec spec(width, height, 3, OIIO::TypeDesc::UINT8);
-  spec.channelnames = {"R", "G", "B"};
-  spec.attribute("oiio:ColorSpace", "sRGB");
+  ImageSpec spec(width, height, {"R", "G", "B"}, ImageSpec::Format::uint8);
+  spec.display_referred = true;
   write_image_atomic(path, spec, pixels.data());
 }
 

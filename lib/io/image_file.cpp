@@ -1,5 +1,17 @@
 #include "io/image_file.h"
 
+#include <OpenEXR/ImfChannelList.h>
+#include <OpenEXR/ImfFrameBuffer.h>
+#include <OpenEXR/ImfHeader.h>
+#include <OpenEXR/ImfInputFile.h>
+#include <OpenEXR/ImfFloatAttribute.h>
+#include <OpenEXR/ImfIntAttribute.h>
+#include <OpenEXR/ImfOutputFile.h>
+#include <OpenEXR/ImfPartType.h>
+#include <OpenEXR/ImfStringAttribute.h>
+#include <OpenEXR/ImfVecAttribute.h>
+#include <dlfcn.h>
+
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
@@ -48,13 +60,14 @@ bool string_vector_fits(const std::vector<char>& v) {
 // OpenEXR 3.1 allocates what a header claims before reading it: a 6 KB file whose string attribute
 // claims 1.6 GB took 1.7 GB (found by fuzz_lut). The headers are walked here first, and every attribute
 // must fit in the file, as must the chunk offset table the data window implies (8 bytes per chunk).
-void check_exr_header(const std::string& path) {
+// Returns whether the file is an OpenEXR file (by its magic number).
+bool check_exr_header(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   std::error_code ec;
   const std::uint64_t file_size = std::filesystem::file_size(path, ec);
   unsigned char magic[8];
-  if (!in || ec || !in.read(reinterpret_cast<char*>(magic), 8)) return;  // OpenImageIO says why
-  if (!(magic[0] == 0x76 && magic[1] == 0x2f && magic[2] == 0x31 && magic[3] == 0x01)) return;  // not OpenEXR
+  if (!in || ec || !in.read(reinterpret_cast<char*>(magic), 8)) return false;  // OpenImageIO says why
+  if (!(magic[0] == 0x76 && magic[1] == 0x2f && magic[2] == 0x31 && magic[3] == 0x01)) return false;  // not OpenEXR
   const bool multipart = (magic[5] & 0x10) != 0, tiled = (magic[5] & 0x02) != 0;
   // OpenEXR reads at most 31 characters of a name (255 with the long-names flag) and the values of the
   // types it knows by their own size, whatever size the header states: a header that disagrees is parsed
@@ -120,7 +133,7 @@ void check_exr_header(const std::string& path) {
     }
     if (!multipart) break;
   }
-  if (multipart || !has_window) return;  // OpenImageIO refuses a header without a data window
+  if (multipart || !has_window) return true;  // OpenEXR refuses a header without a data window
   const std::int64_t width = std::int64_t(window[2]) - window[0] + 1, height = std::int64_t(window[3]) - window[1] + 1;
   if (width < 1 || height < 1) fail(path, "OpenEXR header: empty data window");
   // OpenEXR sizes its line buffers by the width as it opens the file: nothing facetfit reads is wider or
@@ -141,50 +154,212 @@ void check_exr_header(const std::string& path) {
   if (chunks > (file_size - header_end) / 8)
     fail(path, "OpenEXR header: a " + std::to_string(width) + " x " + std::to_string(height) + " image needs " +
                    std::to_string(chunks) + " chunks, more than the file's " + std::to_string(file_size) + " bytes can hold");
+  return true;
+}
+
+
+// ---- OpenEXR ----------------------------------------------------------------------------------------------
+
+// The spec of an open OpenEXR file: R, G, B, A first (as OpenImageIO orders them), then the others in the
+// file's (sorted) order; the int, float, string and v3f attributes.
+ImageSpec exr_spec(const Imf::Header& header) {
+  ImageSpec spec;
+  const Imath::Box2i window = header.dataWindow();
+  spec.width = window.max.x - window.min.x + 1;
+  spec.height = window.max.y - window.min.y + 1;
+  for (const char* name : {"R", "G", "B", "A"})
+    if (header.channels().findChannel(name)) spec.channels.push_back(name);
+  for (auto c = header.channels().begin(); c != header.channels().end(); ++c)
+    if (std::find(spec.channels.begin(), spec.channels.end(), c.name()) == spec.channels.end()) spec.channels.push_back(c.name());
+  for (auto a = header.begin(); a != header.end(); ++a) {
+    if (const auto* i = dynamic_cast<const Imf::IntAttribute*>(&a.attribute())) spec.set(a.name(), i->value());
+    else if (const auto* f = dynamic_cast<const Imf::FloatAttribute*>(&a.attribute())) spec.set(a.name(), f->value());
+    else if (const auto* t = dynamic_cast<const Imf::StringAttribute*>(&a.attribute())) spec.set(a.name(), t->value());
+    else if (const auto* v = dynamic_cast<const Imf::V3fAttribute*>(&a.attribute()))
+      spec.set(a.name(), std::array<float, 3>{v->value().x, v->value().y, v->value().z});
+  }
+  return spec;
+}
+
+// One slice per channel of `spec`, interleaved floats in `pixels`, placed by the data window.
+Imf::FrameBuffer exr_frame_buffer(const ImageSpec& spec, const Imath::Box2i& window, Imf::PixelType type, char* pixels) {
+  const std::size_t size = type == Imf::FLOAT ? sizeof(float) : 1, stride = size * spec.channels.size();
+  Imf::FrameBuffer frame;
+  for (std::size_t c = 0; c < spec.channels.size(); ++c)
+    frame.insert(spec.channels[c], Imf::Slice::Make(type, pixels + c * size, window, stride, stride * std::size_t(spec.width)));
+  return frame;
+}
+
+// Where formats other than OpenEXR are read and written: facetfit-oiio.so, found beside the object this
+// code is linked into (the command's plugin, a Python extension), in ../lib/facetfit from it (an
+// installed executable), or in the build tree. Loaded once per process, on first use, and kept.
+struct LoadedCodec {
+  const ImageCodec* codec = nullptr;
+  std::string error;
+};
+
+LoadedCodec load_codec() {
+  namespace fs = std::filesystem;
+  std::vector<fs::path> candidates;
+  Dl_info self{};
+  if (::dladdr(reinterpret_cast<void*>(&load_codec), &self) != 0 && self.dli_fname) {
+    std::error_code ec;
+    const fs::path here = fs::canonical(self.dli_fname, ec).parent_path();
+    if (!ec) candidates.insert(candidates.end(), {here / "facetfit-oiio.so", here.parent_path() / "lib" / "facetfit" / "facetfit-oiio.so"});
+  }
+#ifdef FACETFIT_MODULE_DIRS
+  for (const char* dir : {FACETFIT_MODULE_DIRS}) candidates.push_back(fs::path(dir) / "facetfit-oiio.so");
+#endif
+  std::string looked;
+  for (const fs::path& path : candidates) {
+    looked += (looked.empty() ? "" : ", ") + path.parent_path().string();
+    if (!fs::exists(path)) continue;
+    void* module = ::dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
+    if (!module) return {nullptr, "cannot load " + path.string() + ": " + first_line(::dlerror())};
+    using Entry = const ImageCodec* (*)();
+    const auto entry = reinterpret_cast<Entry>(::dlsym(module, "facetfit_image_codec"));
+    const ImageCodec* codec = entry ? entry() : nullptr;
+    if (!codec || codec->version != ImageCodec::kVersion) return {nullptr, path.string() + " is not this facetfit's image module"};
+    return {codec, ""};
+  }
+  return {nullptr, "images other than OpenEXR need the module facetfit-oiio.so (OpenImageIO), not found in " + looked};
+}
+
+const ImageCodec& other_formats(const std::string& path) {
+  static const LoadedCodec loaded = load_codec();  // a module, like the libraries it brings, is loaded once
+  if (!loaded.codec) fail(path, loaded.error);
+  return *loaded.codec;
+}
+
+bool has_exr_extension(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char ch) { return char(std::tolower(ch)); });
+  return ext == ".exr";
+}
+
+void write_exr_file(const std::string& path, const std::string& target, const ImageSpec& spec, const void* pixels) {
+  if (spec.format != ImageSpec::Format::float32) fail(target, "cannot write: OpenEXR files are written from float pixels");
+  Imf::Header header(spec.width, spec.height);
+  header.compression() = Imf::ZIP_COMPRESSION;
+  for (const std::string& name : spec.channels) header.channels().insert(name, Imf::Channel(Imf::FLOAT));
+  for (const auto& [name, value] : spec.attributes) {
+    if (const int* i = std::get_if<int>(&value)) header.insert(name, Imf::IntAttribute(*i));
+    else if (const float* f = std::get_if<float>(&value)) header.insert(name, Imf::FloatAttribute(*f));
+    else if (const std::string* t = std::get_if<std::string>(&value)) header.insert(name, Imf::StringAttribute(*t));
+    else if (const auto* v = std::get_if<std::array<float, 3>>(&value)) header.insert(name, Imf::V3fAttribute(Imath::V3f((*v)[0], (*v)[1], (*v)[2])));
+  }
+  Imf::OutputFile out(path.c_str(), header);
+  out.setFrameBuffer(exr_frame_buffer(spec, header.dataWindow(), Imf::FLOAT, const_cast<char*>(static_cast<const char*>(pixels))));
+  out.writePixels(spec.height);
 }
 
 }  // namespace
 
-std::unique_ptr<OIIO::ImageInput> open_image(const std::string& path, const std::string& fallback) {
-  require_regular_file(path);  // OpenImageIO would probe a device with every format reader, forever
-  check_exr_header(path);
-  auto in = OIIO::ImageInput::open(path);
-  if (!in) {
-    const std::string why = OIIO::geterror();
-    fail(path, why.empty() ? fallback : first_line(why));
+struct ImageReader::Backend {
+  std::unique_ptr<Imf::InputFile> exr;
+  const ImageCodec* codec = nullptr;
+  void* handle = nullptr;  // codec's
+  ~Backend() {
+    if (handle) codec->close(handle);
   }
-  return in;
+};
+
+ImageReader::ImageReader(std::string path, ImageSpec spec, std::unique_ptr<Backend> backend)
+    : path_(std::move(path)), spec_(std::move(spec)), backend_(std::move(backend)) {}
+ImageReader::ImageReader(ImageReader&&) noexcept = default;
+ImageReader& ImageReader::operator=(ImageReader&&) noexcept = default;
+ImageReader::~ImageReader() = default;
+
+ImageReader ImageReader::open(const std::string& path, const std::string& fallback) {
+  require_regular_file(path);  // a reader would probe a device with every format reader, forever
+  auto backend = std::make_unique<Backend>();
+  ImageSpec spec;
+  if (check_exr_header(path)) {
+    try {
+      backend->exr = std::make_unique<Imf::InputFile>(path.c_str());
+      const Imf::Header& header = backend->exr->header();
+      if (header.hasType() && Imf::isDeepData(header.type())) fail(path, "deep images are not supported");
+      spec = exr_spec(header);
+    } catch (const Error&) {
+      throw;
+    } catch (const std::exception& e) {
+      const std::string why = first_line(e.what());
+      fail(path, why.empty() ? fallback : why);
+    }
+  } else {
+    backend->codec = &other_formats(path);
+    std::string error;
+    backend->handle = backend->codec->open(path, spec, error);
+    if (!backend->handle) fail(path, error.empty() ? fallback : first_line(error));
+  }
+  if (spec.width < 1 || spec.height < 1 || spec.channels.empty()) fail(path, "empty image");
+  return ImageReader(path, std::move(spec), std::move(backend));
 }
 
-std::array<int, 3> rgb_channels(const OIIO::ImageSpec& spec, const std::string& path, OneChannel one_channel) {
+int ImageSpec::channel_index(const std::string& name) const {
+  const auto at = std::find(channels.begin(), channels.end(), name);
+  return at == channels.end() ? -1 : int(at - channels.begin());
+}
+
+int ImageSpec::get_int(const std::string& name, int fallback) const {
+  const auto at = attributes.find(name);
+  const int* v = at == attributes.end() ? nullptr : std::get_if<int>(&at->second);
+  return v ? *v : fallback;
+}
+
+float ImageSpec::get_float(const std::string& name, float fallback) const {
+  const auto at = attributes.find(name);
+  const float* v = at == attributes.end() ? nullptr : std::get_if<float>(&at->second);
+  return v ? *v : fallback;
+}
+
+std::string ImageSpec::get_string(const std::string& name) const {
+  const auto at = attributes.find(name);
+  const std::string* v = at == attributes.end() ? nullptr : std::get_if<std::string>(&at->second);
+  return v ? *v : std::string();
+}
+
+std::optional<std::array<float, 3>> ImageSpec::get_vec3(const std::string& name) const {
+  const auto at = attributes.find(name);
+  const auto* v = at == attributes.end() ? nullptr : std::get_if<std::array<float, 3>>(&at->second);
+  return v ? std::optional<std::array<float, 3>>(*v) : std::nullopt;
+}
+
+std::vector<float> ImageReader::read_pixels() {
+  std::vector<float> all(std::size_t(spec_.width) * std::size_t(spec_.height) * spec_.channels.size());
+  if (backend_->exr) {
+    try {
+      const Imath::Box2i window = backend_->exr->header().dataWindow();
+      backend_->exr->setFrameBuffer(exr_frame_buffer(spec_, window, Imf::FLOAT, reinterpret_cast<char*>(all.data())));
+      backend_->exr->readPixels(window.min.y, window.max.y);
+    } catch (const std::exception& e) {
+      fail(path_, "cannot read pixels: " + first_line(e.what()));
+    }
+  } else {
+    std::string error;
+    if (!backend_->codec->read(backend_->handle, all.data(), error)) fail(path_, "cannot read pixels: " + first_line(error));
+  }
+  return all;
+}
+
+std::array<int, 3> rgb_channels(const ImageSpec& spec, const std::string& path, OneChannel one_channel) {
   std::array<int, 3> channel{};
-  if (spec.nchannels == 1 && one_channel == OneChannel::grey) return channel;
+  if (spec.channels.size() == 1 && one_channel == OneChannel::grey) return channel;
   const char* names[3] = {"R", "G", "B"};
   for (int c = 0; c < 3; ++c) {
-    channel[std::size_t(c)] = spec.channelindex(names[c]);
+    channel[std::size_t(c)] = spec.channel_index(names[c]);
     if (channel[std::size_t(c)] < 0) {
       std::string present;
-      for (const std::string& n : spec.channelnames) present += (present.empty() ? "" : ", ") + n;
+      for (const std::string& n : spec.channels) present += (present.empty() ? "" : ", ") + n;
       fail(path, std::string("no ") + names[c] + " channel (channels: " + present + ")");
     }
   }
   return channel;
 }
 
-std::vector<float> read_pixels(OIIO::ImageInput& in, const std::string& path) {
-  const OIIO::ImageSpec& spec = in.spec();
-  // read_image reads every slice of a volume and the samples of a deep image: not into this buffer.
-  if (spec.deep) fail(path, "deep images are not supported");
-  if (spec.depth != 1) fail(path, "volume images are not supported");
-  if (spec.width < 1 || spec.height < 1 || spec.nchannels < 1) fail(path, "empty image");
-  std::vector<float> all(std::size_t(spec.width) * std::size_t(spec.height) * std::size_t(spec.nchannels));
-  if (!in.read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, all.data())) fail(path, "cannot read pixels: " + first_line(in.geterror()));
-  return all;
-}
-
-std::vector<float> rgb_of(const std::vector<float>& all, const OIIO::ImageSpec& spec, const std::string& path, OneChannel one_channel) {
+std::vector<float> rgb_of(const std::vector<float>& all, const ImageSpec& spec, const std::string& path, OneChannel one_channel) {
   const std::array<int, 3> channel = rgb_channels(spec, path, one_channel);
-  const std::size_t pixels = std::size_t(spec.width) * std::size_t(spec.height), n = std::size_t(spec.nchannels);
+  const std::size_t pixels = std::size_t(spec.width) * std::size_t(spec.height), n = spec.channels.size();
   std::vector<float> rgb(pixels * 3);
   for (std::size_t p = 0; p < pixels; ++p)
     for (std::size_t c = 0; c < 3; ++c) {
@@ -197,32 +372,36 @@ std::vector<float> rgb_of(const std::vector<float>& all, const OIIO::ImageSpec& 
   return rgb;
 }
 
-std::vector<float> read_rgb(OIIO::ImageInput& in, const std::string& path, OneChannel one_channel) {
-  return rgb_of(read_pixels(in, path), in.spec(), path, one_channel);
+std::vector<float> read_rgb(ImageReader& in, OneChannel one_channel) {
+  return rgb_of(in.read_pixels(), in.spec(), in.path(), one_channel);
 }
 
-void write_image_atomic(const std::string& path, const OIIO::ImageSpec& spec, const void* pixels) {
+void write_image_atomic(const std::string& path, const ImageSpec& spec, const void* pixels) {
   AtomicFile out(path);
-  auto image = OIIO::ImageOutput::create(out.temp_path());
-  if (!image) fail(path, "cannot write: " + OIIO::geterror());
-  errno = 0;
-  if (!image->open(out.temp_path(), spec)) {
-    // OpenImageIO names the temporary and not the reason; the system's reason says more.
-    const int error = errno;
-    fail(path, "cannot write: " + (error != 0 ? std::string(std::strerror(error)) : first_line(image->geterror())));
+  if (has_exr_extension(path)) {
+    errno = 0;
+    try {
+      write_exr_file(out.temp_path(), path, spec, pixels);
+    } catch (const Error&) {
+      throw;
+    } catch (const std::exception& e) {
+      // OpenEXR names the temporary; the system's reason, where there is one, says more.
+      const int error = errno;
+      fail(path, "cannot write: " + (error != 0 ? std::string(std::strerror(error)) : first_line(e.what())));
+    }
+  } else {
+    std::string error;
+    if (!other_formats(path).write(out.temp_path(), spec, pixels, error)) fail(path, "cannot write: " + first_line(error));
   }
-  if (!image->write_image(spec.format, pixels) || !image->close()) fail(path, "cannot write: " + first_line(image->geterror()));
-  image.reset();
   // Some writers (PNG) report no error when the disk fills and leave a truncated file: read it back
   // whole before it takes the target's name.
-  auto check = OIIO::ImageInput::open(out.temp_path());
-  std::vector<unsigned char> back(check ? check->spec().image_bytes() : 0);
-  if (!check || !check->read_image(0, 0, 0, check->spec().nchannels, check->spec().format, back.data())) {
-    const std::string why = check ? check->geterror() : OIIO::geterror();
-    fail(path, "cannot write: the written file does not read back whole (disk full?)" +
-                   (why.empty() ? std::string() : ": " + first_line(why)));
+  try {
+    ImageReader::open(out.temp_path()).read_pixels();
+  } catch (const Error& e) {
+    const std::string why = e.what(), own = out.temp_path() + ": ";
+    fail(path, "cannot write: the written file does not read back whole (disk full?): " +
+                   (why.rfind(own, 0) == 0 ? why.substr(own.size()) : why));
   }
-  check->close();
   out.commit();
 }
 

@@ -1,7 +1,5 @@
 #include "lut/lut.h"
 
-#include <OpenImageIO/imageio.h>
-
 #include <cmath>
 #include <sstream>
 
@@ -13,23 +11,18 @@ namespace facetfit {
 
 namespace {
 
-using OIIO::ImageSpec;
-using OIIO::TypeDesc;
-
 constexpr const char* kPrefix = "facetfit:";
 std::string key(const char* name) { return std::string(kPrefix) + name; }
 
 void set_color(ImageSpec& spec, const char* name, const Rgb& c) {
-  const float v[3] = {float(c.r), float(c.g), float(c.b)};
-  spec.attribute(key(name), OIIO::TypeColor, v);
+  spec.set(key(name), std::array<float, 3>{float(c.r), float(c.g), float(c.b)});
 }
 
 // The named float[3] attribute, or nullopt.
 std::optional<Rgb> get_color(const ImageSpec& spec, const char* name) {
-  const OIIO::ParamValue* p = spec.find_attribute(key(name));
-  if (!p || p->type().basetype != TypeDesc::FLOAT || p->type().basevalues() != 3) return std::nullopt;
-  const float* v = static_cast<const float*>(p->data());
-  return Rgb(v[0], v[1], v[2]);
+  const auto v = spec.get_vec3(key(name));
+  if (!v) return std::nullopt;
+  return Rgb((*v)[0], (*v)[1], (*v)[2]);
 }
 
 // Integer codes of the metadata choices, fixed by the LUT format (docs/lut-format.md), for readers that
@@ -156,66 +149,63 @@ void write_lut(const std::string& path, const Lut& lut) {
     }
   }
 
-  ImageSpec spec(layout.width, layout.height, 3, TypeDesc::FLOAT);
-  spec.channelnames = {"R", "G", "B"};
-  spec.attribute("compression", "zip");
-  spec.attribute("oiio:ColorSpace", "Linear");  // data, not colour: no transfer function
+  ImageSpec spec(layout.width, layout.height, {"R", "G", "B"});  // data, not colour: no transfer function
   const LutMetadata& m = lut.meta;
-  spec.attribute(key("format_version"), m.format_version);
-  spec.attribute(key("facetfit_version"), m.facetfit_version);
-  spec.attribute(key("source"), m.source);
-  spec.attribute(key("source_sha256"), m.source_sha256);
-  spec.attribute(key("resolution"), m.resolution);
-  spec.attribute(key("smith"), to_string(m.smith));
-  spec.attribute(key("iterations"), m.iterations);
-  spec.attribute(key("residual"), float(m.residual));
-  spec.attribute(key("alpha_ggx"), float(m.alpha_ggx));
-  spec.attribute(key("alpha_beckmann"), float(m.alpha_beckmann));
+  spec.set(key("format_version"), m.format_version);
+  spec.set(key("facetfit_version"), m.facetfit_version);
+  spec.set(key("source"), m.source);
+  spec.set(key("source_sha256"), m.source_sha256);
+  spec.set(key("resolution"), m.resolution);
+  spec.set(key("smith"), to_string(m.smith));
+  spec.set(key("iterations"), m.iterations);
+  spec.set(key("residual"), float(m.residual));
+  spec.set(key("alpha_ggx"), float(m.alpha_ggx));
+  spec.set(key("alpha_beckmann"), float(m.alpha_beckmann));
   set_color(spec, "f0", m.f0);
   set_color(spec, "f82", m.f82);
-  spec.attribute(key("ndf_error_ggx"), float(m.ndf_error_ggx));
-  spec.attribute(key("ndf_error_beckmann"), float(m.ndf_error_beckmann));
-  spec.attribute(key("representation"), to_string(m.representation));
+  spec.set(key("ndf_error_ggx"), float(m.ndf_error_ggx));
+  spec.set(key("ndf_error_beckmann"), float(m.ndf_error_beckmann));
+  spec.set(key("representation"), to_string(m.representation));
   // The same two choices as integers: Cycles' OSL (1.14) returns string attributes as empty strings.
-  spec.attribute(key("smith_code"), smith_code(m.smith));
-  spec.attribute(key("representation_code"), representation_code(m.representation));
-  spec.attribute(key("tolerance"), float(m.tolerance));
+  spec.set(key("smith_code"), smith_code(m.smith));
+  spec.set(key("representation_code"), representation_code(m.representation));
+  spec.set(key("tolerance"), float(m.tolerance));
   set_color(spec, "body", m.body);
-  spec.attribute(key("coat_alpha"), float(m.coat.alpha));
-  spec.attribute(key("coat_f0"), float(m.coat.f0));
+  spec.set(key("coat_alpha"), float(m.coat.alpha));
+  spec.set(key("coat_f0"), float(m.coat.f0));
   for (const auto& [name, p] : {std::pair{"ggx", &m.ggx}, {"beckmann", &m.beckmann}, {"lsq", &m.lsq}}) {
     const std::string n = name;
-    spec.attribute(key((n + "_alpha").c_str()), float(p->alpha));
-    spec.attribute(key((n + "_coat_alpha").c_str()), float(p->coat.alpha));
-    spec.attribute(key((n + "_coat_f0").c_str()), float(p->coat.f0));
+    spec.set(key((n + "_alpha").c_str()), float(p->alpha));
+    spec.set(key((n + "_coat_alpha").c_str()), float(p->coat.alpha));
+    spec.set(key((n + "_coat_f0").c_str()), float(p->coat.f0));
     set_color(spec, (n + "_body").c_str(), p->body);
     set_color(spec, (n + "_f0").c_str(), p->f0);
     set_color(spec, (n + "_f82").c_str(), p->f82);
   }
-  spec.attribute(key("error"), float(m.error));
-  spec.attribute(key("error_ggx"), float(m.error_ggx));
-  spec.attribute(key("error_beckmann"), float(m.error_beckmann));
-  spec.attribute(key("error_lsq"), float(m.error_lsq));
-  spec.attribute(key("error_extraction"), float(m.error_extraction));
-  spec.attribute(key("sampling"), m.sampling ? 1 : 0);
+  spec.set(key("error"), float(m.error));
+  spec.set(key("error_ggx"), float(m.error_ggx));
+  spec.set(key("error_beckmann"), float(m.error_beckmann));
+  spec.set(key("error_lsq"), float(m.error_lsq));
+  spec.set(key("error_extraction"), float(m.error_extraction));
+  spec.set(key("sampling"), m.sampling ? 1 : 0);
   if (lut.anisotropic) {
-    spec.attribute(key("anisotropic_resolution"), m.anisotropic_resolution);
-    spec.attribute(key("anisotropic_phi_count"), m.anisotropic_phi_count);
+    spec.set(key("anisotropic_resolution"), m.anisotropic_resolution);
+    spec.set(key("anisotropic_phi_count"), m.anisotropic_phi_count);
     // The anisotropic GGX fit, what an anisotropic closure takes (the OSL material shader).
     const AnisotropicParametricFit& g = m.anisotropic_ggx;
-    spec.attribute(key("anisotropic_ggx_alpha_x"), float(g.alpha.alpha_x));
-    spec.attribute(key("anisotropic_ggx_alpha_y"), float(g.alpha.alpha_y));
-    spec.attribute(key("anisotropic_ggx_angle"), float(g.alpha.angle));
+    spec.set(key("anisotropic_ggx_alpha_x"), float(g.alpha.alpha_x));
+    spec.set(key("anisotropic_ggx_alpha_y"), float(g.alpha.alpha_y));
+    spec.set(key("anisotropic_ggx_angle"), float(g.alpha.angle));
     set_color(spec, "anisotropic_ggx_body", g.body);
     set_color(spec, "anisotropic_ggx_f0", g.f0);
     set_color(spec, "anisotropic_ggx_f82", g.f82);
-    spec.attribute(key("anisotropic_ggx_error"), float(g.error));
+    spec.set(key("anisotropic_ggx_error"), float(g.error));
   }
   // One line per warning; absent when there is none.
   if (!m.warnings.empty()) {
     std::string text;
     for (const std::string& w : m.warnings) text += (text.empty() ? "" : "\n") + w;
-    spec.attribute(key("warnings"), text);
+    spec.set(key("warnings"), text);
   }
 
   write_image_atomic(path, spec, pixels.data());
@@ -275,9 +265,9 @@ void validate(const std::string& path, const LutMetadata& m) {
 }  // namespace
 
 Lut read_lut(const std::string& path) {
-  auto image = open_image(path);
-  const ImageSpec& spec = image->spec();
-  const int version = spec.get_int_attribute(key("format_version"), -1);
+  ImageReader image = ImageReader::open(path);
+  const ImageSpec& spec = image.spec();
+  const int version = spec.get_int(key("format_version"), -1);
   if (version < 0) fail(path, "not a facetfit LUT (no facetfit:format_version attribute)");
   if (version < 1 || version > kLutAnisotropicVersion)
     fail(path, "LUT format version " + std::to_string(version) + "; this facetfit reads versions 1 to " +
@@ -286,12 +276,12 @@ Lut read_lut(const std::string& path) {
   Lut lut;
   LutMetadata& m = lut.meta;
   m.format_version = version;
-  m.facetfit_version = spec.get_string_attribute(key("facetfit_version"));
-  m.source = spec.get_string_attribute(key("source"));
-  m.source_sha256 = spec.get_string_attribute(key("source_sha256"));
-  m.resolution = spec.get_int_attribute(key("resolution"), -1);
-  const auto smith = parse_smith(spec.get_string_attribute(key("smith")));
-  const auto representation = parse_representation(spec.get_string_attribute(key("representation")));
+  m.facetfit_version = spec.get_string(key("facetfit_version"));
+  m.source = spec.get_string(key("source"));
+  m.source_sha256 = spec.get_string(key("source_sha256"));
+  m.resolution = spec.get_int(key("resolution"), -1);
+  const auto smith = parse_smith(spec.get_string(key("smith")));
+  const auto representation = parse_representation(spec.get_string(key("representation")));
   const auto f0 = get_color(spec, "f0"), f82 = get_color(spec, "f82");
   if (!smith) fail(path, "facetfit:smith is missing or not masking, correlated or separable");
   if (!representation) fail(path, "facetfit:representation is missing or not tabulated, ggx or beckmann");
@@ -301,20 +291,20 @@ Lut read_lut(const std::string& path) {
   m.smith = *smith;
   m.representation = *representation;
   // The integer codes, where present (LUTs of facetfit 0.1.0 before they were added have none), must agree.
-  if (spec.get_int_attribute(key("smith_code"), smith_code(m.smith)) != smith_code(m.smith) ||
-      spec.get_int_attribute(key("representation_code"), representation_code(m.representation)) != representation_code(m.representation))
+  if (spec.get_int(key("smith_code"), smith_code(m.smith)) != smith_code(m.smith) ||
+      spec.get_int(key("representation_code"), representation_code(m.representation)) != representation_code(m.representation))
     fail(path, "facetfit LUT whose smith_code or representation_code contradicts its smith or representation");
   m.f0 = *f0;
   m.f82 = *f82;
-  m.iterations = spec.get_int_attribute(key("iterations"));
-  m.residual = spec.get_float_attribute(key("residual"));
-  m.alpha_ggx = spec.get_float_attribute(key("alpha_ggx"));
-  m.alpha_beckmann = spec.get_float_attribute(key("alpha_beckmann"));
-  m.ndf_error_ggx = spec.get_float_attribute(key("ndf_error_ggx"));
-  m.ndf_error_beckmann = spec.get_float_attribute(key("ndf_error_beckmann"));
-  m.tolerance = spec.get_float_attribute(key("tolerance"));
-  m.sampling = spec.get_int_attribute(key("sampling")) != 0;
-  for (std::string text = spec.get_string_attribute(key("warnings")); !text.empty();) {
+  m.iterations = spec.get_int(key("iterations"));
+  m.residual = spec.get_float(key("residual"));
+  m.alpha_ggx = spec.get_float(key("alpha_ggx"));
+  m.alpha_beckmann = spec.get_float(key("alpha_beckmann"));
+  m.ndf_error_ggx = spec.get_float(key("ndf_error_ggx"));
+  m.ndf_error_beckmann = spec.get_float(key("ndf_error_beckmann"));
+  m.tolerance = spec.get_float(key("tolerance"));
+  m.sampling = spec.get_int(key("sampling")) != 0;
+  for (std::string text = spec.get_string(key("warnings")); !text.empty();) {
     const std::size_t end = text.find('\n');
     m.warnings.push_back(text.substr(0, end));
     text = end == std::string::npos ? "" : text.substr(end + 1);
@@ -327,39 +317,39 @@ Lut read_lut(const std::string& path) {
     const auto body = get_color(spec, "body");
     if (!body) fail(path, "facetfit LUT version 2 without facetfit:body");
     m.body = *body;
-    m.coat = {spec.get_float_attribute(key("coat_alpha")), spec.get_float_attribute(key("coat_f0"))};
+    m.coat = {spec.get_float(key("coat_alpha")), spec.get_float(key("coat_f0"))};
     for (const auto& [name, p] : {std::pair{"ggx", &m.ggx}, {"beckmann", &m.beckmann}, {"lsq", &m.lsq}}) {
       const std::string n = name;
       const auto pb = get_color(spec, (n + "_body").c_str()), pf0 = get_color(spec, (n + "_f0").c_str()),
                  pf82 = get_color(spec, (n + "_f82").c_str());
-      p->alpha = spec.get_float_attribute(key((n + "_alpha").c_str()), -1.0f);
+      p->alpha = spec.get_float(key((n + "_alpha").c_str()), -1.0f);
       if (!pb || !pf0 || !pf82 || !(p->alpha > 0.0)) fail(path, "facetfit LUT without a valid facetfit:" + n + "_* fit");
       *p = {p->alpha, *pb, *pf0, *pf82,
-            {spec.get_float_attribute(key((n + "_coat_alpha").c_str())), spec.get_float_attribute(key((n + "_coat_f0").c_str()))}};
+            {spec.get_float(key((n + "_coat_alpha").c_str())), spec.get_float(key((n + "_coat_f0").c_str()))}};
     }
-    m.error = spec.get_float_attribute(key("error"));
-    m.error_ggx = spec.get_float_attribute(key("error_ggx"));
-    m.error_beckmann = spec.get_float_attribute(key("error_beckmann"));
-    m.error_lsq = spec.get_float_attribute(key("error_lsq"));
-    m.error_extraction = spec.get_float_attribute(key("error_extraction"));
+    m.error = spec.get_float(key("error"));
+    m.error_ggx = spec.get_float(key("error_ggx"));
+    m.error_beckmann = spec.get_float(key("error_beckmann"));
+    m.error_lsq = spec.get_float(key("error_lsq"));
+    m.error_extraction = spec.get_float(key("error_extraction"));
   }
 
   if (version == kLutAnisotropicVersion) {
-    m.anisotropic_resolution = spec.get_int_attribute(key("anisotropic_resolution"), -1);
-    m.anisotropic_phi_count = spec.get_int_attribute(key("anisotropic_phi_count"), -1);
+    m.anisotropic_resolution = spec.get_int(key("anisotropic_resolution"), -1);
+    m.anisotropic_phi_count = spec.get_int(key("anisotropic_phi_count"), -1);
     // Bounded before anything is sized from them; the quadrature's own limits.
     if (m.anisotropic_resolution < 4 || m.anisotropic_resolution > 4096 || m.anisotropic_phi_count < 4 ||
         m.anisotropic_phi_count > 4096 || m.anisotropic_phi_count % 2 != 0)
       fail(path, "facetfit:anisotropic_resolution or facetfit:anisotropic_phi_count is missing or out of range (" +
                      std::to_string(m.anisotropic_resolution) + ", " + std::to_string(m.anisotropic_phi_count) + ")");
     AnisotropicParametricFit& g = m.anisotropic_ggx;
-    g.alpha = {spec.get_float_attribute(key("anisotropic_ggx_alpha_x")), spec.get_float_attribute(key("anisotropic_ggx_alpha_y")),
-               spec.get_float_attribute(key("anisotropic_ggx_angle"))};
+    g.alpha = {spec.get_float(key("anisotropic_ggx_alpha_x")), spec.get_float(key("anisotropic_ggx_alpha_y")),
+               spec.get_float(key("anisotropic_ggx_angle"))};
     const auto g_body = get_color(spec, "anisotropic_ggx_body"), g_f0 = get_color(spec, "anisotropic_ggx_f0"),
                g_f82 = get_color(spec, "anisotropic_ggx_f82");
     if (!g_body || !g_f0 || !g_f82) fail(path, "facetfit LUT version 3 without facetfit:anisotropic_ggx_body, _f0 or _f82");
     g.body = *g_body, g.f0 = *g_f0, g.f82 = *g_f82;
-    g.error = spec.get_float_attribute(key("anisotropic_ggx_error"));
+    g.error = spec.get_float(key("anisotropic_ggx_error"));
   }
   validate(path, m);
   const LutLayout layout = LutLayout::of(m.resolution, m.sampling, m.anisotropic_resolution, m.anisotropic_phi_count);
@@ -368,9 +358,9 @@ Lut read_lut(const std::string& path) {
                    std::to_string(layout.width) + " x " + std::to_string(layout.height) + " for resolution " +
                    std::to_string(m.resolution));
   const std::array<int, 3> channel = rgb_channels(spec, path, OneChannel::refused);
-  const std::vector<float> pixels = read_pixels(*image, path);
+  const std::vector<float> pixels = image.read_pixels();
   const auto get = [&](int row, int x, int c) {
-    const float v = pixels[(std::size_t(row) * spec.width + x) * spec.nchannels + channel[std::size_t(c)]];
+    const float v = pixels[(std::size_t(row) * spec.width + x) * spec.channels.size() + channel[std::size_t(c)]];
     if (!std::isfinite(v)) fail(path, "non-finite value in row " + std::to_string(row) + ", column " + std::to_string(x));
     return double(v);
   };

@@ -1,6 +1,5 @@
 #include "render/environment.h"
 
-#include <OpenImageIO/imageio.h>
 
 #include <algorithm>
 #include <cmath>
@@ -48,14 +47,15 @@ std::uint64_t Environment::bytes_to_load(int width, int height, int channels) {
 }
 
 Environment Environment::load(const std::string& path, std::uint64_t max_bytes) {
-  auto in = open_image(path, "cannot open environment map");
-  const OIIO::ImageSpec& spec = in->spec();
-  if (spec.width < 2 || spec.height < 1 || spec.width > 65536 || spec.height > 32768 || spec.nchannels < 1 || spec.nchannels > 64)
+  ImageReader in = ImageReader::open(path, "cannot open environment map");
+  const ImageSpec& spec = in.spec();
+  const int channels = int(spec.channels.size());
+  if (spec.width < 2 || spec.height < 1 || spec.width > 65536 || spec.height > 32768 || channels < 1 || channels > 64)
     fail(path, "environment map is " + std::to_string(spec.width) + " x " + std::to_string(spec.height) + " x " +
-                   std::to_string(spec.nchannels) + " channels; at most 65536 x 32768, at least 2 x 1, 1 to 64 channels");
+                   std::to_string(channels) + " channels; at most 65536 x 32768, at least 2 x 1, 1 to 64 channels");
   check_memory(path, "a " + std::to_string(spec.width) + " x " + std::to_string(spec.height) + " environment map",
-               bytes_to_load(spec.width, spec.height, spec.nchannels), max_bytes);
-  std::vector<float> rgb = read_rgb(*in, path, OneChannel::grey);
+               bytes_to_load(spec.width, spec.height, channels), max_bytes);
+  std::vector<float> rgb = read_rgb(in, OneChannel::grey);
   return from_pixels(spec.width, spec.height, std::move(rgb));
 }
 

@@ -20,7 +20,7 @@ class Environment {
   static Environment constant(const Rgb& radiance);
   // `rgb` holds width x height interleaved linear Rec.709 values, row 0 at the zenith.
   static Environment from_pixels(int width, int height, std::vector<float> rgb);
-  // Any image OpenImageIO reads (EXR, HDR); throws Error naming the file.
+  // Any image facetfit reads (io/image_file.h: EXR, HDR ...); throws Error naming the file.
   // Refuses, before reading its pixels, a map whose pixels and sampling tables would take more than
   // `max_bytes`.
   static Environment load(const std::string& path, std::uint64_t max_bytes);

@@ -1,6 +1,5 @@
 #include "render/renderer.h"
 
-#include <OpenImageIO/imageio.h>
 #include <tbb/blocked_range2d.h>
 #include <tbb/parallel_for.h>
 
@@ -318,12 +317,8 @@ std::vector<float> RenderedImage::rgb() const {
 }
 
 void write_exr(const std::string& path, const RenderedImage& image, const std::vector<std::pair<std::string, std::string>>& metadata) {
-  OIIO::ImageSpec spec(image.width, image.height, 4, OIIO::TypeDesc::FLOAT);
-  spec.channelnames = {"R", "G", "B", "A"};
-  spec.alpha_channel = 3;
-  spec.attribute("compression", "zip");
-  spec.attribute("oiio:ColorSpace", "Linear");
-  for (const auto& [k, v] : metadata) spec.attribute("facetfit:" + k, v);
+  ImageSpec spec(image.width, image.height, {"R", "G", "B", "A"});
+  for (const auto& [k, v] : metadata) spec.set("facetfit:" + k, v);
   write_image_atomic(path, spec, image.rgba.data());
 }
 

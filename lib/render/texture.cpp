@@ -15,16 +15,17 @@ Texture::Texture(int width, int height, std::vector<float> rgb) : width_(width),
 }
 
 Texture Texture::load(const std::string& path, std::uint64_t max_bytes) {
-  auto in = open_image(path, "cannot open texture");
-  const OIIO::ImageSpec& spec = in->spec();
-  if (spec.width < 1 || spec.height < 1 || spec.nchannels < 1 || spec.width > 65536 || spec.height > 65536 || spec.nchannels > 64)
+  ImageReader in = ImageReader::open(path, "cannot open texture");
+  const ImageSpec& spec = in.spec();
+  const std::size_t channels = spec.channels.size();
+  if (spec.width < 1 || spec.height < 1 || channels < 1 || spec.width > 65536 || spec.height > 65536 || channels > 64)
     fail(path, "texture is " + std::to_string(spec.width) + " x " + std::to_string(spec.height) + " x " +
-                   std::to_string(spec.nchannels) + " channels; at most 65536 x 65536, 1 to 64 channels");
+                   std::to_string(channels) + " channels; at most 65536 x 65536, 1 to 64 channels");
   // The file's channels as floats, then the RGB copy kept.
   const std::uint64_t pixels = std::uint64_t(spec.width) * std::uint64_t(spec.height);
   check_memory(path, "a " + std::to_string(spec.width) + " x " + std::to_string(spec.height) + " texture",
-               pixels * (std::uint64_t(spec.nchannels) + 3u) * sizeof(float), max_bytes);
-  std::vector<float> rgb = read_rgb(*in, path, OneChannel::grey);
+               pixels * (std::uint64_t(channels) + 3u) * sizeof(float), max_bytes);
+  std::vector<float> rgb = read_rgb(in, OneChannel::grey);
   return Texture(spec.width, spec.height, std::move(rgb));
 }
 

@@ -19,7 +19,7 @@ struct TextureCoordinates {
 
 class Texture {
  public:
-  // Any image OpenImageIO reads; R, G, B by name (a grey image repeats its channel). Throws Error naming
+  // Any image facetfit reads (io/image_file.h: EXR, and through OpenImageIO PNG, TIFF ...); R, G, B by name (a grey image repeats its channel). Throws Error naming
   // the file for an unreadable image, one over `max_bytes`, or a non-finite pixel.
   static Texture load(const std::string& path, std::uint64_t max_bytes);
   // `rgb`: width x height interleaved values, row 0 at the top (as image files store them).
