@@ -157,7 +157,6 @@ bool check_exr_header(const std::string& path) {
   return true;
 }
 
-
 // ---- OpenEXR ----------------------------------------------------------------------------------------------
 
 // The spec of an open OpenEXR file: R, G, B, A first (as OpenImageIO orders them), then the others in the
@@ -181,12 +180,13 @@ ImageSpec exr_spec(const Imf::Header& header) {
   return spec;
 }
 
-// One slice per channel of `spec`, interleaved floats in `pixels`, placed by the data window.
-Imf::FrameBuffer exr_frame_buffer(const ImageSpec& spec, const Imath::Box2i& window, Imf::PixelType type, char* pixels) {
-  const std::size_t size = type == Imf::FLOAT ? sizeof(float) : 1, stride = size * spec.channels.size();
+// One float slice per channel of `spec`, interleaved in `pixels`, placed by the data window (OpenEXR
+// converts half and uint channels as it reads).
+Imf::FrameBuffer exr_frame_buffer(const ImageSpec& spec, const Imath::Box2i& window, const float* pixels) {
+  const std::size_t stride = sizeof(float) * spec.channels.size();
   Imf::FrameBuffer frame;
   for (std::size_t c = 0; c < spec.channels.size(); ++c)
-    frame.insert(spec.channels[c], Imf::Slice::Make(type, pixels + c * size, window, stride, stride * std::size_t(spec.width)));
+    frame.insert(spec.channels[c], Imf::Slice::Make(Imf::FLOAT, pixels + c, window, stride, stride * std::size_t(spec.width)));
   return frame;
 }
 
@@ -249,7 +249,7 @@ void write_exr_file(const std::string& path, const std::string& target, const Im
     else if (const auto* v = std::get_if<std::array<float, 3>>(&value)) header.insert(name, Imf::V3fAttribute(Imath::V3f((*v)[0], (*v)[1], (*v)[2])));
   }
   Imf::OutputFile out(path.c_str(), header);
-  out.setFrameBuffer(exr_frame_buffer(spec, header.dataWindow(), Imf::FLOAT, const_cast<char*>(static_cast<const char*>(pixels))));
+  out.setFrameBuffer(exr_frame_buffer(spec, header.dataWindow(), static_cast<const float*>(pixels)));
   out.writePixels(spec.height);
 }
 
@@ -330,7 +330,7 @@ std::vector<float> ImageReader::read_pixels() {
   if (backend_->exr) {
     try {
       const Imath::Box2i window = backend_->exr->header().dataWindow();
-      backend_->exr->setFrameBuffer(exr_frame_buffer(spec_, window, Imf::FLOAT, reinterpret_cast<char*>(all.data())));
+      backend_->exr->setFrameBuffer(exr_frame_buffer(spec_, window, all.data()));
       backend_->exr->readPixels(window.min.y, window.max.y);
     } catch (const std::exception& e) {
       fail(path_, "cannot read pixels: " + first_line(e.what()));
