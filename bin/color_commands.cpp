@@ -1,9 +1,7 @@
 // facetfit deltae : CIEDE2000 of Lab pairs read on stdin.
 // facetfit diff A.exr B.exr : mean and max ΔE00 between two renders through the display chain, and a heatmap.
 
-#include <algorithm>
 #include <array>
-#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <cstdint>
@@ -108,12 +106,6 @@ std::vector<bool> coverage_mask(const Image& a, const Image& b) {
   return mask;
 }
 
-
-bool is_png(std::string path) {
-  std::transform(path.begin(), path.end(), path.begin(), [](unsigned char ch) { return char(std::tolower(ch)); });
-  return path.size() > 4 && path.compare(path.size() - 4, 4, ".png") == 0;
-}
-
 struct DiffArgs {
   std::string a, b, mask, heatmap;
   bool json = false;
@@ -121,7 +113,7 @@ struct DiffArgs {
 
 void run_diff(const DiffArgs& args, Context& ctx) {
   int& status = ctx.status;
-  if (!args.heatmap.empty() && !is_png(args.heatmap)) {
+  if (!args.heatmap.empty() && !has_extension(args.heatmap, ".png")) {
     report_error("--heatmap " + args.heatmap + ": must end in .png");
     status = 2;
     return;

@@ -3,8 +3,8 @@
 #include <OpenEXR/ImfChannelList.h>
 #include <OpenEXR/ImfFrameBuffer.h>
 #include <OpenEXR/ImfHeader.h>
-#include <OpenEXR/ImfInputFile.h>
 #include <OpenEXR/ImfFloatAttribute.h>
+#include <OpenEXR/ImfInputFile.h>
 #include <OpenEXR/ImfIntAttribute.h>
 #include <OpenEXR/ImfOutputFile.h>
 #include <OpenEXR/ImfPartType.h>
@@ -13,6 +13,7 @@
 #include <dlfcn.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <cmath>
 #include <cstdint>
@@ -169,7 +170,7 @@ ImageSpec exr_spec(const Imf::Header& header) {
   for (const char* name : {"R", "G", "B", "A"})
     if (header.channels().findChannel(name)) spec.channels.push_back(name);
   for (auto c = header.channels().begin(); c != header.channels().end(); ++c)
-    if (std::find(spec.channels.begin(), spec.channels.end(), c.name()) == spec.channels.end()) spec.channels.push_back(c.name());
+    if (spec.channel_index(c.name()) < 0) spec.channels.push_back(c.name());
   for (auto a = header.begin(); a != header.end(); ++a) {
     if (const auto* i = dynamic_cast<const Imf::IntAttribute*>(&a.attribute())) spec.set(a.name(), i->value());
     else if (const auto* f = dynamic_cast<const Imf::FloatAttribute*>(&a.attribute())) spec.set(a.name(), f->value());
@@ -231,12 +232,6 @@ const ImageCodec& other_formats(const std::string& path) {
   return *loaded.codec;
 }
 
-bool has_exr_extension(const std::string& path) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char ch) { return char(std::tolower(ch)); });
-  return ext == ".exr";
-}
-
 void write_exr_file(const std::string& path, const std::string& target, const ImageSpec& spec, const void* pixels) {
   if (spec.format != ImageSpec::Format::float32) fail(target, "cannot write: OpenEXR files are written from float pixels");
   Imf::Header header(spec.width, spec.height);
@@ -296,33 +291,10 @@ ImageReader ImageReader::open(const std::string& path, const std::string& fallba
   return ImageReader(path, std::move(spec), std::move(backend));
 }
 
-int ImageSpec::channel_index(const std::string& name) const {
-  const auto at = std::find(channels.begin(), channels.end(), name);
-  return at == channels.end() ? -1 : int(at - channels.begin());
-}
-
-int ImageSpec::get_int(const std::string& name, int fallback) const {
-  const auto at = attributes.find(name);
-  const int* v = at == attributes.end() ? nullptr : std::get_if<int>(&at->second);
-  return v ? *v : fallback;
-}
-
-float ImageSpec::get_float(const std::string& name, float fallback) const {
-  const auto at = attributes.find(name);
-  const float* v = at == attributes.end() ? nullptr : std::get_if<float>(&at->second);
-  return v ? *v : fallback;
-}
-
-std::string ImageSpec::get_string(const std::string& name) const {
-  const auto at = attributes.find(name);
-  const std::string* v = at == attributes.end() ? nullptr : std::get_if<std::string>(&at->second);
-  return v ? *v : std::string();
-}
-
-std::optional<std::array<float, 3>> ImageSpec::get_vec3(const std::string& name) const {
-  const auto at = attributes.find(name);
-  const auto* v = at == attributes.end() ? nullptr : std::get_if<std::array<float, 3>>(&at->second);
-  return v ? std::optional<std::array<float, 3>>(*v) : std::nullopt;
+bool has_extension(const std::string& path, const std::string& extension) {
+  if (path.size() <= extension.size()) return false;
+  return std::equal(extension.begin(), extension.end(), path.end() - std::ptrdiff_t(extension.size()),
+                    [](char e, char p) { return e == char(std::tolower(static_cast<unsigned char>(p))); });
 }
 
 std::vector<float> ImageReader::read_pixels() {
@@ -378,7 +350,7 @@ std::vector<float> read_rgb(ImageReader& in, OneChannel one_channel) {
 
 void write_image_atomic(const std::string& path, const ImageSpec& spec, const void* pixels) {
   AtomicFile out(path);
-  if (has_exr_extension(path)) {
+  if (has_extension(path, ".exr")) {
     errno = 0;
     try {
       write_exr_file(out.temp_path(), path, spec, pixels);

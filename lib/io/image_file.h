@@ -7,6 +7,7 @@
 // a whole `facetfit info` (docs/benchmarks.md, "Start-up").
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <map>
@@ -35,14 +36,28 @@ struct ImageSpec {
   ImageSpec(int w, int h, std::vector<std::string> names, Format f = Format::float32)
       : width(w), height(h), channels(std::move(names)), format(f) {}
 
-  int channel_index(const std::string& name) const;  // -1 when absent
+  int channel_index(const std::string& name) const {  // -1 when absent
+    const auto at = std::find(channels.begin(), channels.end(), name);
+    return at == channels.end() ? -1 : int(at - channels.begin());
+  }
   // Typed attributes: `fallback` when absent or of another type.
-  int get_int(const std::string& name, int fallback = 0) const;
-  float get_float(const std::string& name, float fallback = 0.0f) const;
-  std::string get_string(const std::string& name) const;
-  std::optional<std::array<float, 3>> get_vec3(const std::string& name) const;
+  int get_int(const std::string& name, int fallback = 0) const { return get<int>(name).value_or(fallback); }
+  float get_float(const std::string& name, float fallback = 0.0f) const { return get<float>(name).value_or(fallback); }
+  std::string get_string(const std::string& name) const { return get<std::string>(name).value_or(std::string()); }
+  std::optional<std::array<float, 3>> get_vec3(const std::string& name) const { return get<std::array<float, 3>>(name); }
   void set(const std::string& name, ImageAttribute value) { attributes[name] = std::move(value); }
+
+ private:
+  template <class T>
+  std::optional<T> get(const std::string& name) const {
+    const auto at = attributes.find(name);
+    const T* v = at == attributes.end() ? nullptr : std::get_if<T>(&at->second);
+    return v ? std::optional<T>(*v) : std::nullopt;
+  }
 };
+
+// Whether `path` ends in `extension` (".exr"), in any case, after a name.
+bool has_extension(const std::string& path, const std::string& extension);
 
 // An image file opened for reading: its spec at once, its pixels on demand (a caller checks the size
 // against its memory budget in between).

@@ -2,7 +2,6 @@
 // why it is a module). It holds no facetfit code: errors go back as text.
 #include <OpenImageIO/imageio.h>
 
-#include <algorithm>
 #include <cerrno>
 #include <cstring>
 #include <memory>
@@ -54,8 +53,7 @@ bool write_image(const std::string& path, const ImageSpec& spec, const void* pix
   const OIIO::TypeDesc format = spec.format == ImageSpec::Format::uint8 ? OIIO::TypeDesc::UINT8 : OIIO::TypeDesc::FLOAT;
   OIIO::ImageSpec s(spec.width, spec.height, int(spec.channels.size()), format);
   s.channelnames = spec.channels;
-  s.alpha_channel = int(std::find(spec.channels.begin(), spec.channels.end(), "A") - spec.channels.begin());
-  if (s.alpha_channel == s.nchannels) s.alpha_channel = -1;
+  s.alpha_channel = spec.channel_index("A");
   s.attribute("oiio:ColorSpace", spec.display_referred ? "sRGB" : "Linear");
   for (const auto& [name, value] : spec.attributes) {
     if (const int* i = std::get_if<int>(&value)) s.attribute(name, *i);
