@@ -247,7 +247,11 @@ def main(facetfit, mitsuba_python, dst, rgl=None):
                   "whose symbol lookups by the dynamic loader take %s of that time (`perf record`). A render's process time "
                   "is its render time plus this.\n" % (RUNS, startup[0], startup[1], startup[2]))
         out.write("\n## Where the time goes\n\n`perf record` of one facetfit render (64 spp, whole process), self time by\n"
-                  "library and symbol (the sphere is intersected in closed form, render/tracer.h; Embree traces triangles only).\n")
+                  "library and symbol (the sphere is intersected in closed form, render/tracer.h; Embree traces triangles only).\n"
+                  "A tile's samples are shaded in four steps (render/renderer.cpp): `plan` (the frame, light directions, queues),\n"
+                  "then BRDF sampling and evaluation in one call per material, in SIMD lanes for GGX (`N_AVX2::SampleGgxBatch`,\n"
+                  "`N_AVX2::EvalGgxBatch`, render/ggx_batch.h), then `finish` (shadow rays and their values) in the tile\n"
+                  "loop; a tabulated or measured model is still sampled and evaluated one sample at a time inside `plan`.\n")
         for label, (rows_, libraries) in profiles:
             out.write("\n%s, by library: %s.\n\n| self | library | symbol |\n|---|---|---|\n" % (
                 label, ", ".join("%s %.0f%%" % (dso, pct) for dso, pct in libraries) or "n/a"))

@@ -20,6 +20,7 @@ find_package(Imath CONFIG REQUIRED)
 find_package(OpenEXR CONFIG REQUIRED)  # LUTs, renders and environment maps, read and written directly
 find_package(OpenImageIO CONFIG REQUIRED)  # every other image format, in the module facetfit-oiio.so
 find_package(embree 3 CONFIG REQUIRED)
+find_path(HWY_INCLUDE_DIR hwy/highway.h REQUIRED)  # Google Highway: SIMD lanes of the renderer's shading
 # Debian installs OpenColorIO's CMake config under /usr/share/cmake.
 find_package(OpenColorIO CONFIG REQUIRED PATHS /usr/share/cmake)
 

@@ -12,7 +12,11 @@
 #include "lut/lut.h"
 #include "model/analytic.h"
 #include "model/tabulated.h"
+#include "model/parametric.h"
+#include "model/proposal.h"
 #include "render/renderer.h"
+#include "render/ggx_batch.h"
+#include "render/shading.h"
 #include "render/texture.h"
 #include "support/tensor_file.h"
 #include "test_util.h"
@@ -212,6 +216,69 @@ TEST(Render, RayStreamsAndOneRayAtATimeGiveTheSameImage) {
   EXPECT_LT(worst, 1e-3);
   EXPECT_GT(coverage, 0.5 * 40 * 30);  // the scene is in view and lit: the comparison is not of empty images
   EXPECT_GT(lit, 0.0);
+}
+
+TEST(Shading, GgxInSimdLanesEqualsOnePairAtATime) {
+  // Every term the GGX kernels hold (render/ggx_batch.h): the three Smith forms, F82-tint and the Fresnel
+  // curve, a body and a coat, from alpha 0.005 to 1.5, over pairs that include grazing and below-horizon
+  // directions and batches of every length modulo the lane count; both the AVX2 code (where the CPU has
+  // it) and the baseline, against ShadingModel's one pair at a time.
+  FresnelCurve curve;
+  for (int j = 0; j < FresnelCurve::kSize; ++j) curve.value[std::size_t(j)] = Rgb(0.9 - 0.005 * j, 0.5 + 0.004 * j, 0.2 + 0.001 * j * j / 90.0);
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const auto direction = [&] {
+    const double z = 2.0 * u(rng) - 0.95, phi = 2.0 * kPi * u(rng), s = std::sqrt(std::max(0.0, 1.0 - z * z));
+    return u(rng) < 0.05 ? glm::normalize(Vec3(std::cos(phi), std::sin(phi), 1e-7)) : Vec3(s * std::cos(phi), s * std::sin(phi), z);
+  };
+  const auto near = [](double a, double b) { return std::abs(a - b) <= 1e-12 * std::max(1.0, std::abs(b)); };
+  int cases = 0, found = 0, refused = 0;
+  for (const double alpha : {0.005, 0.3, 1.5})
+    for (const Smith smith : {Smith::masking, Smith::correlated, Smith::separable})
+      for (int variant = 0; variant < 4; ++variant)
+        for (const bool baseline : {false, true}) {
+          const bool with_curve = variant & 1, layered = variant & 2;
+          const Rgb f0(0.9, 0.6, 0.3), body = layered ? Rgb(0.3, 0.2, 0.1) : Rgb(0.0);
+          const Coat coat = layered ? Coat{0.05, 0.04} : Coat{};
+          const Ndf ndf = Ndf::isotropic(NdfType::ggx, alpha);
+          const auto brdf = with_curve ? std::make_shared<ParametricBrdf>(ndf, smith, curve, body, coat)
+                                       : std::make_shared<ParametricBrdf>(ndf, smith, f0, Rgb(0.8, 0.7, 0.5), body, coat);
+          const ShadingModel model(brdf, std::make_shared<GgxProposal>(alpha, f0, body, coat));
+          ASSERT_TRUE(model.batch_model());
+          const std::string where = "alpha " + std::to_string(alpha) + " variant " + std::to_string(variant) + (baseline ? " baseline" : "");
+          EvaluationBatch lanes, reference;
+          SampleBatch drawn, one_by_one;
+          const std::size_t n = 200 + std::size_t(cases % 17);
+          for (std::size_t k = 0; k < n; ++k) {
+            const Vec3 o = direction(), i = direction();
+            lanes.push(o, i), reference.push(o, i);
+            const double u1 = u(rng), u2 = u(rng), u3 = u(rng);
+            drawn.push(o, u1, u2, u3), one_by_one.push(o, u1, u2, u3);
+          }
+          eval_ggx_batch(*model.batch_model(), lanes, baseline), model.eval(reference, false);
+          sample_ggx_batch(*model.batch_model(), drawn, baseline), model.sample_directions(one_by_one, false);
+          for (std::size_t k = 0; k < n; ++k) {
+            const double values[4][2] = {{lanes.r[k], reference.r[k]}, {lanes.g[k], reference.g[k]}, {lanes.b[k], reference.b[k]},
+                                         {lanes.pdf[k], reference.pdf[k]}};
+            for (const auto& v : values) {
+              ASSERT_TRUE(std::isfinite(v[0])) << where << " pair " << k;
+              ASSERT_TRUE(near(v[0], v[1])) << where << " pair " << k << ": " << v[0] << " against " << v[1];
+            }
+            ASSERT_EQ(drawn.found[k], one_by_one.found[k]) << where << " sample " << k;
+            if (!one_by_one.found[k]) {
+              ++refused;
+              continue;
+            }
+            ++found;
+            for (const auto& [a, b] : {std::pair{drawn.ix[k], one_by_one.ix[k]}, {drawn.iy[k], one_by_one.iy[k]}, {drawn.iz[k], one_by_one.iz[k]}})
+              ASSERT_TRUE(near(a, b)) << where << " sample " << k << ": " << a << " against " << b;
+          }
+          ++cases;
+        }
+  EXPECT_EQ(cases, 72);
+  // Both outcomes were compared (about half the views are below the horizon).
+  EXPECT_GT(found, 5000);
+  EXPECT_GT(refused, 1000);
 }
 
 TEST(Render, BadScenesGetOneClearLine) {

@@ -25,6 +25,13 @@ class ParametricBrdf final : public Brdf {
   // already computed: h = normalize(i + o), D(h) and Lambda(o).
   Rgb eval_with(const Vec3& o, const Vec3& i, const Vec3& h, double d, double lambda_o) const;
   const Ndf& ndf() const { return ndf_; }
+  // Its terms, for the renderer's batch evaluation (render/ggx_batch.h): the Fresnel curve when the lobe
+  // uses one (else null, and the F82-tint model holds).
+  Smith smith() const { return smith_; }
+  const FresnelCurve* curve() const { return use_curve_ ? &curve_ : nullptr; }
+  const F82Tint& f82_tint() const { return f82_tint_; }
+  const Rgb& body() const { return body_; }
+  const Coat& coat() const { return coat_; }
 
  private:
   Ndf ndf_;

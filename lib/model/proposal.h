@@ -81,6 +81,7 @@ class GgxProposal final : public Proposal {
     return parts_.pdf(o, i, ggx_visible_pdf_of(o, h, d, g1_o));
   }
   double alpha() const { return alpha_; }
+  const ProposalParts& parts() const { return parts_; }
 
  private:
   double alpha_;

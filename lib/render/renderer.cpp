@@ -15,6 +15,7 @@
 #include "model/tabulated.h"
 #include "model/tabulated_anisotropic.h"
 #include "render/environment.h"
+#include "render/shading_batch.h"
 #include "render/texture.h"
 #include "render/tracer.h"
 
@@ -129,17 +130,80 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
     return Ray{cam.position, glm::normalize(forward + sx * right + sy * up)};
   };
 
-  // Shades the camera ray's hit with u[2..6]: radiance and coverage, and appends the shadow rays and their
-  // values.
-  const auto shade = [&](const Hit& hit, const Vec3& dir, const double* u, Rgb& radiance, double& alpha,
-                         std::vector<Ray>& rays, std::vector<Rgb>& values) {
+  // Shading at a hit is planned, sampled, evaluated, then finished. plan() draws the light directions of
+  // the shadow rays and queues, per material, the BRDF sample directions to draw; sample() draws them;
+  // evaluate() makes the evaluations of f (and the density) every shadow ray's value needs; finish() turns
+  // each into its shadow ray and value. The middle steps are one call per material, in SIMD lanes (GGX),
+  // for one sample on the one-ray path and for a whole tile on the stream path; a model without lanes is
+  // sampled and evaluated inside plan().
+  struct Request {
+    // none: a BRDF sample that found no direction.
+    enum class Kind : std::uint8_t { environment_light, brdf_sample, light, pending_sample, none };
+    Kind kind;
+    std::size_t material;  // whose batches
+    std::size_t slot;      // of its evaluation (pending_sample: of its direction)
+    Vec3 d;                // the shadow ray's direction and length
+    double tfar;
+    double cos_i;          // of the light direction in the local frame
+    Rgb radiance;          // what arrives along d if nothing blocks it
+    double light_pdf;      // the environment's density of d, for multiple importance sampling
+  };
+  // The value of a shadow ray if nothing blocks it, from the evaluation at its direction (cosine cos_i in
+  // the local frame), the radiance arriving along it and the environment's density there; none for a BRDF
+  // sample of zero density (as ShadingModel::sample).
+  const auto shadow_value = [](typename Request::Kind kind, const ShadingModel::Evaluation& e, double cos_i, const Rgb& radiance,
+                               double light_pdf) -> std::optional<Rgb> {
+    switch (kind) {
+      case Request::Kind::environment_light: return e.f * radiance * (cos_i * power_heuristic(light_pdf, e.pdf) / light_pdf);
+      case Request::Kind::brdf_sample:
+        if (!(e.pdf > 0.0)) return std::nullopt;
+        return e.f * (cos_i / e.pdf) * radiance * power_heuristic(e.pdf, light_pdf);
+      case Request::Kind::light: return e.f * radiance * cos_i;
+      case Request::Kind::pending_sample:
+      case Request::Kind::none: break;
+    }
+    return std::nullopt;
+  };
+  // Per sample: what shading found, the requests [first, last) it made and its shadow rays [ray_first,
+  // ray_last), made by plan() where it evaluated at once (`deferred` false) and by finish() otherwise.
+  struct Planned {
+    Rgb radiance;
+    double alpha;
+    Vec3 origin;
+    Frame frame{Vec3(0.0, 0.0, 1.0)};
+    std::size_t first, last;
+    std::size_t ray_first, ray_last;
+    bool deferred;
+  };
+  struct Shading {
+    // Per material.
+    std::vector<SampleBatch> samples;
+    std::vector<EvaluationBatch> evaluations;
+    std::vector<Request> requests;
+    std::size_t pending = 0;  // requests of kind pending_sample
+    explicit Shading(std::size_t materials) : samples(materials), evaluations(materials) {}
+    void clear() {
+      for (SampleBatch& b : samples) b.clear();
+      for (EvaluationBatch& b : evaluations) b.clear();
+      requests.clear();
+      pending = 0;
+    }
+  };
+  const double infinity = std::numeric_limits<double>::infinity();
+
+  // Plans the camera ray's hit with u[2..6].
+  const auto plan = [&](const Hit& hit, const Vec3& dir, const double* u, Shading& shading, Planned& planned, std::vector<Ray>& rays,
+                        std::vector<Rgb>& values) {
+    planned.radiance = Rgb(0.0);
+    planned.alpha = 1.0;
+    planned.first = planned.last = shading.requests.size();
+    planned.ray_first = planned.ray_last = rays.size();
+    planned.deferred = false;
     if (!hit.found()) {
-      radiance = env ? env->radiance(dir) : Rgb(0.0);
-      alpha = 0.0;
+      planned.radiance = env ? env->radiance(dir) : Rgb(0.0);
+      planned.alpha = 0.0;
       return;
     }
-    radiance = Rgb(0.0);
-    alpha = 1.0;
     const ObjectDesc& object = desc.objects[std::size_t(hit.object)];
     const int material = object_material[std::size_t(hit.object)];
     const Vec3 p = cam.position + hit.t * dir;
@@ -167,25 +231,40 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
       }
     }
     const ShadingModel& model = textured ? *textured : *materials[std::size_t(material)];
-    const Vec3 origin = p + eps * n;
-    const auto visible_if_unblocked = [&](const Vec3& d, double tfar, const Rgb& value) {
-      rays.push_back(Ray{origin, d, eps, tfar});
-      values.push_back(value);
+    // Evaluated and sampled at once, its shadow rays made here: a lobe textured here (this call owns it),
+    // and a model without SIMD lanes (queuing its work would only add the queue's cost: 6% more
+    // instructions on a LUT sphere).
+    const bool at_once = textured || !model.batch_model();
+    planned.deferred = !at_once;
+    planned.origin = p + eps * n;
+    planned.frame = frame;
+    const auto request = [&](typename Request::Kind kind, const Vec3& i, const Vec3& d, double tfar, const Rgb& radiance,
+                             double light_pdf) {
+      const bool density = kind != Request::Kind::light;
+      if (at_once) {
+        if (const auto value = shadow_value(kind, model.eval(o, i, density), i.z, radiance, light_pdf)) {
+          rays.push_back(Ray{planned.origin, d, eps, tfar});
+          values.push_back(*value);
+        }
+        return;
+      }
+      const std::size_t slot = shading.evaluations[std::size_t(material)].push(o, i, density);
+      shading.requests.push_back(Request{kind, std::size_t(material), slot, d, tfar, i.z, radiance, light_pdf});
     };
-    const double infinity = std::numeric_limits<double>::infinity();
     if (env && o.z > 0.0) {
       // Light sampling, weighted against the BRDF's proposal.
       const Environment::Sample ls = env->sample(u[0], u[1]);
       const Vec3 il = frame.to_local(ls.d);
-      if (il.z > 0.0 && ls.pdf > 0.0) {
-        const ShadingModel::Evaluation e = model.eval(o, il);
-        visible_if_unblocked(ls.d, infinity, e.f * ls.radiance * (il.z * power_heuristic(ls.pdf, e.pdf) / ls.pdf));
-      }
-      // BRDF sampling, weighted against the environment's.
-      if (const auto bs = model.sample(o, u[2], u[3], u[4])) {
-        const Vec3 d = frame.to_world(bs->i);
+      if (il.z > 0.0 && ls.pdf > 0.0) request(Request::Kind::environment_light, il, ls.d, infinity, ls.radiance, ls.pdf);
+      // BRDF sampling, weighted against the environment's: drawn by sample() unless at once.
+      if (!at_once) {
+        const std::size_t slot = shading.samples[std::size_t(material)].push(o, u[2], u[3], u[4]);
+        shading.requests.push_back(Request{Request::Kind::pending_sample, std::size_t(material), slot, Vec3(0.0), infinity, 0.0, Rgb(0.0), 0.0});
+        ++shading.pending;
+      } else if (const auto i = model.sample_direction(o, u[2], u[3], u[4])) {
+        const Vec3 d = frame.to_world(*i);
         const Environment::Sample e = env->lookup(d);
-        visible_if_unblocked(d, infinity, bs->weight * e.radiance * power_heuristic(bs->pdf, e.pdf));
+        request(Request::Kind::brdf_sample, *i, d, infinity, e.radiance, e.pdf);
       }
     }
     for (const LightDesc& light : desc.lights) {
@@ -202,8 +281,53 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
         dist *= 1.0 - 1e-6;
       }
       const Vec3 il = frame.to_local(d);
-      if (il.z > 0.0 && o.z > 0.0) visible_if_unblocked(d, dist, model.f(o, il) * e * il.z);
+      if (il.z > 0.0 && o.z > 0.0) request(Request::Kind::light, il, d, dist, e, 0.0);
     }
+    planned.last = shading.requests.size();
+    planned.ray_last = rays.size();
+  };
+  // Draws the BRDF sample directions plan() queued, and queues their evaluations: in SIMD lanes where a
+  // material has them, unless `simd` is false.
+  const auto sample = [&](const std::vector<Planned>& planned, Shading& shading, bool simd) {
+    if (shading.pending == 0) return;
+    for (std::size_t m = 0; m < materials.size(); ++m)
+      if (shading.samples[m].size() > 0) materials[m]->sample_directions(shading.samples[m], simd);
+    for (const Planned& p : planned)
+      for (std::size_t q = p.first; q < p.last; ++q) {
+        Request& r = shading.requests[q];
+        if (r.kind != Request::Kind::pending_sample) continue;
+        const SampleBatch& b = shading.samples[r.material];
+        if (!b.found[r.slot]) {
+          r.kind = Request::Kind::none;
+          continue;
+        }
+        const Vec3 i = b.i(r.slot);
+        r.kind = Request::Kind::brdf_sample;
+        r.d = p.frame.to_world(i);
+        const Environment::Sample e = env->lookup(r.d);
+        r.radiance = e.radiance, r.light_pdf = e.pdf, r.cos_i = i.z;
+        r.slot = shading.evaluations[r.material].push(b.o(r.slot), i);
+      }
+  };
+  // Evaluates what plan() and sample() queued.
+  const auto evaluate = [&](Shading& shading, bool simd) {
+    for (std::size_t m = 0; m < materials.size(); ++m)
+      if (shading.evaluations[m].size() > 0) materials[m]->eval(shading.evaluations[m], simd);
+  };
+  // Appends the shadow rays of a deferred sample and their values, in the order of its requests.
+  const auto finish = [&](Planned& planned, const Shading& shading, std::vector<Ray>& rays, std::vector<Rgb>& values) {
+    if (!planned.deferred) return;
+    planned.ray_first = rays.size();
+    for (std::size_t q = planned.first; q < planned.last; ++q) {
+      const Request& r = shading.requests[q];
+      if (r.kind == Request::Kind::none) continue;
+      const EvaluationBatch& b = shading.evaluations[r.material];
+      if (const auto value = shadow_value(r.kind, {b.f(r.slot), b.pdf[r.slot]}, r.cos_i, r.radiance, r.light_pdf)) {
+        rays.push_back(Ray{planned.origin, r.d, eps, r.tfar});
+        values.push_back(*value);
+      }
+    }
+    planned.ray_last = rays.size();
   };
   // The radiance of shadow rays [first, last) that nothing blocks, added in order.
   const auto add_unblocked = [](const std::vector<char>& blocked, const std::vector<Rgb>& values, std::size_t first,
@@ -231,40 +355,44 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
   const int passes = std::max(1, std::min(settings.passes, spp));
   const auto pixel_accum = [&](int x, int y) { return accum.data() + (std::size_t(y) * width + x) * 4; };
 
-  // One ray at a time.
+  // One ray at a time, and each evaluation one pair at a time: the reference the stream path must match.
   const auto render_tile_scalar = [&](const tbb::blocked_range2d<int>& tile, int first, int last) {
     std::vector<Ray> rays;
     std::vector<Rgb> values;
     std::vector<char> blocked;
+    Shading shading(materials.size());
+    std::vector<Planned> planned(1);
     for (int y = tile.rows().begin(); y < tile.rows().end(); ++y)
       for (int x = tile.cols().begin(); x < tile.cols().end(); ++x)
         for (int s = first; s < last; ++s) {
           double u[7];
           sample_numbers(x, y, s, u);
           const Ray ray = camera_ray(x, y, u);
-          Rgb radiance;
-          double alpha;
           rays.clear(), values.clear(), blocked.clear();
-          shade(tracer.intersect(ray), ray.dir, u + 2, radiance, alpha, rays, values);
+          shading.clear();
+          plan(tracer.intersect(ray), ray.dir, u + 2, shading, planned[0], rays, values);
+          sample(planned, shading, false);
+          evaluate(shading, false);
+          finish(planned[0], shading, rays, values);
           for (const Ray& r : rays) blocked.push_back(tracer.occluded(r));
-          add_unblocked(blocked, values, 0, rays.size(), radiance);
-          accumulate(pixel_accum(x, y), radiance, alpha);
+          add_unblocked(blocked, values, 0, rays.size(), planned[0].radiance);
+          accumulate(pixel_accum(x, y), planned[0].radiance, planned[0].alpha);
         }
   };
-  // Every pixel of the tile at once, one sample index after the other: camera rays, then shadow rays, as
-  // streams (Embree's for triangles; coherent camera rays travel together).
+  // Every pixel of the tile at once, one sample index after the other: camera rays, shading, then shadow
+  // rays, as streams (Embree's for triangles; coherent camera rays travel together) and evaluations in
+  // batches.
   const auto render_tile_streams = [&](const tbb::blocked_range2d<int>& tile, int first, int last) {
     const int tw = int(tile.cols().size()), count = tw * int(tile.rows().size());
     const std::size_t n = std::size_t(count);
     std::vector<Ray> cameras(n);
     std::vector<Hit> hits;
     std::vector<double> numbers(n * 7);
-    std::vector<Rgb> radiance(n);
-    std::vector<double> alpha(n);
-    std::vector<std::size_t> owned(n + 1);  // shadow rays of pixel k: [owned[k], owned[k + 1])
+    std::vector<Planned> planned(n);
     std::vector<Ray> rays;
     std::vector<Rgb> values;
     std::vector<char> blocked;
+    Shading shading(materials.size());
     // Each pixel's coordinates once per tile, not two integer divisions per sample.
     std::vector<int> xs(n), ys(n);
     for (int k = 0; k < count; ++k) xs[std::size_t(k)] = tile.cols().begin() + k % tw, ys[std::size_t(k)] = tile.rows().begin() + k / tw;
@@ -276,18 +404,16 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
         cameras[std::size_t(k)] = camera_ray(x, y, u);
       }
       tracer.intersect(cameras, hits, true);
+      shading.clear();
       rays.clear(), values.clear();
-      for (int k = 0; k < count; ++k) {
-        owned[std::size_t(k)] = rays.size();
-        shade(hits[std::size_t(k)], cameras[std::size_t(k)].dir, numbers.data() + std::size_t(k) * 7 + 2, radiance[std::size_t(k)],
-              alpha[std::size_t(k)], rays, values);
-      }
-      owned[std::size_t(count)] = rays.size();
+      for (std::size_t k = 0; k < n; ++k) plan(hits[k], cameras[k].dir, numbers.data() + k * 7 + 2, shading, planned[k], rays, values);
+      sample(planned, shading, true);
+      evaluate(shading, true);
+      for (Planned& p : planned) finish(p, shading, rays, values);
       tracer.occluded(rays, blocked);
-      for (int k = 0; k < count; ++k) {
-        add_unblocked(blocked, values, owned[std::size_t(k)], owned[std::size_t(k) + 1], radiance[std::size_t(k)]);
-        accumulate(pixel_accum(xs[std::size_t(k)], ys[std::size_t(k)]), radiance[std::size_t(k)],
-                   alpha[std::size_t(k)]);
+      for (std::size_t k = 0; k < n; ++k) {
+        add_unblocked(blocked, values, planned[k].ray_first, planned[k].ray_last, planned[k].radiance);
+        accumulate(pixel_accum(xs[k], ys[k]), planned[k].radiance, planned[k].alpha);
       }
     }
   };

@@ -14,6 +14,19 @@ ShadingModel::ShadingModel(std::shared_ptr<const Brdf> brdf, std::shared_ptr<con
   if (lobe && ggx && lobe_weight_ > 0.0 && lobe->ndf().type == NdfType::ggx && lobe->ndf().alpha_x == ggx->alpha() &&
       lobe->ndf().alpha_y == ggx->alpha())
     ggx_brdf_ = lobe, ggx_proposal_ = ggx;
+  // The batch kernel holds one coat for f and density alike.
+  if (ggx_brdf_ && ggx_proposal_->parts().coat.alpha == lobe->coat().alpha && ggx_proposal_->parts().coat.f0 == lobe->coat().f0) {
+    GgxBatchModel& m = batch_model_.emplace();
+    m.alpha_x = m.alpha_y = ggx->alpha();
+    m.smith = lobe->smith();
+    m.curve = lobe->curve() ? lobe->curve()->value.data() : nullptr;
+    m.f0 = lobe->f82_tint().f0, m.a = lobe->f82_tint().a;
+    m.body = lobe->body();
+    if (lobe->coat().present()) m.coat_alpha = lobe->coat().alpha, m.coat_f0 = lobe->coat().f0;
+    const ProposalParts& parts = ggx->parts();
+    m.lobe_weight = lobe_weight_, m.part_lobe = parts.lobe, m.part_body = parts.body;
+    m.part_coat = parts.coat.present() ? parts.coat_weight() : 0.0;
+  }
 }
 
 Rgb ShadingModel::f(const Vec3& o, const Vec3& i) const {
@@ -40,31 +53,48 @@ ShadingModel::Evaluation ShadingModel::eval(const Vec3& o, const Vec3& i) const 
   return {ggx_brdf_->eval_with(o, i, h, d, lambda_o), mixture(i, ggx_proposal_->pdf_with(o, i, h, d, 1.0 / (1.0 + lambda_o)))};
 }
 
-std::optional<ShadingModel::Sample> ShadingModel::sample(const Vec3& o, double u1, double u2, double u3) const {
-  if (o.z <= 0.0) return std::nullopt;
-  Vec3 i;
-  if (u3 < lobe_weight_) {
-    const auto d = proposal_->sample_direction(o, u1, u2);
-    if (!d) return std::nullopt;
-    i = *d;
-  } else {  // cosine-weighted hemisphere (concentric disc)
-    const double a = 2.0 * u1 - 1.0, b = 2.0 * u2 - 1.0;
-    double r = 0.0, phi = 0.0;
-    if (a != 0.0 || b != 0.0) {
-      if (std::abs(a) > std::abs(b)) {
-        r = a;
-        phi = 0.25 * kPi * (b / a);
-      } else {
-        r = b;
-        phi = 0.5 * kPi - 0.25 * kPi * (a / b);
-      }
-    }
-    const double x = r * std::cos(phi), y = r * std::sin(phi);
-    i = Vec3(x, y, std::sqrt(std::max(0.0, 1.0 - x * x - y * y)));
+void ShadingModel::eval(EvaluationBatch& batch, bool simd) const {
+  if (simd && batch_model_) return eval_ggx_batch(*batch_model_, batch);
+  for (std::size_t k = 0; k < batch.size(); ++k) {
+    const Evaluation e = eval(batch.o(k), batch.i(k), batch.with_pdf[k] != 0.0);
+    batch.r[k] = e.f.r, batch.g[k] = e.f.g, batch.b[k] = e.f.b, batch.pdf[k] = e.pdf;
   }
-  const Evaluation e = eval(o, i);
+}
+
+void ShadingModel::sample_directions(SampleBatch& batch, bool simd) const {
+  if (simd && batch_model_) return sample_ggx_batch(*batch_model_, batch);
+  for (std::size_t k = 0; k < batch.size(); ++k) {
+    const auto i = sample_direction(batch.o(k), batch.u1[k], batch.u2[k], batch.u3[k]);
+    batch.found[k] = i ? 1.0 : 0.0;
+    if (i) batch.ix[k] = i->x, batch.iy[k] = i->y, batch.iz[k] = i->z;
+  }
+}
+
+std::optional<ShadingModel::Sample> ShadingModel::sample(const Vec3& o, double u1, double u2, double u3) const {
+  const auto i = sample_direction(o, u1, u2, u3);
+  if (!i) return std::nullopt;
+  const Evaluation e = eval(o, *i);
   if (!(e.pdf > 0.0)) return std::nullopt;
-  return Sample{i, e.f * (i.z / e.pdf), e.pdf};
+  return Sample{*i, e.f * (i->z / e.pdf), e.pdf};
+}
+
+std::optional<Vec3> ShadingModel::sample_direction(const Vec3& o, double u1, double u2, double u3) const {
+  if (o.z <= 0.0) return std::nullopt;
+  if (u3 < lobe_weight_) return proposal_->sample_direction(o, u1, u2);
+  // cosine-weighted hemisphere (concentric disc)
+  const double a = 2.0 * u1 - 1.0, b = 2.0 * u2 - 1.0;
+  double r = 0.0, phi = 0.0;
+  if (a != 0.0 || b != 0.0) {
+    if (std::abs(a) > std::abs(b)) {
+      r = a;
+      phi = 0.25 * kPi * (b / a);
+    } else {
+      r = b;
+      phi = 0.5 * kPi - 0.25 * kPi * (a / b);
+    }
+  }
+  const double x = r * std::cos(phi), y = r * std::sin(phi);
+  return Vec3(x, y, std::sqrt(std::max(0.0, 1.0 - x * x - y * y)));
 }
 
 }  // namespace facetfit

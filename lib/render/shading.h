@@ -12,6 +12,8 @@
 #include "core/brdf.h"
 #include "model/ndf.h"
 #include "model/proposal.h"
+#include "render/ggx_batch.h"
+#include "render/shading_batch.h"
 
 namespace facetfit {
 
@@ -32,9 +34,22 @@ class ShadingModel {
     double pdf;
   };
   Evaluation eval(const Vec3& o, const Vec3& i) const;
+  // The same, or f alone (density zero) unless `with_pdf`: a measured or tabulated proposal's density costs
+  // a lookup of its own, which a light's direction does not need.
+  Evaluation eval(const Vec3& o, const Vec3& i, bool with_pdf) const { return with_pdf ? eval(o, i) : Evaluation{f(o, i), 0.0}; }
+  // eval() of every pair of the batch: in SIMD lanes for a GGX lobe (render/ggx_batch.h) unless `simd` is
+  // false, one pair at a time otherwise (the reference the lanes are tested against).
+  void eval(EvaluationBatch& batch, bool simd = true) const;
+  // The lanes' model, where this one runs in them (tests call render/ggx_batch.h with it).
+  const std::optional<GgxBatchModel>& batch_model() const { return batch_model_; }
 
   using Sample = BrdfSample;
   std::optional<Sample> sample(const Vec3& o, double u1, double u2, double u3) const;
+  // The direction sample() draws, for callers that evaluate in batches (sample() is none where its
+  // density is zero).
+  std::optional<Vec3> sample_direction(const Vec3& o, double u1, double u2, double u3) const;
+  // sample_direction() of every entry of the batch, in SIMD lanes as eval(EvaluationBatch&) is.
+  void sample_directions(SampleBatch& batch, bool simd = true) const;
 
   const Brdf& brdf() const { return *brdf_; }
 
@@ -48,6 +63,7 @@ class ShadingModel {
   // and Lambda(o) once for f and pdf. Null otherwise.
   const ParametricBrdf* ggx_brdf_ = nullptr;
   const GgxProposal* ggx_proposal_ = nullptr;
+  std::optional<GgxBatchModel> batch_model_;  // the same lobe for eval(EvaluationBatch&)
 };
 
 }  // namespace facetfit

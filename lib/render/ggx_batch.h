@@ -1,0 +1,35 @@
+// The GGX material's sampling, f(o, i) and sampling density over a batch, in SIMD lanes (Google Highway,
+// the widest target the CPU has, chosen at run time). The same model as ShadingModel's sample_direction
+// and eval with a ParametricBrdf and a GgxProposal (render/shading.h): every term is theirs, in the same
+// order, so the two agree to rounding (tests/test_render.cpp).
+#pragma once
+
+#include <cstddef>
+
+#include "core/vec.h"
+#include "model/smith.h"
+#include "render/shading_batch.h"
+
+namespace facetfit {
+
+struct GgxBatchModel {
+  double alpha_x = 0.5, alpha_y = 0.5;  // the lobe's NDF
+  Smith smith = Smith::correlated;
+  // Fresnel: the tabulated curve (90 RGB entries, one per degree of theta_d) when not null, else F82-tint
+  // Schlick(f0, mu) - a mu (1 - mu)^6, clamped at zero.
+  const Rgb* curve = nullptr;
+  Rgb f0{1.0}, a{0.0};
+  Rgb body{0.0};                        // Lambertian albedo
+  double coat_alpha = 0.0, coat_f0 = 0.0;  // a coat is present when both are > 0
+  // The density: lobe_weight of the proposal (its parts: visible normals of alpha_x, the body's cosine,
+  // the coat's visible normals), the rest cosine sampling.
+  double lobe_weight = 0.85, part_lobe = 1.0, part_body = 0.0, part_coat = 0.0;
+};
+
+// Fills the batch's r, g, b and pdf for its padded_size() pairs; zero where o or i is below the horizon.
+// `baseline`: the code for CPUs without AVX2, which the tests run too.
+void eval_ggx_batch(const GgxBatchModel& model, EvaluationBatch& batch, bool baseline = false);
+// Fills the batch's i and found for its padded_size() entries.
+void sample_ggx_batch(const GgxBatchModel& model, SampleBatch& batch, bool baseline = false);
+
+}  // namespace facetfit
