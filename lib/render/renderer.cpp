@@ -393,6 +393,10 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
     std::vector<Rgb> values;
     std::vector<char> blocked;
     Shading shading(materials.size());
+    // At most two environment rays and one per light per sample: room for all from the start, so that the
+    // first sample of a tile does not grow them piece by piece.
+    const std::size_t most = n * (2 + desc.lights.size());
+    shading.requests.reserve(most), rays.reserve(most), values.reserve(most), blocked.reserve(most);
     // Each pixel's coordinates once per tile, not two integer divisions per sample.
     std::vector<int> xs(n), ys(n);
     for (int k = 0; k < count; ++k) xs[std::size_t(k)] = tile.cols().begin() + k % tw, ys[std::size_t(k)] = tile.rows().begin() + k / tw;
