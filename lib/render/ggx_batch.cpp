@@ -82,10 +82,10 @@ void SampleGgxBatch(const GgxBatchModel& model, SampleBatch& batch) {
   const std::size_t n = batch.padded_size();
   const V zero = hn::Zero(d), one = hn::Set(d, 1.0), two = hn::Set(d, 2.0), two_pi = hn::Set(d, 2.0 * kPi);
   const V quarter_pi = hn::Set(d, 0.25 * kPi), half_pi = hn::Set(d, 0.5 * kPi);
-  const V alpha = hn::Set(d, model.alpha_x), coat_alpha = hn::Set(d, model.coat_alpha);
+  const V alpha = hn::Set(d, model.alpha), coat_alpha = hn::Set(d, model.coat.alpha);
   const V lobe_weight = hn::Set(d, model.lobe_weight), part_lobe = hn::Set(d, model.part_lobe), part_body = hn::Set(d, model.part_body);
   const V part_coat = hn::Set(d, model.part_coat);
-  const bool coat = model.coat_alpha > 0.0 && model.coat_f0 > 0.0, body = model.part_body > 0.0;
+  const bool coat = model.coat.present(), body = model.part_body > 0.0;
   for (std::size_t k = 0; k < n; k += hn::Lanes(d)) {
     const V ox = hn::LoadU(d, batch.ox.data() + k), oy = hn::LoadU(d, batch.oy.data() + k), oz = hn::LoadU(d, batch.oz.data() + k);
     const V u1 = hn::LoadU(d, batch.u1.data() + k), u2 = hn::LoadU(d, batch.u2.data() + k), u3 = hn::LoadU(d, batch.u3.data() + k);
@@ -132,14 +132,15 @@ void EvalGgxBatch(const GgxBatchModel& model, EvaluationBatch& batch) {
   const D d;
   const std::size_t n = batch.padded_size();
   const V zero = hn::Zero(d), one = hn::Set(d, 1.0), inv_pi = hn::Set(d, kInvPi);
-  const V ax2 = hn::Set(d, model.alpha_x * model.alpha_x), ay2 = hn::Set(d, model.alpha_y * model.alpha_y);
-  const V d_numerator = hn::Set(d, model.alpha_x * model.alpha_x * model.alpha_x * model.alpha_y * model.alpha_y * model.alpha_y / kPi);
-  const bool coat = model.coat_alpha > 0.0 && model.coat_f0 > 0.0;
-  const V cx2 = hn::Set(d, model.coat_alpha * model.coat_alpha);
-  const V c_numerator = hn::Set(d, model.coat_alpha * model.coat_alpha * model.coat_alpha * model.coat_alpha * model.coat_alpha *
-                                       model.coat_alpha / kPi);
-  const V f0[3] = {hn::Set(d, model.f0.r), hn::Set(d, model.f0.g), hn::Set(d, model.f0.b)};
-  const V a[3] = {hn::Set(d, model.a.r), hn::Set(d, model.a.g), hn::Set(d, model.a.b)};
+  // The NDF's terms as Ndf::D and Ndf::lambda form them (alpha_x = alpha_y), for the same rounding.
+  const double al = model.alpha, ca = model.coat.alpha;
+  const V a2 = hn::Set(d, al * al), d_numerator = hn::Set(d, al * al * al * al * al * al / kPi);
+  const bool coat = model.coat.present();
+  const V cx2 = hn::Set(d, ca * ca), c_numerator = hn::Set(d, ca * ca * ca * ca * ca * ca / kPi);
+  const Rgb& f0_rgb = model.f82_tint.f0;
+  const Rgb& a_rgb = model.f82_tint.a;
+  const V f0[3] = {hn::Set(d, f0_rgb.r), hn::Set(d, f0_rgb.g), hn::Set(d, f0_rgb.b)};
+  const V a[3] = {hn::Set(d, a_rgb.r), hn::Set(d, a_rgb.g), hn::Set(d, a_rgb.b)};
   const V body[3] = {hn::Set(d, model.body.r * kInvPi), hn::Set(d, model.body.g * kInvPi), hn::Set(d, model.body.b * kInvPi)};
   double* out[3] = {batch.r.data(), batch.g.data(), batch.b.data()};
   const hn::RebindToSigned<D> di;
@@ -151,8 +152,8 @@ void EvalGgxBatch(const GgxBatchModel& model, EvaluationBatch& batch) {
     V hx = ix + ox, hy = iy + oy, hz = iz + oz;
     const V inv_len = one / hn::Sqrt(hx * hx + hy * hy + hz * hz);
     hx = hx * inv_len, hy = hy * inv_len, hz = hz * inv_len;
-    const V dh = ndf(hx, hy, hz, ax2, ay2, d_numerator);
-    const V lambda_o = lambda(d, ox, oy, oz, ax2, ay2), lambda_i = lambda(d, ix, iy, iz, ax2, ay2);
+    const V dh = ndf(hx, hy, hz, a2, a2, d_numerator);
+    const V lambda_o = lambda(d, ox, oy, oz, a2, a2), lambda_i = lambda(d, ix, iy, iz, a2, a2);
     V g2;
     switch (model.smith) {
       case Smith::masking: g2 = one / (one + hn::Max(lambda_i, lambda_o)); break;
@@ -186,7 +187,7 @@ void EvalGgxBatch(const GgxBatchModel& model, EvaluationBatch& batch) {
     if (coat) {
       const V dc = ndf(hx, hy, hz, cx2, cx2, c_numerator);
       const V lc_o = lambda(d, ox, oy, oz, cx2, cx2), lc_i = lambda(d, ix, iy, iz, cx2, cx2);
-      const V f0c = hn::Set(d, model.coat_f0);
+      const V f0c = hn::Set(d, model.coat.f0);
       const V fc = f0c + (one - f0c) * schlick_weight(d, cos_d);
       coat_f = fc * dc * (one / (one + lc_i + lc_o)) / four_cos;
       coat_pdf = hn::IfThenElseZero(o_faces_h, (one / (one + lc_o)) * dc / (hn::Set(d, 4.0) * oz));

@@ -7,21 +7,23 @@
 #include <cstddef>
 
 #include "core/vec.h"
+#include "model/coat.h"
+#include "model/fresnel.h"
 #include "model/smith.h"
 #include "render/shading_batch.h"
 
 namespace facetfit {
 
 struct GgxBatchModel {
-  double alpha_x = 0.5, alpha_y = 0.5;  // the lobe's NDF
+  double alpha = 0.5;  // the lobe's NDF (isotropic) and its visible normals
   Smith smith = Smith::correlated;
   // Fresnel: the tabulated curve (90 RGB entries, one per degree of theta_d) when not null, else F82-tint
   // Schlick(f0, mu) - a mu (1 - mu)^6, clamped at zero.
   const Rgb* curve = nullptr;
-  Rgb f0{1.0}, a{0.0};
-  Rgb body{0.0};                        // Lambertian albedo
-  double coat_alpha = 0.0, coat_f0 = 0.0;  // a coat is present when both are > 0
-  // The density: lobe_weight of the proposal (its parts: visible normals of alpha_x, the body's cosine,
+  F82Tint f82_tint;
+  Rgb body{0.0};  // Lambertian albedo
+  Coat coat;
+  // The density: lobe_weight of the proposal (its parts: the lobe's visible normals, the body's cosine,
   // the coat's visible normals), the rest cosine sampling.
   double lobe_weight = 0.85, part_lobe = 1.0, part_body = 0.0, part_coat = 0.0;
 };

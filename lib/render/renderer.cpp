@@ -180,13 +180,11 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
     std::vector<SampleBatch> samples;
     std::vector<EvaluationBatch> evaluations;
     std::vector<Request> requests;
-    std::size_t pending = 0;  // requests of kind pending_sample
     explicit Shading(std::size_t materials) : samples(materials), evaluations(materials) {}
     void clear() {
       for (SampleBatch& b : samples) b.clear();
       for (EvaluationBatch& b : evaluations) b.clear();
       requests.clear();
-      pending = 0;
     }
   };
   const double infinity = std::numeric_limits<double>::infinity();
@@ -260,7 +258,6 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
       if (!at_once) {
         const std::size_t slot = shading.samples[std::size_t(material)].push(o, u[2], u[3], u[4]);
         shading.requests.push_back(Request{Request::Kind::pending_sample, std::size_t(material), slot, Vec3(0.0), infinity, 0.0, Rgb(0.0), 0.0});
-        ++shading.pending;
       } else if (const auto i = model.sample_direction(o, u[2], u[3], u[4])) {
         const Vec3 d = frame.to_world(*i);
         const Environment::Sample e = env->lookup(d);
@@ -289,15 +286,19 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
   // Draws the BRDF sample directions plan() queued, and queues their evaluations: in SIMD lanes where a
   // material has them, unless `simd` is false.
   const auto sample = [&](const std::vector<Planned>& planned, Shading& shading, bool simd) {
-    if (shading.pending == 0) return;
-    for (std::size_t m = 0; m < materials.size(); ++m)
-      if (shading.samples[m].size() > 0) materials[m]->sample_directions(shading.samples[m], simd);
+    bool any = false;  // a tile of models without lanes queued none: no pass over its requests
+    for (std::size_t m = 0; m < materials.size(); ++m) {
+      if (shading.samples[m].size() == 0) continue;
+      materials[m]->sample_directions(shading.samples[m], simd);
+      any = true;
+    }
+    if (!any) return;
     for (const Planned& p : planned)
       for (std::size_t q = p.first; q < p.last; ++q) {
         Request& r = shading.requests[q];
         if (r.kind != Request::Kind::pending_sample) continue;
         const SampleBatch& b = shading.samples[r.material];
-        if (!b.found[r.slot]) {
+        if (b.found[r.slot] == 0.0) {
           r.kind = Request::Kind::none;
           continue;
         }

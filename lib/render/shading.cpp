@@ -17,12 +17,12 @@ ShadingModel::ShadingModel(std::shared_ptr<const Brdf> brdf, std::shared_ptr<con
   // The batch kernel holds one coat for f and density alike.
   if (ggx_brdf_ && ggx_proposal_->parts().coat.alpha == lobe->coat().alpha && ggx_proposal_->parts().coat.f0 == lobe->coat().f0) {
     GgxBatchModel& m = batch_model_.emplace();
-    m.alpha_x = m.alpha_y = ggx->alpha();
+    m.alpha = ggx->alpha();
     m.smith = lobe->smith();
     m.curve = lobe->curve() ? lobe->curve()->value.data() : nullptr;
-    m.f0 = lobe->f82_tint().f0, m.a = lobe->f82_tint().a;
+    m.f82_tint = lobe->f82_tint();
     m.body = lobe->body();
-    if (lobe->coat().present()) m.coat_alpha = lobe->coat().alpha, m.coat_f0 = lobe->coat().f0;
+    m.coat = lobe->coat();
     const ProposalParts& parts = ggx->parts();
     m.lobe_weight = lobe_weight_, m.part_lobe = parts.lobe, m.part_body = parts.body;
     m.part_coat = parts.coat.present() ? parts.coat_weight() : 0.0;
