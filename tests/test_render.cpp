@@ -4,6 +4,7 @@
 #include <cmath>
 #include <functional>
 #include <iostream>
+#include <random>
 
 #include "fit/fit.h"
 #include "io/image_file.h"
@@ -15,6 +16,8 @@
 #include "model/parametric.h"
 #include "model/proposal.h"
 #include "render/renderer.h"
+#include "render/environment.h"
+#include "render/environment_batch.h"
 #include "render/ggx_batch.h"
 #include "render/shading.h"
 #include "render/texture.h"
@@ -172,13 +175,16 @@ TEST(Tracer, SpheresAndTrianglesTogether) {
   }
 }
 
-TEST(Render, RayStreamsAndOneRayAtATimeGiveTheSameImage) {
-  // Everything that makes shadow rays: the sky (light and BRDF samples), both kinds of light, a plane the
-  // spheres shadow, and the proposals of every kind (closed-form GGX, tabulated Beckmann, a measured table).
-  const SceneDesc s = parse_scene_text(R"({
+// Everything that makes shadow rays: an environment (light and BRDF samples: the sky's map, or a constant
+// one whose light samples the stream path draws in SIMD lanes), both kinds of light, a plane the spheres
+// shadow, and the proposals of every kind (closed-form GGX, tabulated Beckmann, a measured table).
+class RayStreams : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(RayStreams, AndOneRayAtATimeGiveTheSameImage) {
+  const SceneDesc s = parse_scene_text(std::string(R"({
     "camera": {"position": [0, 1.5, 5], "look_at": [0, 0.3, 0], "fov": 40, "width": 40, "height": 30},
     "render": {"spp": 6, "seed": 3},
-    "environment": {"builtin": "sky"},
+    "environment": )") + GetParam() + R"(,
     "lights": [{"type": "directional", "direction": [0.3, 1, 0.5], "irradiance": [2, 2, 2]},
                {"type": "point", "position": [-2, 3, 1], "intensity": [5, 4, 3]}],
     "materials": {"g": {"type": "ggx", "alpha": 0.2, "f0": [0.9, 0.6, 0.3]},
@@ -216,6 +222,33 @@ TEST(Render, RayStreamsAndOneRayAtATimeGiveTheSameImage) {
   EXPECT_LT(worst, 1e-3);
   EXPECT_GT(coverage, 0.5 * 40 * 30);  // the scene is in view and lit: the comparison is not of empty images
   EXPECT_GT(lit, 0.0);
+}
+
+INSTANTIATE_TEST_SUITE_P(Render, RayStreams, ::testing::Values(R"({"builtin": "sky"})", R"({"constant": [0.3, 0.3, 0.3]})"));
+
+TEST(Environment, ConstantLightSamplesInSimdLanesEqualSample) {
+  const Environment env = Environment::constant(Rgb(0.3));
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (const bool baseline : {false, true})
+    for (std::size_t n : {1, 3, 4, 15, 16, 17, 61}) {
+      SphereSampleBatch batch;
+      std::vector<std::pair<double, double>> numbers;
+      for (std::size_t k = 0; k < n; ++k) {
+        // The ends of [0, 1) too: the poles and phi = 0.
+        const double u1 = k == 0 ? 0.0 : k == 1 ? std::nextafter(1.0, 0.0) : u(rng), u2 = k == 2 ? 0.0 : u(rng);
+        numbers.emplace_back(u1, u2);
+        batch.push(u1, u2);
+      }
+      sample_uniform_sphere_batch(batch, baseline);
+      for (std::size_t k = 0; k < n; ++k) {
+        const Vec3 want = env.sample(numbers[k].first, numbers[k].second).d, got = batch.d(k);
+        EXPECT_NEAR(got.x, want.x, 1e-12) << k;
+        EXPECT_NEAR(got.y, want.y, 1e-15) << k;
+        EXPECT_NEAR(got.z, want.z, 1e-12) << k;
+        EXPECT_NEAR(glm::length(got), 1.0, 1e-12) << k;
+      }
+    }
 }
 
 TEST(Shading, GgxInSimdLanesEqualsOnePairAtATime) {

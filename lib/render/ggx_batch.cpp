@@ -1,8 +1,6 @@
-// Compiled once per SIMD target by Highway's foreach_target (this file includes itself): AVX2 and the
-// baseline, which the dispatch at the end picks between.
-// AVX3_DL, AVX3, SSE4, SSSE3 off (their bits in hwy/detect_targets.h, checked below), before any of
-// Highway's headers.
-#define HWY_DISABLED_TARGETS ((1LL << 7) | (1LL << 8) | (1LL << 11) | (1LL << 12))
+// Compiled once per SIMD target by Highway's foreach_target (this file includes itself): the targets of
+// render/simd_targets.h, which the dispatch at the end picks between.
+#include "render/simd_targets.h"  // before any of Highway's headers
 #undef HWY_TARGET_INCLUDE
 #define HWY_TARGET_INCLUDE "render/ggx_batch.cpp"
 #include <hwy/foreach_target.h>  // before highway.h
@@ -12,8 +10,6 @@
 
 #include "model/fresnel_curve.h"
 #include "render/ggx_batch.h"
-
-static_assert(HWY_DISABLED_TARGETS == (HWY_AVX3_DL | HWY_AVX3 | HWY_SSE4 | HWY_SSSE3), "Highway's target bits moved");
 
 HWY_BEFORE_NAMESPACE();
 namespace facetfit {
@@ -209,47 +205,18 @@ void EvalGgxBatch(const GgxBatchModel& model, EvaluationBatch& batch) {
 HWY_AFTER_NAMESPACE();
 
 #if HWY_ONCE
-#if HWY_ARCH_X86
-#include <cpuid.h>
-#endif
-
 namespace facetfit {
-
-namespace {
-
-// Highway's own run-time dispatch (HWY_DYNAMIC_DISPATCH) lives in libhwy.so, whose static initializer
-// times a clock in every process that loads it: 4 ms more for every command's start-up (perf stat).
-// With two targets the CPU's features pick directly: AVX2 where the CPU has every feature Highway
-// compiles its AVX2 code for, the baseline elsewhere.
-bool has_avx2() {
-#if HWY_ARCH_X86 && (HWY_TARGETS & HWY_AVX2)
-  static const bool yes = [] {
-    __builtin_cpu_init();
-    unsigned eax = 0, ebx = 0, ecx = 0, edx = 0;  // F16C from CPUID itself: clang's builtin lacks its name
-    const bool f16c = __get_cpuid(1, &eax, &ebx, &ecx, &edx) && (ecx & bit_F16C);
-    return f16c && __builtin_cpu_supports("ssse3") && __builtin_cpu_supports("sse4.1") && __builtin_cpu_supports("sse4.2") &&
-           __builtin_cpu_supports("pclmul") && __builtin_cpu_supports("aes") && __builtin_cpu_supports("avx") &&
-           __builtin_cpu_supports("avx2") && __builtin_cpu_supports("bmi") && __builtin_cpu_supports("bmi2") &&
-           __builtin_cpu_supports("fma");
-  }();
-  return yes;
-#else
-  return false;
-#endif
-}
-
-}  // namespace
 
 void eval_ggx_batch(const GgxBatchModel& model, EvaluationBatch& batch, bool baseline) {
 #if HWY_TARGETS & HWY_AVX2
-  if (!baseline && has_avx2()) return N_AVX2::EvalGgxBatch(model, batch);
+  if (!baseline && cpu_has_avx2()) return N_AVX2::EvalGgxBatch(model, batch);
 #endif
   HWY_STATIC_DISPATCH(EvalGgxBatch)(model, batch);
 }
 
 void sample_ggx_batch(const GgxBatchModel& model, SampleBatch& batch, bool baseline) {
 #if HWY_TARGETS & HWY_AVX2
-  if (!baseline && has_avx2()) return N_AVX2::SampleGgxBatch(model, batch);
+  if (!baseline && cpu_has_avx2()) return N_AVX2::SampleGgxBatch(model, batch);
 #endif
   HWY_STATIC_DISPATCH(SampleGgxBatch)(model, batch);
 }

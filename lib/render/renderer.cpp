@@ -15,6 +15,7 @@
 #include "model/tabulated.h"
 #include "model/tabulated_anisotropic.h"
 #include "render/environment.h"
+#include "render/environment_batch.h"
 #include "render/shading_batch.h"
 #include "render/texture.h"
 #include "render/tracer.h"
@@ -124,10 +125,12 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
   // nothing blocks them; the shadow rays. The one-ray-at-a-time path runs them per sample, the stream
   // path per tile, through the tracer's streams. Each sample draws its seven numbers before its camera ray
   // and sums its shadow rays in the same order either way, so both give the same image.
-  const auto camera_ray = [&](int x, int y, const double u[2]) {
+  // Written into its place, not copied in (see Ray in render/tracer.h).
+  const auto camera_ray = [&](int x, int y, const double u[2], Ray& ray) {
     const double sx = (2.0 * (x + u[0]) / width - 1.0) * tan_half * aspect;
     const double sy = (1.0 - 2.0 * (y + u[1]) / height) * tan_half;
-    return Ray{cam.position, glm::normalize(forward + sx * right + sy * up)};
+    ray.origin = cam.position, ray.dir = glm::normalize(forward + sx * right + sy * up);
+    ray.tnear = 0.0, ray.tfar = std::numeric_limits<double>::infinity();
   };
 
   // Shading at a hit is planned, sampled, evaluated, then finished. plan() draws the light directions of
@@ -140,13 +143,16 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
     // none: a BRDF sample that found no direction.
     enum class Kind : std::uint8_t { environment_light, brdf_sample, light, pending_sample, none };
     Kind kind;
-    std::size_t material;  // whose batches
-    std::size_t slot;      // of its evaluation (pending_sample: of its direction)
-    Vec3 d;                // the shadow ray's direction and length
+    std::uint32_t material;  // whose batches
+    std::size_t slot;        // of its evaluation (pending_sample: of its direction)
+    Vec3 d;                  // the shadow ray's direction and length
     double tfar;
-    double cos_i;          // of the light direction in the local frame
-    Rgb radiance;          // what arrives along d if nothing blocks it
-    double light_pdf;      // the environment's density of d, for multiple importance sampling
+    double cos_i;            // of the light direction in the local frame
+    Rgb radiance;            // what arrives along d if nothing blocks it
+    double light_pdf;        // the environment's density of d, for multiple importance sampling
+    // Built in place (emplace_back), as a Ray (render/tracer.h).
+    Request(Kind k, int m, std::size_t s, const Vec3& direction, double length, double cosine, const Rgb& arriving, double density)
+        : kind(k), material(std::uint32_t(m)), slot(s), d(direction), tfar(length), cos_i(cosine), radiance(arriving), light_pdf(density) {}
   };
   // The value of a shadow ray if nothing blocks it, from the evaluation at its direction (cosine cos_i in
   // the local frame), the radiance arriving along it and the environment's density there; none for a BRDF
@@ -180,6 +186,10 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
     std::vector<SampleBatch> samples;
     std::vector<EvaluationBatch> evaluations;
     std::vector<Request> requests;
+    // plan()'s textured lobe and model, while it shades one hit.
+    std::optional<TabulatedMicrofacet> textured_lobe;
+    std::optional<TabulatedAnisotropic> textured_anisotropic;
+    std::optional<ShadingModel> textured;
     explicit Shading(std::size_t materials) : samples(materials), evaluations(materials) {}
     void clear() {
       for (SampleBatch& b : samples) b.clear();
@@ -189,9 +199,10 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
   };
   const double infinity = std::numeric_limits<double>::infinity();
 
-  // Plans the camera ray's hit with u[2..6].
-  const auto plan = [&](const Hit& hit, const Vec3& dir, const double* u, Shading& shading, Planned& planned, std::vector<Ray>& rays,
-                        std::vector<Rgb>& values) {
+  // Plans the camera ray's hit with u[2..6]; `light_d`, where not null, is the environment's sample drawn
+  // with u[2..3] beforehand (a constant environment's, in SIMD lanes on the stream path).
+  const auto plan = [&](const Hit& hit, const Vec3& dir, const double* u, const Vec3* light_d, Shading& shading, Planned& planned,
+                        std::vector<Ray>& rays, std::vector<Rgb>& values) {
     planned.radiance = Rgb(0.0);
     planned.alpha = 1.0;
     planned.first = planned.last = shading.requests.size();
@@ -210,11 +221,13 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
     const std::optional<Vec3>& tangent = tangents[std::size_t(material)];
     const Frame frame = tangent ? Frame(n, *tangent) : Frame(n);
     const Vec3 o = frame.to_local(-dir);
-    // A stretch_texture reshapes the lobe here: a copy sharing its tables, owned by this call (the
-    // shading model refers to it without owning it).
-    std::optional<TabulatedMicrofacet> textured_lobe;
-    std::optional<TabulatedAnisotropic> textured_anisotropic;
-    std::optional<ShadingModel> textured;
+    // A stretch_texture reshapes the lobe here: a copy sharing its tables, held in the tile's scratch
+    // space (the shading model refers to it without owning it). Not a local: GCC cleared the empty
+    // optionals' 216 bytes at every hit (perf: 8% of plan() on a GGX sphere).
+    std::optional<TabulatedMicrofacet>& textured_lobe = shading.textured_lobe;
+    std::optional<TabulatedAnisotropic>& textured_anisotropic = shading.textured_anisotropic;
+    std::optional<ShadingModel>& textured = shading.textured;
+    textured.reset();
     if (const auto& st = stretch_textures[std::size_t(material)]) {
       const Rgb scale = st->texture.lookup(texture_coordinates(object, p));
       const auto clamped = [](double a, double b) { return clamp(a * b, Stretch::kMin, Stretch::kMax); };
@@ -241,23 +254,23 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
       const bool density = kind != Request::Kind::light;
       if (at_once) {
         if (const auto value = shadow_value(kind, model.eval(o, i, density), i.z, radiance, light_pdf)) {
-          rays.push_back(Ray{planned.origin, d, eps, tfar});
+          rays.emplace_back(planned.origin, d, eps, tfar);
           values.push_back(*value);
         }
         return;
       }
       const std::size_t slot = shading.evaluations[std::size_t(material)].push(o, i, density);
-      shading.requests.push_back(Request{kind, std::size_t(material), slot, d, tfar, i.z, radiance, light_pdf});
+      shading.requests.emplace_back(kind, material, slot, d, tfar, i.z, radiance, light_pdf);
     };
     if (env && o.z > 0.0) {
       // Light sampling, weighted against the BRDF's proposal.
-      const Environment::Sample ls = env->sample(u[0], u[1]);
+      const Environment::Sample ls = light_d ? env->lookup(*light_d) : env->sample(u[0], u[1]);
       const Vec3 il = frame.to_local(ls.d);
       if (il.z > 0.0 && ls.pdf > 0.0) request(Request::Kind::environment_light, il, ls.d, infinity, ls.radiance, ls.pdf);
       // BRDF sampling, weighted against the environment's: drawn by sample() unless at once.
       if (!at_once) {
         const std::size_t slot = shading.samples[std::size_t(material)].push(o, u[2], u[3], u[4]);
-        shading.requests.push_back(Request{Request::Kind::pending_sample, std::size_t(material), slot, Vec3(0.0), infinity, 0.0, Rgb(0.0), 0.0});
+        shading.requests.emplace_back(Request::Kind::pending_sample, material, slot, Vec3(0.0), infinity, 0.0, Rgb(0.0), 0.0);
       } else if (const auto i = model.sample_direction(o, u[2], u[3], u[4])) {
         const Vec3 d = frame.to_world(*i);
         const Environment::Sample e = env->lookup(d);
@@ -324,7 +337,7 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
       if (r.kind == Request::Kind::none) continue;
       const EvaluationBatch& b = shading.evaluations[r.material];
       if (const auto value = shadow_value(r.kind, {b.f(r.slot), b.pdf[r.slot]}, r.cos_i, r.radiance, r.light_pdf)) {
-        rays.push_back(Ray{planned.origin, r.d, eps, r.tfar});
+        rays.emplace_back(planned.origin, r.d, eps, r.tfar);
         values.push_back(*value);
       }
     }
@@ -368,10 +381,11 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
         for (int s = first; s < last; ++s) {
           double u[7];
           sample_numbers(x, y, s, u);
-          const Ray ray = camera_ray(x, y, u);
+          Ray ray;
+          camera_ray(x, y, u, ray);
           rays.clear(), values.clear(), blocked.clear();
           shading.clear();
-          plan(tracer.intersect(ray), ray.dir, u + 2, shading, planned[0], rays, values);
+          plan(tracer.intersect(ray), ray.dir, u + 2, nullptr, shading, planned[0], rays, values);
           sample(planned, shading, false);
           evaluate(shading, false);
           finish(planned[0], shading, rays, values);
@@ -394,6 +408,9 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
     std::vector<Rgb> values;
     std::vector<char> blocked;
     Shading shading(materials.size());
+    // A constant environment's light samples, drawn in SIMD lanes for the whole tile.
+    const bool sphere_lanes = env && env->is_constant();
+    SphereSampleBatch light_samples;
     // At most two environment rays and one per light per sample: room for all from the start, so that the
     // first sample of a tile does not grow them piece by piece.
     const std::size_t most = n * (2 + desc.lights.size());
@@ -406,12 +423,20 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
         const int x = xs[std::size_t(k)], y = ys[std::size_t(k)];
         double* u = numbers.data() + std::size_t(k) * 7;
         sample_numbers(x, y, s, u);
-        cameras[std::size_t(k)] = camera_ray(x, y, u);
+        camera_ray(x, y, u, cameras[std::size_t(k)]);
       }
       tracer.intersect(cameras, hits, true);
+      if (sphere_lanes) {
+        light_samples.clear();
+        for (std::size_t k = 0; k < n; ++k) light_samples.push(numbers[k * 7 + 2], numbers[k * 7 + 3]);
+        sample_uniform_sphere_batch(light_samples);
+      }
       shading.clear();
       rays.clear(), values.clear();
-      for (std::size_t k = 0; k < n; ++k) plan(hits[k], cameras[k].dir, numbers.data() + k * 7 + 2, shading, planned[k], rays, values);
+      for (std::size_t k = 0; k < n; ++k) {
+        const Vec3 light_d = sphere_lanes ? light_samples.d(k) : Vec3(0.0);
+        plan(hits[k], cameras[k].dir, numbers.data() + k * 7 + 2, sphere_lanes ? &light_d : nullptr, shading, planned[k], rays, values);
+      }
       sample(planned, shading, true);
       evaluate(shading, true);
       for (Planned& p : planned) finish(p, shading, rays, values);

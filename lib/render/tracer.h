@@ -20,6 +20,12 @@ struct Ray {
   Vec3 origin, dir;
   double tnear = 0.0;
   double tfar = std::numeric_limits<double>::infinity();
+  Ray() = default;
+  // A constructor rather than an aggregate, so that a vector builds a ray in place (emplace_back): a ray
+  // built whole and copied in is written in 8-byte and read in 16-byte pieces, which stalls store
+  // forwarding (perf: 11% of a GGX render on one load).
+  Ray(const Vec3& o, const Vec3& d, double t0 = 0.0, double t1 = std::numeric_limits<double>::infinity())
+      : origin(o), dir(d), tnear(t0), tfar(t1) {}
 };
 
 struct Hit {

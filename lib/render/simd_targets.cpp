@@ -1,0 +1,30 @@
+#include "render/simd_targets.h"
+
+#include <hwy/highway.h>
+
+#if HWY_ARCH_X86
+#include <cpuid.h>
+#endif
+
+static_assert(HWY_DISABLED_TARGETS == (HWY_AVX3_DL | HWY_AVX3 | HWY_SSE4 | HWY_SSSE3), "Highway's target bits moved");
+
+namespace facetfit {
+
+bool cpu_has_avx2() {
+#if HWY_ARCH_X86 && (HWY_TARGETS & HWY_AVX2)
+  static const bool yes = [] {
+    __builtin_cpu_init();
+    unsigned eax = 0, ebx = 0, ecx = 0, edx = 0;  // F16C from CPUID itself: clang's builtin lacks its name
+    const bool f16c = __get_cpuid(1, &eax, &ebx, &ecx, &edx) && (ecx & bit_F16C);
+    return f16c && __builtin_cpu_supports("ssse3") && __builtin_cpu_supports("sse4.1") && __builtin_cpu_supports("sse4.2") &&
+           __builtin_cpu_supports("pclmul") && __builtin_cpu_supports("aes") && __builtin_cpu_supports("avx") &&
+           __builtin_cpu_supports("avx2") && __builtin_cpu_supports("bmi") && __builtin_cpu_supports("bmi2") &&
+           __builtin_cpu_supports("fma");
+  }();
+  return yes;
+#else
+  return false;
+#endif
+}
+
+}  // namespace facetfit
