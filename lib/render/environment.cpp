@@ -111,8 +111,7 @@ Environment::Sample Environment::at_pixel(const Vec3& d, int pixel) const {
   return {d, Rgb(p[0], p[1], p[2]), pdf};
 }
 
-Environment::Sample Environment::lookup(const Vec3& d) const {
-  if (is_constant()) return {d, constant_, 1.0 / (4.0 * kPi)};
+Environment::Sample Environment::lookup_map(const Vec3& d) const {
   int x, y;
   return at_pixel(d, pixel_of(d, &x, &y));
 }

@@ -35,8 +35,12 @@ class Environment {
     Rgb radiance;
     double pdf;  // per steradian
   };
-  // Radiance and pdf of a direction with one pixel lookup (the d of the result is d).
-  Sample lookup(const Vec3& d) const;
+  // Radiance and pdf of a direction with one pixel lookup (the d of the result is d). Inline for the
+  // constant environment, which every BRDF sample of a sphere under it asks.
+  Sample lookup(const Vec3& d) const {
+    if (is_constant()) return {d, constant_, 1.0 / (4.0 * kPi)};
+    return lookup_map(d);
+  }
   Sample sample(double u1, double u2) const;
   double pdf(const Vec3& d) const;
   bool is_constant() const { return width_ == 0; }
@@ -48,6 +52,7 @@ class Environment {
   void build_distribution();
   int pixel_of(const Vec3& d, int* x, int* y) const;
   Sample at_pixel(const Vec3& d, int pixel) const;
+  Sample lookup_map(const Vec3& d) const;
 
   int width_ = 0, height_ = 0;  // 0: constant
   Rgb constant_{0.0};
