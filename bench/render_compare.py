@@ -248,10 +248,12 @@ def main(facetfit, mitsuba_python, dst, rgl=None):
                   "is its render time plus this.\n" % (RUNS, startup[0], startup[1], startup[2]))
         out.write("\n## Where the time goes\n\n`perf record` of one facetfit render (64 spp, whole process), self time by\n"
                   "library and symbol (the sphere is intersected in closed form, render/tracer.h; Embree traces triangles only).\n"
-                  "A tile's samples are shaded in four steps (render/renderer.cpp): `plan` (the frame, light directions, queues),\n"
-                  "then BRDF sampling and evaluation in one call per material, in SIMD lanes for GGX (`N_AVX2::SampleGgxBatch`,\n"
-                  "`N_AVX2::EvalGgxBatch`, render/ggx_batch.h), then `finish` (shadow rays and their values) in the tile\n"
-                  "loop; a tabulated or measured model is still sampled and evaluated one sample at a time inside `plan`.\n")
+                  "A tile's samples are shaded in steps (render/renderer.cpp): camera rays, a constant environment's light\n"
+                  "samples in SIMD lanes (`N_AVX2::SampleUniformSphereBatch`, render/environment_batch.h) and each hit's frame\n"
+                  "(`place`) in the tile loop; `plan` (light directions, queues); BRDF sampling and evaluation in one call per\n"
+                  "material, in SIMD lanes for GGX (`N_AVX2::SampleGgxBatch`, `N_AVX2::EvalGgxBatch`, render/ggx_batch.h);\n"
+                  "then `finish` (shadow rays and their values) in the tile loop. A tabulated or measured model is still\n"
+                  "sampled and evaluated one sample at a time inside `plan`.\n")
         for label, (rows_, libraries) in profiles:
             out.write("\n%s, by library: %s.\n\n| self | library | symbol |\n|---|---|---|\n" % (
                 label, ", ".join("%s %.0f%%" % (dso, pct) for dso, pct in libraries) or "n/a"))
