@@ -125,9 +125,9 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
   // nothing blocks them; the shadow rays. The one-ray-at-a-time path runs them per sample, the stream
   // path per tile, through the tracer's streams. Each sample draws its seven numbers before its camera ray
   // and sums its shadow rays in the same order either way, so both give the same image.
-  // Written into its place, not copied in (see Ray in render/tracer.h).
   // Products, not quotients: a division per axis and sample waited on the last (perf).
   const double to_sx = 2.0 / width, to_sy = 2.0 / height;
+  // Written into its place, not copied in (see Ray in render/tracer.h).
   const auto camera_ray = [&](int x, int y, const double u[2], Ray& ray) {
     const double sx = ((x + u[0]) * to_sx - 1.0) * tan_half * aspect;
     const double sy = (1.0 - (y + u[1]) * to_sy) * tan_half;
