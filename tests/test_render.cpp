@@ -658,10 +658,7 @@ TEST(Texture, BilinearBetweenPixelCentresWithVFromTheBottomAndBothAxesPeriodic) 
 }  // namespace
 }  // namespace facetfit
 
-#include <random>
-
 #include "core/memory_budget.h"
-#include "render/environment.h"
 
 namespace facetfit {
 namespace {

@@ -285,9 +285,8 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
         const std::size_t slot = shading.samples[std::size_t(material)].push(o, u[2], u[3], u[4]);
         shading.requests.emplace_back(Request::Kind::pending_sample, material, slot, Vec3(0.0), infinity, 0.0, Rgb(0.0), 0.0);
       } else if (const auto i = model.sample_direction(o, u[2], u[3], u[4])) {
-        const Vec3 d = frame.to_world(*i);
-        const Environment::Sample e = env->lookup(d);
-        request(Request::Kind::brdf_sample, *i, d, infinity, e.radiance, e.pdf);
+        const Environment::Sample e = env->lookup(frame.to_world(*i));  // its d: the world direction
+        request(Request::Kind::brdf_sample, *i, e.d, infinity, e.radiance, e.pdf);
       }
     }
     for (const LightDesc& light : desc.lights) {
@@ -330,9 +329,8 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
         }
         const Vec3 i = b.i(r.slot);
         r.kind = Request::Kind::brdf_sample;
-        r.d = p.frame.to_world(i);
-        const Environment::Sample e = env->lookup(r.d);
-        r.radiance = e.radiance, r.light_pdf = e.pdf, r.cos_i = i.z;
+        const Environment::Sample e = env->lookup(p.frame.to_world(i));
+        r.d = e.d, r.radiance = e.radiance, r.light_pdf = e.pdf, r.cos_i = i.z;
         r.slot = shading.evaluations[r.material].push(b.o(r.slot), i);
       }
   };
