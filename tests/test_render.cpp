@@ -20,6 +20,7 @@
 #include "render/environment_batch.h"
 #include "render/ggx_batch.h"
 #include "render/shading.h"
+#include "render/tabulated_batch.h"
 #include "render/texture.h"
 #include "support/tensor_file.h"
 #include "test_util.h"
@@ -177,10 +178,12 @@ TEST(Tracer, SpheresAndTrianglesTogether) {
 
 // Everything that makes shadow rays: an environment (light and BRDF samples: the sky's map, or a constant
 // one whose light samples the stream path draws in SIMD lanes), both kinds of light, a plane the spheres
-// shadow, and the proposals of every kind (closed-form GGX, tabulated Beckmann, a measured table).
+// shadow, and the proposals of every kind (closed-form GGX, tabulated Beckmann, a measured table, a LUT).
 class RayStreams : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(RayStreams, AndOneRayAtATimeGiveTheSameImage) {
+  test::TempDir dir;
+  write_gold_lut(dir.file("gold.exr"));
   const SceneDesc s = parse_scene_text(std::string(R"({
     "camera": {"position": [0, 1.5, 5], "look_at": [0, 0.3, 0], "fov": 40, "width": 40, "height": 30},
     "render": {"spp": 6, "seed": 3},
@@ -190,10 +193,12 @@ TEST_P(RayStreams, AndOneRayAtATimeGiveTheSameImage) {
     "materials": {"g": {"type": "ggx", "alpha": 0.2, "f0": [0.9, 0.6, 0.3]},
                   "b": {"type": "beckmann", "alpha": 0.4},
                   "m": {"type": "measured", "file": "builtin:red-plastic"},
+                  "l": {"type": "lut", "file": ")" + dir.file("gold.exr") + R"("},
                   "floor": {"type": "lambert", "albedo": [0.5, 0.5, 0.5]}},
     "objects": [{"type": "sphere", "center": [-1.2, 0.5, 0], "radius": 0.5, "material": "g"},
                 {"type": "sphere", "center": [0, 0.5, 0], "radius": 0.5, "material": "b"},
                 {"type": "sphere", "center": [1.2, 0.5, 0], "radius": 0.5, "material": "m"},
+                {"type": "sphere", "center": [-0.6, 1.5, -0.8], "radius": 0.4, "material": "l"},
                 {"type": "plane", "point": [0, 0, 0], "normal": [0, 1, 0], "size": 8, "material": "floor"}]
   })", "streams.json", ".");
   RenderSettings one_ray;
@@ -312,6 +317,86 @@ TEST(Shading, GgxInSimdLanesEqualsOnePairAtATime) {
   // Both outcomes were compared (about half the views are below the horizon).
   EXPECT_GT(found, 5000);
   EXPECT_GT(refused, 1000);
+}
+
+TEST(Shading, TabulatedInSimdLanesEqualsOnePairAtATime) {
+  // Every term the tabulated kernel holds (render/tabulated_batch.h): D's spline from a peak a node wide to
+  // a flat lobe (GGX 0.005 to 1.5 and Beckmann tabulated), G1's table under the three Smith forms, the
+  // Fresnel curve, a body and a coat, the visible normals' density at every view slice and their draw (the
+  // slice, the interval's bisection, the azimuth's Newton steps); pairs that include grazing and
+  // below-horizon directions, batches of every length modulo the lane count, both the AVX2 code (where the
+  // CPU has it) and the baseline, against ShadingModel's one pair at a time.
+  FresnelCurve curve;
+  for (int j = 0; j < FresnelCurve::kSize; ++j) curve.value[std::size_t(j)] = Rgb(0.9 - 0.005 * j, 0.5 + 0.004 * j, 0.2 + 0.001 * j * j / 90.0);
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const auto direction = [&] {
+    const double z = 2.0 * u(rng) - 0.95, phi = 2.0 * kPi * u(rng), s = std::sqrt(std::max(0.0, 1.0 - z * z));
+    return u(rng) < 0.05 ? glm::normalize(Vec3(std::cos(phi), std::sin(phi), 1e-7)) : Vec3(s * std::cos(phi), s * std::sin(phi), z);
+  };
+  // Relative to the value (or to 1e-3 of the batch's largest), 1e-10 rather than the GGX kernel's 1e-12:
+  // theta_h = acos(h.z) turns the last bit of h.z (which the lanes may round otherwise: fused multiply-adds)
+  // into 1e-16 / theta_h of theta_h, which a peak a node wide (alpha 0.005: d ln D / d theta_h up to ~400)
+  // turns into up to 3e-11 of D.
+  // A drawn direction within 1e-7, what a float ray direction resolves: the azimuth's Newton steps stop
+  // there (model/tabulated.cpp), and near the end of its range, where the density vanishes, the CDF's
+  // rounding alone moves the root by ~1e-9.
+  int cases = 0, compared = 0, found = 0;
+  double worst = 0.0, sample_worst = 0.0;
+  for (const auto& [type, alpha] : {std::pair{NdfType::ggx, 0.005}, {NdfType::ggx, 0.3}, {NdfType::ggx, 1.5}, {NdfType::beckmann, 0.3}})
+    for (const Smith smith : {Smith::masking, Smith::correlated, Smith::separable})
+      for (const bool layered : {false, true})
+        for (const bool baseline : {false, true}) {
+          MicrofacetTables tables{tabulate_ndf(Ndf::isotropic(type, alpha)), smith, curve, layered ? Rgb(0.3, 0.2, 0.1) : Rgb(0.0),
+                                  layered ? Coat{0.05, 0.04} : Coat{}};
+          const auto lobe = std::make_shared<TabulatedMicrofacet>(tables);
+          const ShadingModel model(lobe, lobe);
+          ASSERT_TRUE(model.tabulated_batch_model());
+          ASSERT_TRUE(model.has_lanes());
+          const std::string where = "alpha " + std::to_string(alpha) + (layered ? " layered" : "") + (baseline ? " baseline" : "");
+          EvaluationBatch lanes, reference;
+          SampleBatch drawn, one_by_one;
+          const std::size_t n = 300 + std::size_t(cases % 17);
+          for (std::size_t k = 0; k < n; ++k) {
+            Vec3 o = direction(), i = direction();
+            if (k % 3 == 0) i = glm::normalize(Vec3(-o.x, -o.y, o.z) + 0.02 * direction());  // near the peak
+            lanes.push(o, i), reference.push(o, i);
+            const double u1 = u(rng), u2 = u(rng), u3 = u(rng);
+            drawn.push(o, u1, u2, u3), one_by_one.push(o, u1, u2, u3);
+          }
+          eval_tabulated_batch(*model.tabulated_batch_model(), lanes, baseline), model.eval(reference, false);
+          sample_tabulated_batch(*model.tabulated_batch_model(), drawn, baseline), model.sample_directions(one_by_one, false);
+          for (std::size_t k = 0; k < n; ++k) {
+            ASSERT_EQ(drawn.found[k], one_by_one.found[k]) << where << " sample " << k;
+            if (!one_by_one.found[k]) continue;
+            ++found;
+            const Vec3 a = drawn.i(k), b = one_by_one.i(k);
+            sample_worst = std::max(sample_worst, glm::length(a - b));
+            ASSERT_LE(glm::length(a - b), 1e-7) << where << " sample " << k << ": " << a.x << " " << a.y << " " << a.z << " against "
+                                                << b.x << " " << b.y << " " << b.z;
+          }
+          double largest[4] = {};
+          for (std::size_t k = 0; k < n; ++k)
+            for (const auto& [c, v] : {std::pair{0, reference.r[k]}, {1, reference.g[k]}, {2, reference.b[k]}, {3, reference.pdf[k]}})
+              largest[c] = std::max(largest[c], std::abs(v));
+          for (std::size_t k = 0; k < n; ++k) {
+            const double values[4][2] = {{lanes.r[k], reference.r[k]}, {lanes.g[k], reference.g[k]}, {lanes.b[k], reference.b[k]},
+                                         {lanes.pdf[k], reference.pdf[k]}};
+            for (int c = 0; c < 4; ++c) {
+              const double a = values[c][0], b = values[c][1];
+              ASSERT_TRUE(std::isfinite(a)) << where << " pair " << k;
+              const double scale = std::max(std::abs(b), 1e-3 * largest[c]);
+              ASSERT_LE(std::abs(a - b), 1e-10 * scale) << where << " pair " << k << " value " << c << ": " << a << " against " << b;
+              if (scale > 0.0) worst = std::max(worst, std::abs(a - b) / scale);
+              compared += b != 0.0;
+            }
+          }
+          ++cases;
+        }
+  std::printf("[ lanes ] worst relative difference of f and pdf %.2e, of a drawn direction %.2e\n", worst, sample_worst);
+  EXPECT_EQ(cases, 48);
+  EXPECT_GT(compared, 20000);  // about half the pairs are above the horizon, four values each
+  EXPECT_GT(found, 5000);
 }
 
 TEST(Render, BadScenesGetOneClearLine) {

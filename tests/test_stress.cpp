@@ -12,9 +12,11 @@
 #include "model/analytic.h"
 #include "model/parametric.h"
 #include "model/proposal.h"
+#include "model/tabulated.h"
 #include "render/environment_batch.h"
 #include "render/ggx_batch.h"
 #include "render/shading.h"
+#include "render/tabulated_batch.h"
 #include "test_util.h"
 
 namespace facetfit {
@@ -216,6 +218,36 @@ TEST(GgxLanes, EveryBatchLengthAndDegenerateDirectionStayFiniteAndInBounds) {
             if (s.found[k] != 0.0) {
               EXPECT_GT(s.oz[k], 0.0);
               for (const double v : {s.ix[k], s.iy[k], s.iz[k]}) ASSERT_TRUE(std::isfinite(v)) << "alpha " << alpha << " sample " << k;
+            }
+          }
+        }
+    }
+}
+
+TEST(TabulatedLanes, EveryBatchLengthAndDegenerateDirectionStayFiniteAndInBounds) {
+  // As above for a LUT's kernel (render/tabulated_batch.h), whose grid lookups gather: an index past a
+  // table shows under the sanitizers. The NDF from a peak a node wide to a flat one, and all zero (no facet
+  // visible: sampling tables uniform, sigma zero).
+  const Vec3 degenerate[] = {{0, 0, 1}, {1, 0, 0}, {0, -1, 0}, {0.6, 0, 0.8}, {-0.6, 0, -0.8}, {0, 0, -1}, {1e-300, 0, 1}, {0.9999999, 0, 1e-12}};
+  FresnelCurve curve;
+  for (auto& v : curve.value) v = Rgb(0.5, 0.6, 0.7);
+  for (const double alpha : {0.0, 0.005, 1.5})
+    for (const bool layered : {false, true}) {
+      TabulatedNdf ndf = tabulate_ndf(Ndf::isotropic(NdfType::ggx, alpha > 0.0 ? alpha : 0.3));
+      if (alpha == 0.0) std::fill(ndf.ndf.begin(), ndf.ndf.end(), 0.0), std::fill(ndf.sigma.begin(), ndf.sigma.end(), 0.0);
+      const auto lobe = std::make_shared<TabulatedMicrofacet>(
+          MicrofacetTables{ndf, Smith::correlated, curve, layered ? Rgb(0.2) : Rgb(0.0), layered ? Coat{0.005, 0.04} : Coat{}});
+      const ShadingModel model(lobe, lobe);
+      ASSERT_TRUE(model.tabulated_batch_model());
+      for (std::size_t n = 0; n <= 40; ++n)
+        for (const bool baseline : {false, true}) {
+          EvaluationBatch e;
+          for (std::size_t k = 0; k < n; ++k) e.push(glm::normalize(degenerate[k % 8]), glm::normalize(degenerate[(k * 3 + 1) % 8]));
+          eval_tabulated_batch(*model.tabulated_batch_model(), e, baseline);
+          for (std::size_t k = 0; k < n; ++k) {
+            for (const double v : {e.r[k], e.g[k], e.b[k], e.pdf[k]}) ASSERT_TRUE(std::isfinite(v)) << "alpha " << alpha << " pair " << k;
+            if (!(e.oz[k] > 0.0 && e.iz[k] > 0.0)) {
+              EXPECT_EQ(e.pdf[k], 0.0);
             }
           }
         }

@@ -83,6 +83,9 @@ class TabulatedMicrofacet final : public Brdf, public Proposal {
   const MicrofacetTables& tables() const { return shared_->tables; }
   const VisibleNormalTables& sampling() const { return shared_->sampling; }
   const Stretch& stretch() const { return stretch_; }
+  // What SIMD kernels read (render/tabulated_batch.h): cos(theta_j) at the grid's nodes, and G1's table.
+  const std::vector<double>& cos_nodes() const { return shared_->cos_nodes; }
+  const G1Table& g1_table() const { return *shared_->g1; }
   bool can_sample() const override { return !shared_->sampling.empty(); }
 
   // The same lobe under another stretch: shares the tables, so it is cheap enough to make per shading

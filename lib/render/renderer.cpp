@@ -138,7 +138,7 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
   // Shading at a hit is planned, sampled, evaluated, then finished. plan() draws the light directions of
   // the shadow rays and queues, per material, the BRDF sample directions to draw; sample() draws them;
   // evaluate() makes the evaluations of f (and the density) every shadow ray's value needs; finish() turns
-  // each into its shadow ray and value. The middle steps are one call per material, in SIMD lanes (GGX),
+  // each into its shadow ray and value. The middle steps are one call per material, in SIMD lanes (GGX, LUT),
   // for one sample on the one-ray path and for a whole tile on the stream path; a model without lanes is
   // sampled and evaluated inside plan().
   struct Request {
@@ -260,7 +260,7 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
     // Evaluated and sampled at once, its shadow rays made here: a lobe textured here (this call owns it),
     // and a model without SIMD lanes (queuing its work would only add the queue's cost: 6% more
     // instructions on a LUT sphere).
-    const bool at_once = textured || !model.batch_model();
+    const bool at_once = textured || !model.has_lanes();
     planned.deferred = !at_once;
     const auto request = [&](typename Request::Kind kind, const Vec3& i, const Vec3& d, double tfar, const Rgb& radiance,
                              double light_pdf) {

@@ -4,6 +4,7 @@
 
 #include "model/ndf.h"
 #include "model/parametric.h"
+#include "model/tabulated.h"
 
 namespace facetfit {
 
@@ -27,6 +28,10 @@ ShadingModel::ShadingModel(std::shared_ptr<const Brdf> brdf, std::shared_ptr<con
     m.lobe_weight = lobe_weight_, m.part_lobe = parts.lobe, m.part_body = parts.body;
     m.part_coat = parts.coat.present() ? parts.coat_weight() : 0.0;
   }
+  // A LUT: the tabulated lobe sampled by itself.
+  const auto* tabulated = dynamic_cast<const TabulatedMicrofacet*>(proposal_.get());
+  if (!batch_model_ && tabulated && lobe_weight_ > 0.0 && brdf_.get() == static_cast<const Brdf*>(tabulated))
+    tabulated_batch_model_ = TabulatedBatchModel::of(*tabulated, lobe_weight_);
 }
 
 Rgb ShadingModel::f(const Vec3& o, const Vec3& i) const {
@@ -55,6 +60,7 @@ ShadingModel::Evaluation ShadingModel::eval(const Vec3& o, const Vec3& i) const 
 
 void ShadingModel::eval(EvaluationBatch& batch, bool simd) const {
   if (simd && batch_model_) return eval_ggx_batch(*batch_model_, batch);
+  if (simd && tabulated_batch_model_) return eval_tabulated_batch(*tabulated_batch_model_, batch);
   for (std::size_t k = 0; k < batch.size(); ++k) {
     const Evaluation e = eval(batch.o(k), batch.i(k), batch.with_pdf[k] != 0.0);
     batch.r[k] = e.f.r, batch.g[k] = e.f.g, batch.b[k] = e.f.b, batch.pdf[k] = e.pdf;
@@ -63,6 +69,7 @@ void ShadingModel::eval(EvaluationBatch& batch, bool simd) const {
 
 void ShadingModel::sample_directions(SampleBatch& batch, bool simd) const {
   if (simd && batch_model_) return sample_ggx_batch(*batch_model_, batch);
+  if (simd && tabulated_batch_model_) return sample_tabulated_batch(*tabulated_batch_model_, batch);
   for (std::size_t k = 0; k < batch.size(); ++k) {
     const auto i = sample_direction(batch.o(k), batch.u1[k], batch.u2[k], batch.u3[k]);
     batch.found[k] = i ? 1.0 : 0.0;

@@ -1,0 +1,298 @@
+// Compiled once per SIMD target by Highway's foreach_target (this file includes itself), as
+// render/ggx_batch.cpp.
+#include "render/simd_targets.h"  // before any of Highway's headers
+#undef HWY_TARGET_INCLUDE
+#define HWY_TARGET_INCLUDE "render/tabulated_batch.cpp"
+#include <hwy/foreach_target.h>  // before highway.h
+
+#include <hwy/highway.h>
+#include <hwy/contrib/math/math-inl.h>
+
+#include "render/lanes-inl.h"
+#include "render/tabulated_batch.h"
+
+HWY_BEFORE_NAMESPACE();
+namespace facetfit {
+namespace HWY_NAMESPACE {
+namespace hn = hwy::HWY_NAMESPACE;
+
+namespace {
+
+using lanes::D;
+using lanes::DI;
+using lanes::V;
+using I = hn::Vec<DI>;
+
+// Interval j and fraction t of the theta grid at theta = acos(c), c in [-1, 1] (ThetaGrid::locate).
+struct GridPosition {
+  I j;
+  V t;
+};
+GridPosition locate(D d, V c, int resolution) {
+  const DI di;
+  const V theta = hn::Acos(d, hn::Min(hn::Max(c, hn::Set(d, -1.0)), hn::Set(d, 1.0)));
+  const V x = hn::Min(hn::Sqrt(hn::Max(hn::Zero(d), theta) / hn::Set(d, 0.5 * kPi)), hn::Set(d, 1.0)) * hn::Set(d, double(resolution));
+  const I j = hn::Min(hn::ConvertTo(di, x), hn::Set(di, resolution - 1));
+  return {j, x - hn::ConvertTo(d, j)};
+}
+
+// The Catmull-Rom spline through `values` at p (ThetaGrid::interpolate): node j - 1 mirrored to node 1
+// at j = 0, the ghost past the last node folded into the weights of the last two.
+V spline(D d, const double* values, const GridPosition& p, int resolution) {
+  const DI di;
+  const V t = p.t, t2 = t * t, t3 = t2 * t, half = hn::Set(d, 0.5);
+  const V w0 = half * (hn::Neg(t) + hn::Set(d, 2.0) * t2 - t3);
+  V w1 = half * (hn::Set(d, 2.0) - hn::Set(d, 5.0) * t2 + hn::Set(d, 3.0) * t3);
+  V w2 = half * (t + hn::Set(d, 4.0) * t2 - hn::Set(d, 3.0) * t3);
+  V w3 = half * (t3 - t2);
+  const I one = hn::Set(di, 1);
+  const I i0 = hn::IfThenElse(p.j == hn::Zero(di), one, p.j - one);
+  const auto past = hn::RebindMask(d, p.j + hn::Set(di, 2) > hn::Set(di, resolution));
+  w2 = hn::IfThenElse(past, w2 + hn::Set(d, 2.0) * w3, w2);
+  w1 = hn::IfThenElse(past, w1 - w3, w1);
+  w3 = hn::IfThenElseZero(hn::Not(past), w3);
+  const I i3 = hn::Min(p.j + hn::Set(di, 2), hn::Set(di, resolution));
+  V v = w0 * hn::GatherIndex(d, values, i0);
+  v = v + w1 * hn::GatherIndex(d, values, p.j);
+  v = v + w2 * hn::GatherIndex(d, values, p.j + one);
+  return v + w3 * hn::GatherIndex(d, values, i3);
+}
+
+// G1 of the table (G1Table::operator()) at c = cos(theta) > 0; lanes at or below the horizon read 0.
+V g1(D d, const TabulatedBatchModel& model, V c) {
+  const DI di;
+  const V zero = hn::Zero(d), one = hn::Set(d, 1.0), scale = hn::Set(d, double(model.g1_size));
+  const V cz = hn::Max(c, zero);
+  const V x = hn::Sqrt(cz) * scale;
+  const I m = hn::Min(hn::ConvertTo(di, x), hn::Set(di, model.g1_size - 1));
+  const V t = x - hn::ConvertTo(d, m);
+  const V lo = hn::GatherIndex(d, model.g1_ratios, m), hi = hn::GatherIndex(d, model.g1_ratios, m + hn::Set(di, 1));
+  const V ratio = hn::IfThenElse(x >= scale, hn::Set(d, model.g1_ratios[model.g1_size]), lo + t * (hi - lo));
+  return hn::IfThenElseZero(c > zero, hn::Min(one, cz * ratio));
+}
+
+// 2 integral over phi of max(0, a cos(phi) + b), a, b >= 0 (positive_phi_integral).
+V positive_phi_integral(D d, V a, V b) {
+  const auto whole = a <= b;
+  const V safe_a = hn::IfThenElse(whole, hn::Set(d, 1.0), a);
+  const V ratio = hn::Max(hn::Neg(b) / safe_a, hn::Set(d, -1.0));
+  const V part = hn::Set(d, 2.0) * (hn::Sqrt(hn::Max(hn::Zero(d), a * a - b * b)) + b * hn::Acos(d, ratio));
+  return hn::IfThenElse(whole, hn::Set(d, 2.0 * kPi) * b, part);
+}
+
+// phi in (-pi, pi] with density proportional to max(0, a cos(phi) + b), a, b >= 0, from u in [0, 1), as
+// (cos phi, sin phi): sample_phi of model/tabulated.cpp, its Newton steps on the CDF a sin(phi) + b phi in
+// every lane until each has stopped (4 steps for most, at most 40).
+struct CosSin {
+  V c, s;
+};
+CosSin sample_phi(D d, V a, V b, V u) {
+  const V zero = hn::Zero(d), one = hn::Set(d, 1.0), two = hn::Set(d, 2.0), half = hn::Set(d, 0.5), pi = hn::Set(d, kPi);
+  const auto whole = a <= b;
+  const V ratio = hn::Min(hn::Max(hn::Neg(b) / hn::IfThenElse(whole, one, a), hn::Set(d, -1.0)), one);
+  const V phi_max = hn::IfThenElse(whole, pi, hn::Acos(d, ratio));
+  const auto lower = u < half;
+  const V sign = hn::IfThenElse(lower, hn::Set(d, -1.0), one);
+  u = hn::IfThenElse(lower, two * u, two * u - one);
+  const V total = a * hn::Sin(d, phi_max) + b * phi_max;
+  const auto flat = hn::Not(total > zero);
+  const V target = u * total;
+  V lo = zero, hi = phi_max, phi = u * phi_max, c = one, s = zero;
+  auto active = hn::Not(flat);
+  for (int it = 0; it < 40 && !hn::AllFalse(d, active); ++it) {
+    const V sin_phi = hn::Sin(d, phi), cos_phi = hn::Cos(d, phi);
+    const V f = a * sin_phi + b * phi - target;
+    const auto beyond = f > zero;
+    hi = hn::IfThenElse(beyond, phi, hi), lo = hn::IfThenElse(beyond, lo, phi);
+    const V df = a * cos_phi + b, mid = half * (lo + hi);
+    V next = hn::IfThenElse(df > zero, phi - f / hn::IfThenElse(df > zero, df, one), mid);
+    next = hn::IfThenElse(hn::And(next > lo, next < hi), next, mid);
+    const V step = next - phi;
+    // Stopped: the rotation by the last step to first order.
+    const auto stops = hn::And(active, hn::Abs(step) < hn::Set(d, 1e-7));
+    c = hn::IfThenElse(stops, cos_phi - sin_phi * step, c), s = hn::IfThenElse(stops, sin_phi + cos_phi * step, s);
+    active = hn::AndNot(stops, active);
+    phi = hn::IfThenElse(active, next, phi);
+  }
+  if (!hn::AllFalse(d, active)) c = hn::IfThenElse(active, hn::Cos(d, phi), c), s = hn::IfThenElse(active, hn::Sin(d, phi), s);
+  if (!hn::AllFalse(d, flat)) {  // no density: uniform
+    const V uniform = u * pi;
+    c = hn::IfThenElse(flat, hn::Cos(d, uniform), c), s = hn::IfThenElse(flat, hn::Sin(d, uniform), s);
+  }
+  return {c, sign * s};
+}
+
+// The lobe's visible normals seen from o reflected about: i (TabulatedMicrofacet::lobe_direction, unstretched),
+// to be refused where i.z <= 0. `top_step`: the largest power of two <= the grid's resolution.
+lanes::Direction lobe_direction(D d, const TabulatedBatchModel& model, int top_step, V ox, V oy, V oz, V u1, V u2) {
+  const DI di;
+  const V zero = hn::Zero(d), one = hn::Set(d, 1.0);
+  const int r = model.resolution;
+  // One of the two view slices around o with the weights of the mixture, reusing u1.
+  const GridPosition view = locate(d, oz, r);
+  const V keep = one - view.t;
+  const auto first = u1 < keep;
+  V u = hn::IfThenElse(first, u1 / keep, (u1 - keep) / hn::IfThenElse(view.t > zero, view.t, one));
+  u = hn::Min(hn::Max(u, zero), hn::Set(d, 1.0 - 1e-16));
+  const I slice = hn::IfThenElse(hn::RebindMask(di, first), view.j, view.j + hn::Set(di, 1));
+  // The interval of theta_h: the last node of the slice's running sums <= u (sample_cdf: zero-mass
+  // intervals are never chosen), by bisection.
+  const I row = slice * hn::Set(di, r + 1), last = hn::Set(di, r);
+  I k = hn::Zero(di);
+  for (int step = top_step; step > 0; step >>= 1) {
+    const I probe = k + hn::Set(di, step);
+    const V at = hn::GatherIndex(d, model.cdf, row + hn::Min(probe, last));
+    const auto take = hn::And(hn::RebindMask(d, hn::Set(di, r + 1) > probe), at <= u);
+    k = hn::IfThenElse(hn::RebindMask(di, take), probe, k);
+  }
+  k = hn::Min(k, last - hn::Set(di, 1));
+  const V c0 = hn::GatherIndex(d, model.cdf, row + k), c1 = hn::GatherIndex(d, model.cdf, row + k + hn::Set(di, 1));
+  const V mass = c1 - c0;
+  const auto some = mass > zero;
+  const V frac = hn::IfThenElse(some, hn::Min(hn::Max((u - c0) / hn::IfThenElse(some, mass, one), zero), one), hn::Set(d, 0.5));
+  // Uniform in cos(theta_h) within the interval.
+  const V n0 = hn::GatherIndex(d, model.cos_nodes, k), n1 = hn::GatherIndex(d, model.cos_nodes, k + hn::Set(di, 1));
+  const V cos_h = n0 - frac * (n0 - n1);
+  const V sin_h = hn::Sqrt(hn::Max(zero, one - cos_h * cos_h)), sin_o = hn::Sqrt(hn::Max(zero, one - oz * oz));
+  // phi relative to o's azimuth, then turned to it by o.xy / |o.xy|.
+  const CosSin phi = sample_phi(d, sin_o * sin_h, oz * cos_h, u2);
+  V hx = sin_h * phi.c, hy = sin_h * phi.s;
+  const V o_xy = hn::Sqrt(ox * ox + oy * oy);
+  const auto turned = hn::And(sin_o > zero, o_xy > zero);
+  const V safe = hn::IfThenElse(turned, o_xy, one), turn_c = ox / safe, turn_s = oy / safe;
+  const V tx = turn_c * hx - turn_s * hy, ty = turn_s * hx + turn_c * hy;
+  hx = hn::IfThenElse(turned, tx, hx), hy = hn::IfThenElse(turned, ty, hy);
+  const V two_o_h = hn::Set(d, 2.0) * (ox * hx + oy * hy + oz * cos_h);
+  return {two_o_h * hx - ox, two_o_h * hy - oy, two_o_h * cos_h - oz};
+}
+
+}  // namespace
+
+void SampleTabulatedBatch(const TabulatedBatchModel& model, SampleBatch& batch) {
+  const D d;
+  int top_step = 1;
+  while (top_step * 2 <= model.resolution) top_step *= 2;
+  const lanes::ProposalWeights weights{model.lobe_weight, model.part_lobe, model.part_body, model.part_coat};
+  lanes::sample_proposal(d, weights, model.coat, batch, [&](V ox, V oy, V oz, V u1, V u2, V, V) {
+    return lobe_direction(d, model, top_step, ox, oy, oz, u1, u2);
+  });
+}
+
+void EvalTabulatedBatch(const TabulatedBatchModel& model, EvaluationBatch& batch) {
+  const D d;
+  const DI di;
+  const std::size_t n = batch.padded_size();
+  const V zero = hn::Zero(d), one = hn::Set(d, 1.0), four = hn::Set(d, 4.0), inv_pi = hn::Set(d, kInvPi);
+  const int resolution = model.resolution;
+  const I row = hn::Set(di, model.resolution + 1);  // nodes per view slice of the running sums
+  const V body[3] = {hn::Set(d, model.body.r * kInvPi), hn::Set(d, model.body.g * kInvPi), hn::Set(d, model.body.b * kInvPi)};
+  const bool coat = model.coat.present();
+  double* out[3] = {batch.r.data(), batch.g.data(), batch.b.data()};
+  for (std::size_t k = 0; k < n; k += hn::Lanes(d)) {
+    const V ox = hn::LoadU(d, batch.ox.data() + k), oy = hn::LoadU(d, batch.oy.data() + k), oz = hn::LoadU(d, batch.oz.data() + k);
+    const V ix = hn::LoadU(d, batch.ix.data() + k), iy = hn::LoadU(d, batch.iy.data() + k), iz = hn::LoadU(d, batch.iz.data() + k);
+    const auto above = hn::And(iz > zero, oz > zero);
+    // h = normalize(i + o)
+    V hx = ix + ox, hy = iy + oy, hz = iz + oz;
+    const V inv_len = one / hn::Sqrt(hx * hx + hy * hy + hz * hz);
+    hx = hx * inv_len, hy = hy * inv_len, hz = hz * inv_len;
+    const auto h_up = hz > zero;
+    // theta_h once, for D and for the normal's place on the grid.
+    const GridPosition normal = locate(d, hn::IfThenElse(h_up, hz, one), resolution);
+    const V four_cos = four * iz * oz;
+    const V cos_d = hn::Min(hn::Max(ix * hx + iy * hy + iz * hz, zero), one);
+    const V o_dot_h = ox * hx + oy * hy + oz * hz;
+    const auto o_faces_h = o_dot_h > zero;
+    V coat_f = zero, coat_pdf = zero;
+    if (coat) {
+      const lanes::CoatTerms terms = lanes::coat_terms(d, model.coat, ox, oy, oz, ix, iy, iz, hx, hy, hz, cos_d, four_cos, o_faces_h);
+      coat_f = terms.f, coat_pdf = terms.pdf;
+    }
+    {
+      const V dh = hn::IfThenElseZero(h_up, hn::Max(zero, spline(d, model.ndf, normal, model.resolution)));
+      const V g1_i = g1(d, model, iz), g1_o = g1(d, model, oz);
+      V g2;
+      switch (model.smith) {
+        case Smith::masking: g2 = hn::Min(g1_i, g1_o); break;
+        case Smith::correlated: {
+          const V den = g1_i + g1_o - g1_i * g1_o;
+          g2 = hn::IfThenElseZero(den > zero, g1_i * g1_o / hn::IfThenElse(den > zero, den, one));
+          break;
+        }
+        case Smith::separable: g2 = g1_i * g1_o; break;
+      }
+      V fresnel[3];
+      lanes::fresnel_curve(d, model.curve, cos_d, fresnel);
+      const V specular = dh * g2 / four_cos;
+      for (int c = 0; c < 3; ++c) hn::StoreU(hn::IfThenElseZero(above, body[c] + fresnel[c] * specular + coat_f), d, out[c] + k);
+    }
+
+    // The lobe's visible normals (TabulatedMicrofacet::measured_visible_normal_pdf): the mass of the
+    // normal's theta_h interval, mixed linearly between the two view slices around o, spread uniformly in
+    // cos(theta_h) and over phi as max(0, o.h); reflected about h, d(omega_i) = 4 (o.h) d(omega_h).
+    const GridPosition view = locate(d, oz, resolution);
+    const I at = view.j * row + normal.j;
+    const V mass_lo = hn::GatherIndex(d, model.cdf, at + hn::Set(di, 1)) - hn::GatherIndex(d, model.cdf, at);
+    const V mass_hi = hn::GatherIndex(d, model.cdf, at + row + hn::Set(di, 1)) - hn::GatherIndex(d, model.cdf, at + row);
+    const V mass = (one - view.t) * mass_lo + view.t * mass_hi;
+    const V band = hn::GatherIndex(d, model.cos_nodes, normal.j) - hn::GatherIndex(d, model.cos_nodes, normal.j + hn::Set(di, 1));
+    const V sin_o = hn::Sqrt(hn::Max(zero, one - oz * oz)), sin_h = hn::Sqrt(hn::Max(zero, one - hz * hz));
+    const V phi_total = positive_phi_integral(d, sin_o * sin_h, oz * hz);
+    const auto visible = hn::And(hn::And(o_faces_h, h_up), hn::And(band > zero, phi_total > zero));
+    const V safe_band = hn::IfThenElse(visible, band, one), safe_total = hn::IfThenElse(visible, phi_total, one);
+    const V safe_oh = hn::IfThenElse(visible, o_dot_h, one);
+    const V lobe_pdf = hn::IfThenElseZero(visible, mass / safe_band * o_dot_h / safe_total / (four * safe_oh));
+    V parts = hn::Set(d, model.part_lobe) * lobe_pdf + hn::Set(d, model.part_body) * iz * inv_pi;
+    if (coat) parts = parts + hn::Set(d, model.part_coat) * coat_pdf;
+    const V pdf = hn::Set(d, model.lobe_weight) * parts + hn::Set(d, 1.0 - model.lobe_weight) * (iz * inv_pi);
+    hn::StoreU(hn::IfThenElseZero(above, pdf), d, batch.pdf.data() + k);
+  }
+}
+
+// NOLINTNEXTLINE(google-readability-namespace-comments)
+}  // namespace HWY_NAMESPACE
+}  // namespace facetfit
+HWY_AFTER_NAMESPACE();
+
+#if HWY_ONCE
+#include "model/tabulated.h"
+
+namespace facetfit {
+
+std::optional<TabulatedBatchModel> TabulatedBatchModel::of(const TabulatedMicrofacet& lobe, double lobe_weight) {
+  if (!lobe.stretch().identity() || !lobe.can_sample()) return std::nullopt;
+  const MicrofacetTables& tables = lobe.tables();
+  if (tables.fresnel.value.size() != std::size_t(FresnelCurve::kSize)) return std::nullopt;
+  TabulatedBatchModel m;
+  m.resolution = tables.ndf.grid.resolution;
+  m.ndf = tables.ndf.ndf.data();
+  m.cos_nodes = lobe.cos_nodes().data();
+  m.cdf = lobe.sampling().cdf.data();
+  m.g1_ratios = lobe.g1_table().ratios();
+  m.g1_size = lobe.g1_table().size();
+  m.smith = tables.smith;
+  m.curve = tables.fresnel.value.data();
+  m.body = tables.body;
+  m.coat = tables.coat;
+  m.lobe_weight = lobe_weight;
+  m.part_lobe = lobe.lobe_weight(), m.part_body = lobe.body_weight();
+  m.part_coat = tables.coat.present() ? lobe.coat_weight() : 0.0;
+  return m;
+}
+
+void eval_tabulated_batch(const TabulatedBatchModel& model, EvaluationBatch& batch, bool baseline) {
+#if HWY_TARGETS & HWY_AVX2
+  if (!baseline && cpu_has_avx2()) return N_AVX2::EvalTabulatedBatch(model, batch);
+#endif
+  HWY_STATIC_DISPATCH(EvalTabulatedBatch)(model, batch);
+}
+
+void sample_tabulated_batch(const TabulatedBatchModel& model, SampleBatch& batch, bool baseline) {
+#if HWY_TARGETS & HWY_AVX2
+  if (!baseline && cpu_has_avx2()) return N_AVX2::SampleTabulatedBatch(model, batch);
+#endif
+  HWY_STATIC_DISPATCH(SampleTabulatedBatch)(model, batch);
+}
+
+}  // namespace facetfit
+#endif

@@ -1,0 +1,48 @@
+// The tabulated microfacet model (a LUT: model/tabulated.h) over a batch, in SIMD lanes, as
+// render/ggx_batch.h does for GGX: ShadingModel's sample_direction and eval (f(o, i) and the sampling
+// density) with the model as BRDF and proposal, every term theirs in the same order, so the two agree to
+// rounding (tests/test_render.cpp). The arc cosines of the grid lookups and the sines and cosines of the
+// azimuth's Newton steps are Highway's.
+#pragma once
+
+#include <optional>
+
+#include "core/vec.h"
+#include "model/coat.h"
+#include "model/smith.h"
+#include "render/shading_batch.h"
+
+namespace facetfit {
+
+class TabulatedMicrofacet;
+
+struct TabulatedBatchModel {
+  // The theta grid (model/theta_grid.h) and its tables: D and cos(theta) at the resolution + 1 nodes, the
+  // visible normals' running sums ((resolution + 1) view slices of resolution + 1 nodes).
+  int resolution = 0;
+  const double* ndf = nullptr;
+  const double* cos_nodes = nullptr;
+  const double* cdf = nullptr;
+  // G1 / cos(theta) at cos(theta) = (m / g1_size)^2, m = 0..g1_size (model/tabulated_ndf.h, G1Table).
+  const double* g1_ratios = nullptr;
+  int g1_size = 0;
+  Smith smith = Smith::correlated;
+  const Rgb* curve = nullptr;  // the Fresnel curve's 90 entries
+  Rgb body{0.0};
+  Coat coat;
+  // The density: lobe_weight of the model's own (its parts: the lobe's visible normals, the body's cosine,
+  // the coat's visible normals), the rest cosine sampling.
+  double lobe_weight = 0.85, part_lobe = 1.0, part_body = 0.0, part_coat = 0.0;
+
+  // The lanes' model of `lobe` sampled with weight lobe_weight; none where the kernels do not hold it (a
+  // stretched lobe, or one without sampling tables).
+  static std::optional<TabulatedBatchModel> of(const TabulatedMicrofacet& lobe, double lobe_weight);
+};
+
+// Fills the batch's r, g, b and pdf for its padded_size() pairs; zero where o or i is below the horizon.
+// `baseline`: the code for CPUs without AVX2, which the tests run too.
+void eval_tabulated_batch(const TabulatedBatchModel& model, EvaluationBatch& batch, bool baseline = false);
+// Fills the batch's i and found for its padded_size() entries (ShadingModel::sample_direction).
+void sample_tabulated_batch(const TabulatedBatchModel& model, SampleBatch& batch, bool baseline = false);
+
+}  // namespace facetfit
