@@ -399,6 +399,48 @@ TEST(Shading, TabulatedInSimdLanesEqualsOnePairAtATime) {
   EXPECT_GT(found, 5000);
 }
 
+TEST(Shading, TabulatedProposalInSimdLanesEqualsOnePairAtATime) {
+  // A tabulated lobe that only samples another BRDF (a Beckmann lobe's tabulated NDF, a measured table's
+  // fitted LUT): the lanes draw the directions and give the density, f stays the BRDF's own. ShadingModel's
+  // batch calls in lanes against the same calls one pair at a time.
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const auto direction = [&] {
+    const double z = 2.0 * u(rng) - 0.95, phi = 2.0 * kPi * u(rng), s = std::sqrt(std::max(0.0, 1.0 - z * z));
+    return Vec3(s * std::cos(phi), s * std::sin(phi), z);
+  };
+  int found = 0;
+  for (const bool layered : {false, true}) {
+    const Ndf ndf = Ndf::isotropic(NdfType::beckmann, 0.25);
+    const Rgb body = layered ? Rgb(0.2, 0.3, 0.4) : Rgb(0.0);
+    const Coat coat = layered ? Coat{0.05, 0.04} : Coat{};
+    const auto brdf = std::make_shared<ParametricBrdf>(ndf, Smith::correlated, Rgb(0.9, 0.6, 0.3), Rgb(0.8, 0.7, 0.5), body, coat);
+    const auto proposal = std::make_shared<TabulatedMicrofacet>(MicrofacetTables{tabulate_ndf(ndf), Smith::correlated, {}, body, coat});
+    const ShadingModel model(brdf, proposal);
+    ASSERT_TRUE(model.has_lanes());
+    EvaluationBatch lanes, reference;
+    SampleBatch drawn, one_by_one;
+    for (std::size_t k = 0; k < 403; ++k) {
+      const Vec3 o = direction(), i = direction();
+      lanes.push(o, i), reference.push(o, i);
+      const double u1 = u(rng), u2 = u(rng), u3 = u(rng);
+      drawn.push(o, u1, u2, u3), one_by_one.push(o, u1, u2, u3);
+    }
+    model.eval(lanes, true), model.eval(reference, false);
+    model.sample_directions(drawn, true), model.sample_directions(one_by_one, false);
+    for (std::size_t k = 0; k < lanes.size(); ++k) {
+      // f is the BRDF's, one pair at a time either way.
+      EXPECT_EQ(lanes.f(k), reference.f(k)) << k;
+      EXPECT_NEAR(lanes.pdf[k], reference.pdf[k], 1e-10 * std::max(1.0, reference.pdf[k])) << k;
+      ASSERT_EQ(drawn.found[k], one_by_one.found[k]) << k;
+      if (!one_by_one.found[k]) continue;
+      ++found;
+      EXPECT_LE(glm::length(drawn.i(k) - one_by_one.i(k)), 1e-7) << k;
+    }
+  }
+  EXPECT_GT(found, 300);
+}
+
 TEST(Render, BadScenesGetOneClearLine) {
   test::TempDir dir;
   test::write_bytes(dir.file("a.json"), R"({"objects": [{"type": "sphere", "material": "nope"}]})");

@@ -28,10 +28,13 @@ ShadingModel::ShadingModel(std::shared_ptr<const Brdf> brdf, std::shared_ptr<con
     m.lobe_weight = lobe_weight_, m.part_lobe = parts.lobe, m.part_body = parts.body;
     m.part_coat = parts.coat.present() ? parts.coat_weight() : 0.0;
   }
-  // A LUT: the tabulated lobe sampled by itself.
+  // A tabulated proposal: a LUT sampled by itself, or the fitted LUT of a measured table (or the tabulated
+  // NDF of a Beckmann lobe), whose f the lanes do not hold.
   const auto* tabulated = dynamic_cast<const TabulatedMicrofacet*>(proposal_.get());
-  if (!batch_model_ && tabulated && lobe_weight_ > 0.0 && brdf_.get() == static_cast<const Brdf*>(tabulated))
+  if (!batch_model_ && tabulated && lobe_weight_ > 0.0) {
     tabulated_batch_model_ = TabulatedBatchModel::of(*tabulated, lobe_weight_);
+    tabulated_f_ = brdf_.get() == static_cast<const Brdf*>(tabulated);
+  }
 }
 
 Rgb ShadingModel::f(const Vec3& o, const Vec3& i) const {
@@ -60,7 +63,15 @@ ShadingModel::Evaluation ShadingModel::eval(const Vec3& o, const Vec3& i) const 
 
 void ShadingModel::eval(EvaluationBatch& batch, bool simd) const {
   if (simd && batch_model_) return eval_ggx_batch(*batch_model_, batch);
-  if (simd && tabulated_batch_model_) return eval_tabulated_batch(*tabulated_batch_model_, batch);
+  if (simd && tabulated_batch_model_) {
+    eval_tabulated_batch(*tabulated_batch_model_, batch, false, tabulated_f_);
+    if (tabulated_f_) return;
+    for (std::size_t k = 0; k < batch.size(); ++k) {
+      const Rgb v = f(batch.o(k), batch.i(k));
+      batch.r[k] = v.r, batch.g[k] = v.g, batch.b[k] = v.b;
+    }
+    return;
+  }
   for (std::size_t k = 0; k < batch.size(); ++k) {
     const Evaluation e = eval(batch.o(k), batch.i(k), batch.with_pdf[k] != 0.0);
     batch.r[k] = e.f.r, batch.g[k] = e.f.g, batch.b[k] = e.f.b, batch.pdf[k] = e.pdf;

@@ -38,15 +38,15 @@ class ShadingModel {
   // The same, or f alone (density zero) unless `with_pdf`: a measured or tabulated proposal's density costs
   // a lookup of its own, which a light's direction does not need.
   Evaluation eval(const Vec3& o, const Vec3& i, bool with_pdf) const { return with_pdf ? eval(o, i) : Evaluation{f(o, i), 0.0}; }
-  // eval() of every pair of the batch: in SIMD lanes for a GGX lobe (render/ggx_batch.h) or a tabulated one
-  // sampled by itself (render/tabulated_batch.h) unless `simd` is false, one pair at a time otherwise (the
-  // reference the lanes are tested against).
+  // eval() of every pair of the batch: in SIMD lanes for a GGX lobe (render/ggx_batch.h) or a tabulated
+  // proposal (render/tabulated_batch.h: the density, and f where the BRDF is the lobe itself) unless `simd`
+  // is false, one pair at a time otherwise (the reference the lanes are tested against).
   void eval(EvaluationBatch& batch, bool simd = true) const;
   // The lanes' model, where this one runs in them (tests call render/ggx_batch.h with it).
   const std::optional<GgxBatchModel>& batch_model() const { return batch_model_; }
   const std::optional<TabulatedBatchModel>& tabulated_batch_model() const { return tabulated_batch_model_; }
-  // Whether eval(EvaluationBatch&) and sample_directions() run in lanes: a batch then costs less than the
-  // pairs one by one.
+  // Whether eval(EvaluationBatch&) and sample_directions() run in lanes (wholly or in part): a batch then
+  // costs less than the pairs one by one.
   bool has_lanes() const { return batch_model_ || tabulated_batch_model_; }
 
   using Sample = BrdfSample;
@@ -70,7 +70,9 @@ class ShadingModel {
   const ParametricBrdf* ggx_brdf_ = nullptr;
   const GgxProposal* ggx_proposal_ = nullptr;
   std::optional<GgxBatchModel> batch_model_;  // the same lobe for eval(EvaluationBatch&)
-  std::optional<TabulatedBatchModel> tabulated_batch_model_;  // a LUT, for both batch calls
+  // A tabulated proposal's lanes: its draws and density, and f too where the BRDF is the lobe itself.
+  std::optional<TabulatedBatchModel> tabulated_batch_model_;
+  bool tabulated_f_ = false;
 };
 
 }  // namespace facetfit

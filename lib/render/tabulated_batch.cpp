@@ -178,7 +178,7 @@ void SampleTabulatedBatch(const TabulatedBatchModel& model, SampleBatch& batch) 
   });
 }
 
-void EvalTabulatedBatch(const TabulatedBatchModel& model, EvaluationBatch& batch) {
+void EvalTabulatedBatch(const TabulatedBatchModel& model, EvaluationBatch& batch, bool with_f) {
   const D d;
   const DI di;
   const std::size_t n = batch.padded_size();
@@ -208,7 +208,7 @@ void EvalTabulatedBatch(const TabulatedBatchModel& model, EvaluationBatch& batch
       const lanes::CoatTerms terms = lanes::coat_terms(d, model.coat, ox, oy, oz, ix, iy, iz, hx, hy, hz, cos_d, four_cos, o_faces_h);
       coat_f = terms.f, coat_pdf = terms.pdf;
     }
-    {
+    if (with_f) {
       const V dh = hn::IfThenElseZero(h_up, hn::Max(zero, spline(d, model.ndf, normal, model.resolution)));
       const V g1_i = g1(d, model, iz), g1_o = g1(d, model, oz);
       V g2;
@@ -280,11 +280,11 @@ std::optional<TabulatedBatchModel> TabulatedBatchModel::of(const TabulatedMicrof
   return m;
 }
 
-void eval_tabulated_batch(const TabulatedBatchModel& model, EvaluationBatch& batch, bool baseline) {
+void eval_tabulated_batch(const TabulatedBatchModel& model, EvaluationBatch& batch, bool baseline, bool with_f) {
 #if HWY_TARGETS & HWY_AVX2
-  if (!baseline && cpu_has_avx2()) return N_AVX2::EvalTabulatedBatch(model, batch);
+  if (!baseline && cpu_has_avx2()) return N_AVX2::EvalTabulatedBatch(model, batch, with_f);
 #endif
-  HWY_STATIC_DISPATCH(EvalTabulatedBatch)(model, batch);
+  HWY_STATIC_DISPATCH(EvalTabulatedBatch)(model, batch, with_f);
 }
 
 void sample_tabulated_batch(const TabulatedBatchModel& model, SampleBatch& batch, bool baseline) {

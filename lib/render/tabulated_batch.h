@@ -1,6 +1,6 @@
 // The tabulated microfacet model (a LUT: model/tabulated.h) over a batch, in SIMD lanes, as
 // render/ggx_batch.h does for GGX: ShadingModel's sample_direction and eval (f(o, i) and the sampling
-// density) with the model as BRDF and proposal, every term theirs in the same order, so the two agree to
+// density) with the model as BRDF and proposal, or as the proposal alone (its density), every term theirs in the same order, so the two agree to
 // rounding (tests/test_render.cpp). The arc cosines of the grid lookups and the sines and cosines of the
 // azimuth's Newton steps are Highway's.
 #pragma once
@@ -34,14 +34,15 @@ struct TabulatedBatchModel {
   // the coat's visible normals), the rest cosine sampling.
   double lobe_weight = 0.85, part_lobe = 1.0, part_body = 0.0, part_coat = 0.0;
 
-  // The lanes' model of `lobe` sampled with weight lobe_weight; none where the kernels do not hold it (a
-  // stretched lobe, or one without sampling tables).
+  // The lanes' model of `lobe` as a proposal taken with weight lobe_weight; none where the kernels do not
+  // hold it (a stretched lobe, or one without sampling tables).
   static std::optional<TabulatedBatchModel> of(const TabulatedMicrofacet& lobe, double lobe_weight);
 };
 
 // Fills the batch's r, g, b and pdf for its padded_size() pairs; zero where o or i is below the horizon.
-// `baseline`: the code for CPUs without AVX2, which the tests run too.
-void eval_tabulated_batch(const TabulatedBatchModel& model, EvaluationBatch& batch, bool baseline = false);
+// `baseline`: the code for CPUs without AVX2, which the tests run too. Without `with_f`, pdf alone: the
+// density of a model the lobe only samples (a measured table's fitted LUT).
+void eval_tabulated_batch(const TabulatedBatchModel& model, EvaluationBatch& batch, bool baseline = false, bool with_f = true);
 // Fills the batch's i and found for its padded_size() entries (ShadingModel::sample_direction).
 void sample_tabulated_batch(const TabulatedBatchModel& model, SampleBatch& batch, bool baseline = false);
 
