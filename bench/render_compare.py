@@ -252,9 +252,10 @@ def main(facetfit, mitsuba_python, dst, rgl=None):
                   "samples in SIMD lanes (`N_AVX2::SampleUniformSphereBatch`, render/environment_batch.h) and each hit's frame\n"
                   "(`place`) in the tile loop; `plan` (light directions, queues); BRDF sampling and evaluation in one call per\n"
                   "material, in SIMD lanes for GGX (`N_AVX2::SampleGgxBatch`, `N_AVX2::EvalGgxBatch`, render/ggx_batch.h)\n"
-                  "and for a LUT (`N_AVX2::SampleTabulatedBatch`, `N_AVX2::EvalTabulatedBatch`, render/tabulated_batch.h);\n"
-                  "then `finish` (shadow rays and their values) in the tile loop. A measured model is still sampled and\n"
-                  "evaluated one sample at a time inside `plan`.\n")
+                  "and for a LUT or a measured table's fitted LUT (`N_AVX2::SampleTabulatedBatch`, `N_AVX2::EvalTabulatedBatch`,\n"
+                  "render/tabulated_batch.h), a MERL-layout table's f too (`N_AVX2::EvalMerlBatch`, render/merl_batch.h);\n"
+                  "then `finish` (shadow rays and their values) in the tile loop. An RGL or UTIA file's own evaluation is\n"
+                  "still one pair at a time.\n")
         for label, (rows_, libraries) in profiles:
             out.write("\n%s, by library: %s.\n\n| self | library | symbol |\n|---|---|---|\n" % (
                 label, ", ".join("%s %.0f%%" % (dso, pct) for dso, pct in libraries) or "n/a"))

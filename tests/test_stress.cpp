@@ -15,6 +15,7 @@
 #include "model/tabulated.h"
 #include "render/environment_batch.h"
 #include "render/ggx_batch.h"
+#include "render/merl_batch.h"
 #include "render/shading.h"
 #include "render/tabulated_batch.h"
 #include "test_util.h"
@@ -252,6 +253,26 @@ TEST(TabulatedLanes, EveryBatchLengthAndDegenerateDirectionStayFiniteAndInBounds
           }
         }
     }
+}
+
+TEST(MerlLanes, EveryBatchLengthAndDegenerateDirectionStayFiniteAndInBounds) {
+  // As above for a MERL-layout table's kernel (render/merl_batch.h): its eight gathers per channel stay
+  // inside the table at every edge of its axes (the normal, the horizon, phi_d wrapping), for a table
+  // whose bins are all measured and one whose bins are all missing.
+  const Vec3 degenerate[] = {{0, 0, 1}, {1, 0, 0}, {0, -1, 0}, {0.6, 0, 0.8}, {-0.6, 0, -0.8}, {0, 0, -1}, {1e-300, 0, 1}, {0.9999999, 0, 1e-12}};
+  for (const bool empty : {false, true}) {
+    const MerlTable table = empty ? MerlTable() : load_table("builtin:red-plastic");
+    const auto model = MerlBatchModel::of(table);
+    ASSERT_TRUE(model);
+    for (std::size_t n = 0; n <= 40; ++n)
+      for (const bool baseline : {false, true}) {
+        EvaluationBatch e;
+        for (std::size_t k = 0; k < n; ++k) e.push(glm::normalize(degenerate[k % 8]), glm::normalize(degenerate[(k * 3 + 1) % 8]));
+        eval_merl_batch(*model, e, baseline);
+        for (std::size_t k = 0; k < n; ++k)
+          for (const double v : {e.r[k], e.g[k], e.b[k]}) ASSERT_TRUE(std::isfinite(v)) << "pair " << k;
+      }
+  }
 }
 
 TEST(EnvironmentLanes, EveryBatchLengthAndTheEndsOfTheUnitIntervalStayOnTheSphere) {

@@ -4,6 +4,7 @@
 
 #include "model/ndf.h"
 #include "model/parametric.h"
+#include "io/merl.h"
 #include "model/tabulated.h"
 
 namespace facetfit {
@@ -34,6 +35,7 @@ ShadingModel::ShadingModel(std::shared_ptr<const Brdf> brdf, std::shared_ptr<con
   if (!batch_model_ && tabulated && lobe_weight_ > 0.0) {
     tabulated_batch_model_ = TabulatedBatchModel::of(*tabulated, lobe_weight_);
     tabulated_f_ = brdf_.get() == static_cast<const Brdf*>(tabulated);
+    if (const auto* table = dynamic_cast<const MerlTable*>(brdf_.get())) merl_batch_model_ = MerlBatchModel::of(*table);
   }
 }
 
@@ -66,6 +68,7 @@ void ShadingModel::eval(EvaluationBatch& batch, bool simd) const {
   if (simd && tabulated_batch_model_) {
     eval_tabulated_batch(*tabulated_batch_model_, batch, false, tabulated_f_);
     if (tabulated_f_) return;
+    if (merl_batch_model_) return eval_merl_batch(*merl_batch_model_, batch);
     for (std::size_t k = 0; k < batch.size(); ++k) {
       const Rgb v = f(batch.o(k), batch.i(k));
       batch.r[k] = v.r, batch.g[k] = v.g, batch.b[k] = v.b;

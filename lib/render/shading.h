@@ -13,6 +13,7 @@
 #include "model/ndf.h"
 #include "model/proposal.h"
 #include "render/ggx_batch.h"
+#include "render/merl_batch.h"
 #include "render/shading_batch.h"
 #include "render/tabulated_batch.h"
 
@@ -39,8 +40,9 @@ class ShadingModel {
   // a lookup of its own, which a light's direction does not need.
   Evaluation eval(const Vec3& o, const Vec3& i, bool with_pdf) const { return with_pdf ? eval(o, i) : Evaluation{f(o, i), 0.0}; }
   // eval() of every pair of the batch: in SIMD lanes for a GGX lobe (render/ggx_batch.h) or a tabulated
-  // proposal (render/tabulated_batch.h: the density, and f where the BRDF is the lobe itself) unless `simd`
-  // is false, one pair at a time otherwise (the reference the lanes are tested against).
+  // proposal (render/tabulated_batch.h: the density, and f where the BRDF is the lobe itself; a MERL-layout
+  // table's f in render/merl_batch.h) unless `simd` is false, one pair at a time otherwise (the reference
+  // the lanes are tested against).
   void eval(EvaluationBatch& batch, bool simd = true) const;
   // The lanes' model, where this one runs in them (tests call render/ggx_batch.h with it).
   const std::optional<GgxBatchModel>& batch_model() const { return batch_model_; }
@@ -73,6 +75,7 @@ class ShadingModel {
   // A tabulated proposal's lanes: its draws and density, and f too where the BRDF is the lobe itself.
   std::optional<TabulatedBatchModel> tabulated_batch_model_;
   bool tabulated_f_ = false;
+  std::optional<MerlBatchModel> merl_batch_model_;  // f of a MERL-layout table under a tabulated proposal
 };
 
 }  // namespace facetfit

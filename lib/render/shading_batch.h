@@ -1,7 +1,7 @@
 // Many samplings and evaluations of one shading model at once, in structure-of-arrays form: the renderer
 // gathers what a tile's samples need (BRDF sample directions; then f and the density for light samples,
-// BRDF samples and lights) and makes each kind in one call, which the GGX material and a LUT run in SIMD
-// lanes (render/ggx_batch.h, render/tabulated_batch.h).
+// BRDF samples and lights) and makes each kind in one call, which the GGX material, a LUT and a MERL table
+// run in SIMD lanes (render/ggx_batch.h, render/tabulated_batch.h, render/merl_batch.h).
 #pragma once
 
 #include <cstddef>

@@ -1,0 +1,27 @@
+// A MERL-layout table's f(o, i) over a batch, in SIMD lanes (render/ggx_batch.h does GGX): MerlTable::eval
+// with its linear lookup, every term its own in the same order (half/diff angles, bin coordinates, the
+// eight corners with missing neighbours dropped per channel), so the two agree to rounding
+// (tests/test_render.cpp). The arc cosines and the arc tangent are Highway's.
+#pragma once
+
+#include <optional>
+
+#include "render/shading_batch.h"
+
+namespace facetfit {
+
+class MerlTable;
+
+struct MerlBatchModel {
+  const float* channel[3] = {nullptr, nullptr, nullptr};  // MerlTable::channel(c), index() order
+
+  // None unless the table reads between bins linearly (its nearest lookup stays one pair at a time).
+  static std::optional<MerlBatchModel> of(const MerlTable& table);
+};
+
+// Fills the batch's r, g and b for its padded_size() pairs (pdf untouched): zero where o or i is below the
+// horizon or a channel has no measured neighbour (MerlTable::eval's none). `baseline`: the code for CPUs
+// without AVX2, which the tests run too.
+void eval_merl_batch(const MerlBatchModel& model, EvaluationBatch& batch, bool baseline = false);
+
+}  // namespace facetfit
