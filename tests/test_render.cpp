@@ -46,6 +46,21 @@ void write_texture(const std::string& path, int width, int height, const std::fu
   write_image_atomic(path, ImageSpec(width, height, {"R", "G", "B"}), px.data());
 }
 
+// A Fresnel curve whose three channels differ and vary along theta_d, for the SIMD kernels' tests.
+FresnelCurve coloured_curve() {
+  FresnelCurve curve;
+  for (int j = 0; j < FresnelCurve::kSize; ++j) curve.value[std::size_t(j)] = Rgb(0.9 - 0.005 * j, 0.5 + 0.004 * j, 0.2 + 0.001 * j * j / 90.0);
+  return curve;
+}
+
+// A direction for the SIMD kernels' tests: cos(theta) uniform on [-0.95, 1.05] (so about half the pairs
+// have one direction below the horizon), a fraction `grazing` of them on the horizon (cos(theta) 1e-7).
+Vec3 lane_test_direction(std::mt19937_64& rng, double grazing) {
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const double z = 2.0 * u(rng) - 0.95, phi = 2.0 * kPi * u(rng), s = std::sqrt(std::max(0.0, 1.0 - z * z));
+  return u(rng) < grazing ? glm::normalize(Vec3(std::cos(phi), std::sin(phi), 1e-7)) : Vec3(s * std::cos(phi), s * std::sin(phi), z);
+}
+
 // A sphere of `m` filling most of a small image, under a uniform environment of radiance 1.
 SceneDesc furnace(const MaterialDesc& m, int spp = 64) {
   SceneDesc s = default_scene(m);
@@ -262,14 +277,10 @@ TEST(Shading, GgxInSimdLanesEqualsOnePairAtATime) {
   // curve, a body and a coat, from alpha 0.005 to 1.5, over pairs that include grazing and below-horizon
   // directions and batches of every length modulo the lane count; both the AVX2 code (where the CPU has
   // it) and the baseline, against ShadingModel's one pair at a time.
-  FresnelCurve curve;
-  for (int j = 0; j < FresnelCurve::kSize; ++j) curve.value[std::size_t(j)] = Rgb(0.9 - 0.005 * j, 0.5 + 0.004 * j, 0.2 + 0.001 * j * j / 90.0);
+  const FresnelCurve curve = coloured_curve();
   std::mt19937_64 rng(7);
   std::uniform_real_distribution<double> u(0.0, 1.0);
-  const auto direction = [&] {
-    const double z = 2.0 * u(rng) - 0.95, phi = 2.0 * kPi * u(rng), s = std::sqrt(std::max(0.0, 1.0 - z * z));
-    return u(rng) < 0.05 ? glm::normalize(Vec3(std::cos(phi), std::sin(phi), 1e-7)) : Vec3(s * std::cos(phi), s * std::sin(phi), z);
-  };
+  const auto direction = [&] { return lane_test_direction(rng, 0.05); };
   const auto near = [](double a, double b) { return std::abs(a - b) <= 1e-12 * std::max(1.0, std::abs(b)); };
   int cases = 0, found = 0, refused = 0;
   for (const double alpha : {0.005, 0.3, 1.5})
@@ -327,14 +338,10 @@ TEST(Shading, TabulatedInSimdLanesEqualsOnePairAtATime) {
   // slice, the interval's bisection, the azimuth's Newton steps); pairs that include grazing and
   // below-horizon directions, batches of every length modulo the lane count, both the AVX2 code (where the
   // CPU has it) and the baseline, against ShadingModel's one pair at a time.
-  FresnelCurve curve;
-  for (int j = 0; j < FresnelCurve::kSize; ++j) curve.value[std::size_t(j)] = Rgb(0.9 - 0.005 * j, 0.5 + 0.004 * j, 0.2 + 0.001 * j * j / 90.0);
+  const FresnelCurve curve = coloured_curve();
   std::mt19937_64 rng(11);
   std::uniform_real_distribution<double> u(0.0, 1.0);
-  const auto direction = [&] {
-    const double z = 2.0 * u(rng) - 0.95, phi = 2.0 * kPi * u(rng), s = std::sqrt(std::max(0.0, 1.0 - z * z));
-    return u(rng) < 0.05 ? glm::normalize(Vec3(std::cos(phi), std::sin(phi), 1e-7)) : Vec3(s * std::cos(phi), s * std::sin(phi), z);
-  };
+  const auto direction = [&] { return lane_test_direction(rng, 0.05); };
   // Relative to the value (or to 1e-3 of the batch's largest), 1e-10 rather than the GGX kernel's 1e-12:
   // theta_h = acos(h.z) turns the last bit of h.z (which the lanes may round otherwise: fused multiply-adds)
   // into 1e-16 / theta_h of theta_h, which a peak a node wide (alpha 0.005: d ln D / d theta_h up to ~400)
@@ -406,10 +413,7 @@ TEST(Shading, TabulatedProposalInSimdLanesEqualsOnePairAtATime) {
   // batch calls in lanes against the same calls one pair at a time.
   std::mt19937_64 rng(5);
   std::uniform_real_distribution<double> u(0.0, 1.0);
-  const auto direction = [&] {
-    const double z = 2.0 * u(rng) - 0.95, phi = 2.0 * kPi * u(rng), s = std::sqrt(std::max(0.0, 1.0 - z * z));
-    return Vec3(s * std::cos(phi), s * std::sin(phi), z);
-  };
+  const auto direction = [&] { return lane_test_direction(rng, 0.0); };
   int found = 0;
   for (const bool layered : {false, true}) {
     const Ndf ndf = Ndf::isotropic(NdfType::beckmann, 0.25);
@@ -456,10 +460,7 @@ TEST(Shading, MerlTableInSimdLanesEqualsOnePairAtATime) {
   }
   const auto model = MerlBatchModel::of(table);
   ASSERT_TRUE(model);
-  const auto direction = [&] {
-    const double z = 2.0 * u(rng) - 0.95, phi = 2.0 * kPi * u(rng), s = std::sqrt(std::max(0.0, 1.0 - z * z));
-    return u(rng) < 0.05 ? glm::normalize(Vec3(std::cos(phi), std::sin(phi), 1e-7)) : Vec3(s * std::cos(phi), s * std::sin(phi), z);
-  };
+  const auto direction = [&] { return lane_test_direction(rng, 0.05); };
   double worst = 0.0;
   int values = 0, zero = 0;
   for (const bool baseline : {false, true}) {

@@ -22,8 +22,7 @@ using lanes::V;
 void SampleGgxBatch(const GgxBatchModel& model, SampleBatch& batch) {
   const D d;
   const V alpha = hn::Set(d, model.alpha);
-  const lanes::ProposalWeights weights{model.lobe_weight, model.part_lobe, model.part_body, model.part_coat};
-  lanes::sample_proposal(d, weights, model.coat, batch, [&](V ox, V oy, V oz, V u1, V, V cos_phi, V sin_phi) {
+  lanes::sample_proposal(d, model.weights, model.coat, batch, [&](V ox, V oy, V oz, V u1, V, V cos_phi, V sin_phi) {
     return lanes::ggx_visible_direction(d, ox, oy, oz, alpha, u1, cos_phi, sin_phi);
   });
 }
@@ -31,7 +30,7 @@ void SampleGgxBatch(const GgxBatchModel& model, SampleBatch& batch) {
 void EvalGgxBatch(const GgxBatchModel& model, EvaluationBatch& batch) {
   const D d;
   const std::size_t n = batch.padded_size();
-  const V zero = hn::Zero(d), one = hn::Set(d, 1.0), inv_pi = hn::Set(d, kInvPi);
+  const V zero = hn::Zero(d), one = hn::Set(d, 1.0);
   // The NDF's terms as Ndf::D and Ndf::lambda form them (alpha_x = alpha_y), for the same rounding.
   const double al = model.alpha;
   const V a2 = hn::Set(d, al * al), d_numerator = hn::Set(d, al * al * al * al * al * al / kPi);
@@ -77,13 +76,8 @@ void EvalGgxBatch(const GgxBatchModel& model, EvaluationBatch& batch) {
       coat_f = terms.f, coat_pdf = terms.pdf;
     }
     for (int c = 0; c < 3; ++c) hn::StoreU(hn::IfThenElseZero(above, body[c] + fresnel[c] * specular + coat_f), d, out[c] + k);
-    // The proposal's parts, mixed with cosine sampling.
     const V lobe_pdf = hn::IfThenElseZero(o_faces_h, (one / (one + lambda_o)) * dh / (hn::Set(d, 4.0) * oz));
-    V parts = hn::Set(d, model.part_lobe) * lobe_pdf + hn::Set(d, model.part_body) * iz * inv_pi;
-    if (coat) parts = parts + hn::Set(d, model.part_coat) * coat_pdf;
-    const V cosine = iz * inv_pi;
-    const V pdf = hn::Set(d, model.lobe_weight) * parts + hn::Set(d, 1.0 - model.lobe_weight) * cosine;
-    hn::StoreU(hn::IfThenElseZero(above, pdf), d, batch.pdf.data() + k);
+    hn::StoreU(hn::IfThenElseZero(above, lanes::mixture_density(d, model.weights, coat, lobe_pdf, coat_pdf, iz)), d, batch.pdf.data() + k);
   }
 }
 

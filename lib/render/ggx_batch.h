@@ -23,9 +23,7 @@ struct GgxBatchModel {
   F82Tint f82_tint;
   Rgb body{0.0};  // Lambertian albedo
   Coat coat;
-  // The density: lobe_weight of the proposal (its parts: the lobe's visible normals, the body's cosine,
-  // the coat's visible normals), the rest cosine sampling.
-  double lobe_weight = 0.85, part_lobe = 1.0, part_body = 0.0, part_coat = 0.0;
+  ProposalWeights weights;
 };
 
 // Fills the batch's r, g, b and pdf for its padded_size() pairs; zero where o or i is below the horizon.

@@ -110,14 +110,17 @@ inline Direction ggx_visible_direction(D d, V ox, V oy, V oz, V alpha, V u1, V c
   return {two_o_h * hx - ox, two_o_h * hy - oy, two_o_h * hz - oz};
 }
 
-// A shading model's proposal mixed with cosine sampling (ShadingModel::sample_direction): lobe_weight of
-// the samples from the proposal, whose parts (ProposalParts::sample) are the lobe, the body's cosine and a
-// coat's GGX visible normals.
-struct ProposalWeights {
-  double lobe_weight, part_lobe, part_body, part_coat;
-};
+// The density of i for a shading model that draws with `weights` (ShadingModel::pdf), from the lobe's and
+// the coat's densities (the body's is the cosine's).
+inline V mixture_density(D d, const ProposalWeights& weights, bool coat, V lobe_pdf, V coat_pdf, V iz) {
+  const V inv_pi = hn::Set(d, kInvPi);
+  V parts = hn::Set(d, weights.part_lobe) * lobe_pdf + hn::Set(d, weights.part_body) * iz * inv_pi;
+  if (coat) parts = parts + hn::Set(d, weights.part_coat) * coat_pdf;
+  return hn::Set(d, weights.lobe_weight) * parts + hn::Set(d, 1.0 - weights.lobe_weight) * (iz * inv_pi);
+}
 
-// Fills the batch's i and found for its padded_size() entries. `lobe(ox, oy, oz, u1, u2, cos_phi, sin_phi)`
+// Fills the batch's i and found for its padded_size() entries, drawn with `weights` (ShadingModel::
+// sample_direction). `lobe(ox, oy, oz, u1, u2, cos_phi, sin_phi)`
 // draws the lobe's direction (to be refused where i.z <= 0) with u1 rescaled to the lobe's part and
 // (cos, sin) of phi = 2 pi u2; it runs on every lane, the lanes that pick another part discard it.
 template <class Lobe>

@@ -26,8 +26,7 @@ ShadingModel::ShadingModel(std::shared_ptr<const Brdf> brdf, std::shared_ptr<con
     m.body = lobe->body();
     m.coat = lobe->coat();
     const ProposalParts& parts = ggx->parts();
-    m.lobe_weight = lobe_weight_, m.part_lobe = parts.lobe, m.part_body = parts.body;
-    m.part_coat = parts.coat.present() ? parts.coat_weight() : 0.0;
+    m.weights = {lobe_weight_, parts.lobe, parts.body, parts.coat.present() ? parts.coat_weight() : 0.0};
   }
   // A tabulated proposal: a LUT sampled by itself, or the fitted LUT of a measured table (or the tabulated
   // NDF of a Beckmann lobe), whose f the lanes do not hold.

@@ -39,6 +39,13 @@ class Columns {
   std::size_t size_ = 0, capacity_ = 0;
 };
 
+// How a shading model draws its directions, as the SIMD kernels read it (ShadingModel::sample_direction):
+// lobe_weight of the draws from the proposal, whose parts (ProposalParts, model/proposal.h) are the lobe,
+// the body's cosine and a coat's visible normals (part_coat 0 without a coat), the rest cosine sampling.
+struct ProposalWeights {
+  double lobe_weight = 0.85, part_lobe = 1.0, part_body = 0.0, part_coat = 0.0;
+};
+
 // f(o, i) and the sampling density of i, for pairs (o, i) in the local frame. A pair pushed without
 // `with_pdf` (a light's direction, which nothing weighs against sampling) may get its density or zero.
 struct EvaluationBatch : Columns {

@@ -172,8 +172,7 @@ void SampleTabulatedBatch(const TabulatedBatchModel& model, SampleBatch& batch) 
   const D d;
   int top_step = 1;
   while (top_step * 2 <= model.resolution) top_step *= 2;
-  const lanes::ProposalWeights weights{model.lobe_weight, model.part_lobe, model.part_body, model.part_coat};
-  lanes::sample_proposal(d, weights, model.coat, batch, [&](V ox, V oy, V oz, V u1, V u2, V, V) {
+  lanes::sample_proposal(d, model.weights, model.coat, batch, [&](V ox, V oy, V oz, V u1, V u2, V, V) {
     return lobe_direction(d, model, top_step, ox, oy, oz, u1, u2);
   });
 }
@@ -182,7 +181,7 @@ void EvalTabulatedBatch(const TabulatedBatchModel& model, EvaluationBatch& batch
   const D d;
   const DI di;
   const std::size_t n = batch.padded_size();
-  const V zero = hn::Zero(d), one = hn::Set(d, 1.0), four = hn::Set(d, 4.0), inv_pi = hn::Set(d, kInvPi);
+  const V zero = hn::Zero(d), one = hn::Set(d, 1.0), four = hn::Set(d, 4.0);
   const int resolution = model.resolution;
   const I row = hn::Set(di, model.resolution + 1);  // nodes per view slice of the running sums
   const V body[3] = {hn::Set(d, model.body.r * kInvPi), hn::Set(d, model.body.g * kInvPi), hn::Set(d, model.body.b * kInvPi)};
@@ -242,10 +241,7 @@ void EvalTabulatedBatch(const TabulatedBatchModel& model, EvaluationBatch& batch
     const V safe_band = hn::IfThenElse(visible, band, one), safe_total = hn::IfThenElse(visible, phi_total, one);
     const V safe_oh = hn::IfThenElse(visible, o_dot_h, one);
     const V lobe_pdf = hn::IfThenElseZero(visible, mass / safe_band * o_dot_h / safe_total / (four * safe_oh));
-    V parts = hn::Set(d, model.part_lobe) * lobe_pdf + hn::Set(d, model.part_body) * iz * inv_pi;
-    if (coat) parts = parts + hn::Set(d, model.part_coat) * coat_pdf;
-    const V pdf = hn::Set(d, model.lobe_weight) * parts + hn::Set(d, 1.0 - model.lobe_weight) * (iz * inv_pi);
-    hn::StoreU(hn::IfThenElseZero(above, pdf), d, batch.pdf.data() + k);
+    hn::StoreU(hn::IfThenElseZero(above, lanes::mixture_density(d, model.weights, coat, lobe_pdf, coat_pdf, iz)), d, batch.pdf.data() + k);
   }
 }
 
@@ -274,9 +270,7 @@ std::optional<TabulatedBatchModel> TabulatedBatchModel::of(const TabulatedMicrof
   m.curve = tables.fresnel.value.data();
   m.body = tables.body;
   m.coat = tables.coat;
-  m.lobe_weight = lobe_weight;
-  m.part_lobe = lobe.lobe_weight(), m.part_body = lobe.body_weight();
-  m.part_coat = tables.coat.present() ? lobe.coat_weight() : 0.0;
+  m.weights = {lobe_weight, lobe.lobe_weight(), lobe.body_weight(), tables.coat.present() ? lobe.coat_weight() : 0.0};
   return m;
 }
 

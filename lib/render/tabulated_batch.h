@@ -30,9 +30,7 @@ struct TabulatedBatchModel {
   const Rgb* curve = nullptr;  // the Fresnel curve's 90 entries
   Rgb body{0.0};
   Coat coat;
-  // The density: lobe_weight of the model's own (its parts: the lobe's visible normals, the body's cosine,
-  // the coat's visible normals), the rest cosine sampling.
-  double lobe_weight = 0.85, part_lobe = 1.0, part_body = 0.0, part_coat = 0.0;
+  ProposalWeights weights;
 
   // The lanes' model of `lobe` as a proposal taken with weight lobe_weight; none where the kernels do not
   // hold it (a stretched lobe, or one without sampling tables).
