@@ -55,7 +55,7 @@ class G1Table {
     return std::min(1.0, cos_theta * (ratio_[std::size_t(m)] + t * (ratio_[std::size_t(m) + 1] - ratio_[std::size_t(m)])));
   }
 
- // The table, for SIMD kernels that read it (render/tabulated_batch.h): size() + 1 entries.
+  // The table, for SIMD kernels that read it (render/tabulated_batch.h): size() + 1 entries.
   const double* ratios() const { return ratio_.data(); }
   int size() const { return int(scale_); }
 

@@ -88,8 +88,8 @@ void EvalMerlBatch(const MerlBatchModel& model, EvaluationBatch& batch) {
     for (int corner = 0; corner < 8; ++corner) {
       const V w = ((corner & 1) ? ah.t : one - ah.t) * ((corner & 2) ? ad.t : one - ad.t) * ((corner & 4) ? ap.t : one - ap.t);
       const auto counts = w > zero;
-      const V bin = ((corner & 4) ? ap.i1 : ap.i0) +
-                    hn::Set(d, MerlTable::kPhiD) * (((corner & 2) ? ad.i1 : ad.i0) + hn::Set(d, MerlTable::kThetaD) * ((corner & 1) ? ah.i1 : ah.i0));
+      const V i = (corner & 1) ? ah.i1 : ah.i0, j = (corner & 2) ? ad.i1 : ad.i0, p = (corner & 4) ? ap.i1 : ap.i0;
+      const V bin = p + hn::Set(d, MerlTable::kPhiD) * (j + hn::Set(d, MerlTable::kThetaD) * i);  // MerlTable::index
       const auto index = hn::DemoteTo(di, bin);
       for (int ch = 0; ch < 3; ++ch) {
         const V v = hn::PromoteTo(d, hn::GatherIndex(df, model.channel[ch], index));

@@ -138,7 +138,7 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
   // Shading at a hit is planned, sampled, evaluated, then finished. plan() draws the light directions of
   // the shadow rays and queues, per material, the BRDF sample directions to draw; sample() draws them;
   // evaluate() makes the evaluations of f (and the density) every shadow ray's value needs; finish() turns
-  // each into its shadow ray and value. The middle steps are one call per material, in SIMD lanes (GGX, LUT),
+  // each into its shadow ray and value. The middle steps are one call per material, in SIMD lanes (GGX, LUT, MERL),
   // for one sample on the one-ray path and for a whole tile on the stream path; a model without lanes is
   // sampled and evaluated inside plan().
   struct Request {

@@ -2,9 +2,9 @@
 
 #include <cmath>
 
+#include "io/merl.h"
 #include "model/ndf.h"
 #include "model/parametric.h"
-#include "io/merl.h"
 #include "model/tabulated.h"
 
 namespace facetfit {

@@ -1,8 +1,8 @@
 // The tabulated microfacet model (a LUT: model/tabulated.h) over a batch, in SIMD lanes, as
 // render/ggx_batch.h does for GGX: ShadingModel's sample_direction and eval (f(o, i) and the sampling
-// density) with the model as BRDF and proposal, or as the proposal alone (its density), every term theirs in the same order, so the two agree to
-// rounding (tests/test_render.cpp). The arc cosines of the grid lookups and the sines and cosines of the
-// azimuth's Newton steps are Highway's.
+// density) with the model as BRDF and proposal, or as the proposal alone (its density), every term theirs
+// in the same order, so the two agree to rounding (tests/test_render.cpp). The arc cosines of the grid
+// lookups and the sines and cosines of the azimuth's Newton steps are Highway's.
 #pragma once
 
 #include <optional>
