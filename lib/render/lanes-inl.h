@@ -1,6 +1,6 @@
-// The terms the renderer's SIMD kernels share (render/ggx_batch.cpp, render/tabulated_batch.cpp), compiled
-// into each kernel file once per SIMD target: Highway's per-target header pattern (the guard toggles with
-// HWY_TARGET_TOGGLE). Include after <hwy/highway.h> and <hwy/contrib/math/math-inl.h>.
+// The terms the renderer's SIMD kernels share (render/ggx_batch.cpp, tabulated_batch.cpp, merl_batch.cpp),
+// compiled into each kernel file once per SIMD target: Highway's per-target header pattern (the guard
+// toggles with HWY_TARGET_TOGGLE). Include after <hwy/highway.h> and <hwy/contrib/math/math-inl.h>.
 #if defined(FACETFIT_RENDER_LANES_INL_H_) == defined(HWY_TARGET_TOGGLE)
 #ifdef FACETFIT_RENDER_LANES_INL_H_
 #undef FACETFIT_RENDER_LANES_INL_H_
@@ -119,10 +119,10 @@ inline V mixture_density(D d, const ProposalWeights& weights, bool coat, V lobe_
   return hn::Set(d, weights.lobe_weight) * parts + hn::Set(d, 1.0 - weights.lobe_weight) * (iz * inv_pi);
 }
 
-// Fills the batch's i and found for its padded_size() entries, drawn with `weights` (ShadingModel::
-// sample_direction). `lobe(ox, oy, oz, u1, u2, cos_phi, sin_phi)`
-// draws the lobe's direction (to be refused where i.z <= 0) with u1 rescaled to the lobe's part and
-// (cos, sin) of phi = 2 pi u2; it runs on every lane, the lanes that pick another part discard it.
+// Fills the batch's i and found for its padded_size() entries, drawn with `weights`
+// (ShadingModel::sample_direction). `lobe(ox, oy, oz, u1, u2, cos_phi, sin_phi)` draws the lobe's
+// direction (to be refused where i.z <= 0) with u1 rescaled to the lobe's part and (cos, sin) of
+// phi = 2 pi u2; it runs on every lane, the lanes that pick another part discard it.
 template <class Lobe>
 void sample_proposal(D d, const ProposalWeights& weights, const Coat& coat, SampleBatch& batch, const Lobe& lobe) {
   const std::size_t n = batch.padded_size();

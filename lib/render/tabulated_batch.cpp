@@ -122,8 +122,8 @@ CosSin sample_phi(D d, V a, V b, V u) {
   return {c, sign * s};
 }
 
-// The lobe's visible normals seen from o reflected about: i (TabulatedMicrofacet::lobe_direction, unstretched),
-// to be refused where i.z <= 0. `top_step`: the largest power of two <= the grid's resolution.
+// o reflected about a normal drawn from the lobe's visible normals seen from o: i
+// (TabulatedMicrofacet::lobe_direction, unstretched), to be refused where i.z <= 0. `top_step`: the largest power of two <= the grid's resolution.
 lanes::Direction lobe_direction(D d, const TabulatedBatchModel& model, int top_step, V ox, V oy, V oz, V u1, V u2) {
   const DI di;
   const V zero = hn::Zero(d), one = hn::Set(d, 1.0);
