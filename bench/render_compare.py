@@ -73,17 +73,19 @@ def median(xs):
     return statistics.median(xs)
 
 
-def facetfit_run(binary, work, material, spp, prefix=()):
-    """(render time it prints, whole process, peak memory in MiB), medians."""
+def facetfit_run(binary, work, material, spp, prefix=(), environment=True, light=True):
+    """(render time it prints, whole process, peak memory in MiB), medians; without the environment or the
+    light where told (the stages of docs/render-speed.md)."""
     prefix = list(prefix)
     scene = {
         "camera": {"position": [0, 0.6, 4], "look_at": [0, 0, 0], "up": [0, 1, 0], "fov": 30, "width": SIZE, "height": SIZE},
         "render": {"spp": spp, "seed": 1},
-        "environment": {"constant": [0.3, 0.3, 0.3]},
-        "lights": [{"type": "directional", "direction": [0.3, 1, 0.5], "irradiance": [3, 3, 3]}],
+        "lights": [{"type": "directional", "direction": [0.3, 1, 0.5], "irradiance": [3, 3, 3]}] if light else [],
         "materials": {"m": material},
         "objects": [{"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "m"}],
     }
+    if environment:
+        scene["environment"] = {"constant": [0.3, 0.3, 0.3]}
     path = os.path.join(work, "scene.json")
     with open(path, "w") as f:
         json.dump(scene, f)
@@ -204,6 +206,12 @@ def main(facetfit, mitsuba_python, dst, rgl=None):
                ("Mitsuba scalar_rgb", mitsuba_run(mitsuba_python, "scalar_rgb", ggx_mi, 64, env, one_cpu)[0], rows[0][5][0])]
     if llvm:
         scaling.append(("Mitsuba llvm_ad_rgb", mitsuba_run(mitsuba_python, "llvm_ad_rgb", ggx_mi, 64, env, one_cpu)[0], rows[0][6][0]))
+    # The GGX sphere's stages on one CPU: camera rays and hits alone, then each light alone, then both.
+    stages = [(what, facetfit_run(facetfit, work, ggx_ff, 64, one_cpu, environment=e, light=l)[0]) for what, e, l in (
+        ("camera rays and their hits alone (no light, no environment)", False, False),
+        ("and the directional light (an evaluation and a shadow ray per hit)", False, True),
+        ("and the environment instead (a light sample, a BRDF sample, two evaluations, two shadow rays per hit)", True, False))]
+    stages.append(("both (the scene above)", scaling[0][1]))
     profiles = [(label, profile(facetfit, work, ff)) for label, ff, _ in cases[:2]]
     startup = start_up(facetfit)
     report = (0, 0.0)
@@ -248,14 +256,23 @@ def main(facetfit, mitsuba_python, dst, rgl=None):
                   "is its render time plus this.\n" % (RUNS, startup[0], startup[1], startup[2]))
         out.write("\n## Where the time goes\n\n`perf record` of one facetfit render (64 spp, whole process), self time by\n"
                   "library and symbol (the sphere is intersected in closed form, render/tracer.h; Embree traces triangles only).\n"
-                  "A tile's samples are shaded in steps (render/renderer.cpp): camera rays, a constant environment's light\n"
-                  "samples in SIMD lanes (`N_AVX2::SampleUniformSphereBatch`, render/environment_batch.h) and each hit's frame\n"
-                  "(`place`) in the tile loop; `plan` (light directions, queues); BRDF sampling and evaluation in one call per\n"
+                  "A tile's samples are shaded in steps (render/renderer.cpp): their numbers and camera rays in SIMD lanes\n"
+                  "(`N_AVX2::DrawCameraSamples`, render/camera_batch.h), a constant environment's light samples in SIMD lanes\n"
+                  "(`N_AVX2::SampleUniformSphereBatch`, render/environment_batch.h), the hits and each hit's frame (`place`)\n"
+                  "in the tile loop; `plan` (light directions, queues); BRDF sampling and evaluation in one call per\n"
                   "material, in SIMD lanes for GGX (`N_AVX2::SampleGgxBatch`, `N_AVX2::EvalGgxBatch`, render/ggx_batch.h)\n"
                   "and for a LUT or a measured table's fitted LUT (`N_AVX2::SampleTabulatedBatch`, `N_AVX2::EvalTabulatedBatch`,\n"
                   "render/tabulated_batch.h), a MERL-layout table's f too (`N_AVX2::EvalMerlBatch`, render/merl_batch.h);\n"
                   "then `finish` (shadow rays and their values) in the tile loop. An RGL or UTIA file's own evaluation is\n"
                   "still one pair at a time.\n")
+        out.write("\nBy stage: the GGX sphere at 64 spp on one CPU with parts of the scene left out (one render each, the\n"
+                  "median of %d); the camera stage (the numbers and camera rays in SIMD lanes, render/camera_batch.h, the\n"
+                  "sphere's hits, each hit's frame, the accumulation) is what every sample pays.\n\n"
+                  "| the samples' work | facetfit render, 1 CPU | share of the whole |\n|---|---|---|\n" % RUNS)
+        for what, seconds in stages:
+            out.write("| %s | %.3f s | %.0f%% |\n" % (what, seconds, 100.0 * seconds / stages[-1][1]))
+        if llvm:
+            out.write("\nMitsuba 3 llvm_ad_rgb renders the whole scene on one CPU in %.3f s (Scaling above).\n" % scaling[-1][1])
         for label, (rows_, libraries) in profiles:
             out.write("\n%s, by library: %s.\n\n| self | library | symbol |\n|---|---|---|\n" % (
                 label, ", ".join("%s %.0f%%" % (dso, pct) for dso, pct in libraries) or "n/a"))

@@ -16,6 +16,7 @@
 #include "model/parametric.h"
 #include "model/proposal.h"
 #include "render/renderer.h"
+#include "render/camera_batch.h"
 #include "render/environment.h"
 #include "render/environment_batch.h"
 #include "render/ggx_batch.h"
@@ -270,6 +271,47 @@ TEST(Environment, ConstantLightSamplesInSimdLanesEqualSample) {
         EXPECT_NEAR(glm::length(got), 1.0, 1e-12) << k;
       }
     }
+}
+
+TEST(Camera, SamplesInSimdLanesEqualOneAtATime) {
+  // The numbers exactly (integer arithmetic, and 53 bits to a double), the directions to rounding; pixels
+  // of a wide image (large keys), seeds that set the high bits, sample indices past 2^24 (shifted by 40),
+  // batches of every length modulo the lane count; both the AVX2 code (where the CPU has it) and the
+  // baseline.
+  PinholeCamera camera;
+  camera.position = Vec3(0.0, 0.6, 4.0);
+  camera.forward = glm::normalize(-camera.position);
+  camera.right = glm::normalize(glm::cross(camera.forward, Vec3(0.0, 1.0, 0.0)));
+  camera.up = glm::cross(camera.right, camera.forward);
+  camera.tan_half = std::tan(0.5 * 30.0 * kPi / 180.0), camera.aspect = 16000.0 / 9000.0;
+  camera.to_sx = 2.0 / 16000.0, camera.to_sy = 2.0 / 9000.0;
+  std::mt19937 rng(11);
+  std::uniform_int_distribution<int> px(0, 15999), py(0, 8999);
+  for (const bool baseline : {false, true})
+    for (std::size_t n : {1, 3, 4, 15, 16, 17, 61})
+      for (const auto& [seed, s] : {std::pair<std::uint64_t, int>{1, 0}, {0xFFFFFFFFFFFFull, 63}, {7, (1 << 24) + 5}}) {
+        CameraSampleBatch batch;
+        std::vector<std::pair<int, int>> pixels;
+        for (std::size_t k = 0; k < n; ++k) {
+          pixels.emplace_back(k == 0 ? 0 : px(rng), k == 0 ? 0 : py(rng));
+          batch.push(pixels.back().first, pixels.back().second);
+        }
+        camera_sample_batch(camera, seed, s, batch, baseline);
+        for (std::size_t k = 0; k < n; ++k) {
+          const auto [x, y] = pixels[k];
+          const std::uint64_t start = SampleSequence::start(seed, SampleSequence::pixel_key(x, y), s);
+          double u[kSampleNumbers];
+          for (int j = 0; j < kSampleNumbers; ++j) {
+            u[j] = SampleSequence::number(start, j);
+            ASSERT_EQ(batch.u[j][k], u[j]) << "number " << j << " of pixel (" << x << ", " << y << ")";
+            ASSERT_TRUE(u[j] >= 0.0 && u[j] < 1.0);
+          }
+          const Vec3 want = camera.direction(x, y, u[0], u[1]), got = batch.d(k);
+          EXPECT_NEAR(got.x, want.x, 1e-15) << k;
+          EXPECT_NEAR(got.y, want.y, 1e-15) << k;
+          EXPECT_NEAR(got.z, want.z, 1e-15) << k;
+        }
+      }
 }
 
 TEST(Shading, GgxInSimdLanesEqualsOnePairAtATime) {

@@ -13,6 +13,7 @@
 #include "model/parametric.h"
 #include "model/proposal.h"
 #include "model/tabulated.h"
+#include "render/camera_batch.h"
 #include "render/environment_batch.h"
 #include "render/ggx_batch.h"
 #include "render/merl_batch.h"
@@ -289,6 +290,30 @@ TEST(EnvironmentLanes, EveryBatchLengthAndTheEndsOfTheUnitIntervalStayOnTheSpher
         EXPECT_NEAR(glm::length(b.d(k)), 1.0, 1e-12) << "sample " << k;
       }
     }
+}
+
+TEST(CameraLanes, EveryBatchLengthAndTheImageCornersGiveUnitDirections) {
+  // As above for a tile's camera samples (render/camera_batch.h): any length from 0 to 40 under the
+  // sanitizers, the corners of a one-pixel and of a 16384-pixel-wide image, a camera looking straight
+  // down (forward along -y, the up vector's axis turned into the image's); numbers in [0, 1).
+  for (const int size : {1, 16384}) {
+    PinholeCamera camera;
+    camera.position = Vec3(0.0, 5.0, 0.0);
+    camera.forward = Vec3(0.0, -1.0, 0.0), camera.right = Vec3(1.0, 0.0, 0.0), camera.up = Vec3(0.0, 0.0, -1.0);
+    camera.tan_half = std::tan(0.5 * 170.0 * kPi / 180.0), camera.aspect = 1.0;
+    camera.to_sx = camera.to_sy = 2.0 / size;
+    for (std::size_t n = 0; n <= 40; ++n)
+      for (const bool baseline : {false, true}) {
+        CameraSampleBatch b;
+        for (std::size_t k = 0; k < n; ++k) b.push(k % 2 ? size - 1 : 0, k % 4 < 2 ? 0 : size - 1);
+        camera_sample_batch(camera, ~std::uint64_t(0), 1 << 30, b, baseline);
+        for (std::size_t k = 0; k < n; ++k) {
+          for (const auto& u : b.u) ASSERT_TRUE(u[k] >= 0.0 && u[k] < 1.0) << "sample " << k;
+          for (const double v : {b.dx[k], b.dy[k], b.dz[k]}) ASSERT_TRUE(std::isfinite(v)) << "sample " << k;
+          EXPECT_NEAR(glm::length(b.d(k)), 1.0, 1e-12) << "sample " << k;
+        }
+      }
+  }
 }
 
 }  // namespace

@@ -14,6 +14,7 @@
 #include "io/input.h"
 #include "model/tabulated.h"
 #include "model/tabulated_anisotropic.h"
+#include "render/camera_batch.h"
 #include "render/environment.h"
 #include "render/environment_batch.h"
 #include "render/shading_batch.h"
@@ -23,18 +24,6 @@
 namespace facetfit {
 
 namespace {
-
-// SplitMix64: a counter-based generator, so each pixel's sequence depends on (seed, pixel) only.
-struct Random {
-  std::uint64_t state;
-  double next() {
-    std::uint64_t z = (state += 0x9E3779B97F4A7C15ull);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    z ^= z >> 31;
-    return double(z >> 11) * 0x1.0p-53;
-  }
-};
 
 double power_heuristic(double a, double b) { return a * a / (a * a + b * b); }
 
@@ -110,10 +99,13 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
   const int width = cam.width, height = cam.height;
   const int spp = settings.spp > 0 ? settings.spp : desc.spp;
   const std::uint64_t seed = settings.seed > 0 ? settings.seed : desc.seed;
-  const Vec3 forward = glm::normalize(cam.look_at - cam.position);
-  const Vec3 right = glm::normalize(glm::cross(forward, cam.up));
-  const Vec3 up = glm::cross(right, forward);
-  const double tan_half = std::tan(0.5 * cam.fov_degrees * kPi / 180.0), aspect = double(width) / height;
+  PinholeCamera camera;
+  camera.position = cam.position;
+  camera.forward = glm::normalize(cam.look_at - cam.position);
+  camera.right = glm::normalize(glm::cross(camera.forward, cam.up));
+  camera.up = glm::cross(camera.right, camera.forward);
+  camera.tan_half = std::tan(0.5 * cam.fov_degrees * kPi / 180.0), camera.aspect = double(width) / height;
+  camera.to_sx = 2.0 / width, camera.to_sy = 2.0 / height;
   double scene_scale = 1.0;
   for (const ObjectDesc& o : desc.objects) scene_scale = std::max({scene_scale, glm::length(o.center) + o.radius, o.size});
   // Shadow rays start off the surface and ignore hits closer than this: Embree intersects triangles in
@@ -125,13 +117,9 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
   // nothing blocks them; the shadow rays. The one-ray-at-a-time path runs them per sample, the stream
   // path per tile, through the tracer's streams. Each sample draws its seven numbers before its camera ray
   // and sums its shadow rays in the same order either way, so both give the same image.
-  // Products, not quotients: a division per axis and sample waited on the last (perf).
-  const double to_sx = 2.0 / width, to_sy = 2.0 / height;
   // Written into its place, not copied in (see Ray in render/tracer.h).
-  const auto camera_ray = [&](int x, int y, const double u[2], Ray& ray) {
-    const double sx = ((x + u[0]) * to_sx - 1.0) * tan_half * aspect;
-    const double sy = (1.0 - (y + u[1]) * to_sy) * tan_half;
-    ray.origin = cam.position, ray.dir = glm::normalize(forward + sx * right + sy * up);
+  const auto camera_ray = [&](const Vec3& dir, Ray& ray) {
+    ray.origin = cam.position, ray.dir = dir;
     ray.tnear = 0.0, ray.tfar = std::numeric_limits<double>::infinity();
   };
 
@@ -360,11 +348,11 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
     for (std::size_t q = first; q < last; ++q)
       if (!blocked[q]) radiance += values[q];
   };
-  // The sequence of sample s of pixel (x, y): independent of passes, tiles, threads and paths.
-  const auto sample_numbers = [&](int x, int y, int s, double u[7]) {
-    Random rng{seed * 0x100000001B3ull ^ (std::uint64_t(y) * 73856093u + std::uint64_t(x) * 19349663u) * 0x9E3779B97F4A7C15ull ^
-               std::uint64_t(s) << 40};
-    for (int k = 0; k < 7; ++k) u[k] = rng.next();
+  // The numbers of sample s of pixel (x, y) (render/camera_batch.h): independent of passes, tiles, threads
+  // and paths.
+  const auto sample_numbers = [&](int x, int y, int s, double u[kSampleNumbers]) {
+    const std::uint64_t sequence = SampleSequence::start(seed, SampleSequence::pixel_key(x, y), s);
+    for (int k = 0; k < kSampleNumbers; ++k) u[k] = SampleSequence::number(sequence, k);
   };
   const auto accumulate = [](double* acc, Rgb radiance, double alpha) {
     if (!std::isfinite(radiance.r) || !std::isfinite(radiance.g) || !std::isfinite(radiance.b)) radiance = Rgb(0.0);
@@ -390,10 +378,10 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
     for (int y = tile.rows().begin(); y < tile.rows().end(); ++y)
       for (int x = tile.cols().begin(); x < tile.cols().end(); ++x)
         for (int s = first; s < last; ++s) {
-          double u[7];
+          double u[kSampleNumbers];
           sample_numbers(x, y, s, u);
           Ray ray;
-          camera_ray(x, y, u, ray);
+          camera_ray(camera.direction(x, y, u[0], u[1]), ray);
           rays.clear(), values.clear(), blocked.clear();
           shading.clear();
           const Hit hit = tracer.intersect(ray);
@@ -415,7 +403,6 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
     const std::size_t n = std::size_t(count);
     std::vector<Ray> cameras(n);
     std::vector<Hit> hits;
-    std::vector<double> numbers(n * 7);
     std::vector<Planned> planned(n);
     std::vector<Ray> rays;
     std::vector<Rgb> values;
@@ -428,20 +415,21 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
     // first sample of a tile does not grow them piece by piece.
     const std::size_t most = n * (2 + desc.lights.size());
     shading.requests.reserve(most), rays.reserve(most), values.reserve(most), blocked.reserve(most);
-    // Each pixel's coordinates once per tile, not two integer divisions per sample.
+    // Each pixel's coordinates and its part of the sequences once per tile; per sample index, the numbers
+    // and camera rays of all in SIMD lanes.
     std::vector<int> xs(n), ys(n);
-    for (int k = 0; k < count; ++k) xs[std::size_t(k)] = tile.cols().begin() + k % tw, ys[std::size_t(k)] = tile.rows().begin() + k / tw;
+    CameraSampleBatch samples;
+    for (int k = 0; k < count; ++k) {
+      xs[std::size_t(k)] = tile.cols().begin() + k % tw, ys[std::size_t(k)] = tile.rows().begin() + k / tw;
+      samples.push(xs[std::size_t(k)], ys[std::size_t(k)]);
+    }
     for (int s = first; s < last; ++s) {
-      for (int k = 0; k < count; ++k) {
-        const int x = xs[std::size_t(k)], y = ys[std::size_t(k)];
-        double* u = numbers.data() + std::size_t(k) * 7;
-        sample_numbers(x, y, s, u);
-        camera_ray(x, y, u, cameras[std::size_t(k)]);
-      }
+      camera_sample_batch(camera, seed, s, samples);
+      for (std::size_t k = 0; k < n; ++k) camera_ray(samples.d(k), cameras[k]);
       tracer.intersect(cameras, hits, true);
       if (sphere_lanes) {
         light_samples.clear();
-        for (std::size_t k = 0; k < n; ++k) light_samples.push(numbers[k * 7 + 2], numbers[k * 7 + 3]);
+        for (std::size_t k = 0; k < n; ++k) light_samples.push(samples.u[2][k], samples.u[3][k]);
         sample_uniform_sphere_batch(light_samples);
       }
       for (std::size_t k = 0; k < n; ++k) place(hits[k], cameras[k].dir, planned[k]);
@@ -449,7 +437,8 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
       rays.clear(), values.clear();
       for (std::size_t k = 0; k < n; ++k) {
         const Vec3 light_d = sphere_lanes ? light_samples.d(k) : Vec3(0.0);
-        plan(hits[k], cameras[k].dir, numbers.data() + k * 7 + 2, sphere_lanes ? &light_d : nullptr, shading, planned[k], rays, values);
+        const double u[5] = {samples.u[2][k], samples.u[3][k], samples.u[4][k], samples.u[5][k], samples.u[6][k]};
+        plan(hits[k], cameras[k].dir, u, sphere_lanes ? &light_d : nullptr, shading, planned[k], rays, values);
       }
       sample(planned, shading, true);
       evaluate(shading, true);

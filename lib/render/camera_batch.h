@@ -1,0 +1,73 @@
+// A tile's camera samples in SIMD lanes (Google Highway, as render/ggx_batch.h): each pixel's numbers for
+// one sample index and its camera ray's direction. Drawn one sample at a time inside the tile loop, their
+// 64-bit hashes, square roots and divisions took 40% of a render that traces camera rays only (perf).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "render/shading_batch.h"
+
+namespace facetfit {
+
+// The numbers a sample draws: two for the pixel's jitter, five for its shading (render/renderer.cpp).
+constexpr int kSampleNumbers = 7;
+
+// SplitMix64, a counter-based generator: the sequence of sample s of pixel (x, y) starts at a state that
+// depends on (seed, x, y, s) only, so an image does not depend on passes, tiles, threads or paths.
+struct SampleSequence {
+  static constexpr std::uint64_t kStep = 0x9E3779B97F4A7C15ull;
+  static std::uint64_t pixel_key(int x, int y) {
+    return (std::uint64_t(y) * 73856093u + std::uint64_t(x) * 19349663u) * kStep;
+  }
+  static std::uint64_t start(std::uint64_t seed, std::uint64_t pixel_key, int s) {
+    return seed * 0x100000001B3ull ^ pixel_key ^ std::uint64_t(s) << 40;
+  }
+  // Number j of the sequence from `start`: its (j + 1)-th state, mixed; a double in [0, 1) from 53 bits.
+  static double number(std::uint64_t start, int j) {
+    std::uint64_t z = start + std::uint64_t(j + 1) * kStep;
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    z ^= z >> 31;
+    return double(z >> 11) * 0x1.0p-53;
+  }
+};
+
+// A pinhole camera: image point (x + u0, y + u1), in pixels from the top left, to a unit direction.
+struct PinholeCamera {
+  Vec3 position, forward, right, up;
+  double tan_half = 1.0, aspect = 1.0;
+  double to_sx = 1.0, to_sy = 1.0;  // 2 / width, 2 / height: products, not quotients (a division per axis
+                                    // and sample waited on the last: perf)
+  Vec3 direction(double x, double y, double u0, double u1) const {
+    const double sx = ((x + u0) * to_sx - 1.0) * tan_half * aspect;
+    const double sy = (1.0 - (y + u1) * to_sy) * tan_half;
+    return glm::normalize(forward + sx * right + sy * up);
+  }
+};
+
+// Per pixel of a tile: in, its coordinates and SampleSequence::pixel_key; out, for one sample index, the
+// seven numbers (u[j]) and the camera ray's direction.
+struct CameraSampleBatch : Columns {
+  std::vector<double> x, y;
+  std::vector<std::uint64_t> key;
+  std::vector<double> u[kSampleNumbers];
+  std::vector<double> dx, dy, dz;
+  std::size_t push(int px, int py) {
+    const std::size_t k = next([this](std::size_t n) {
+      resize({&x, &y, &dx, &dy, &dz}, n, 0.0);
+      for (std::vector<double>& c : u) c.resize(n, 0.0);
+      key.resize(n, 0);
+    });
+    x[k] = px, y[k] = py, key[k] = SampleSequence::pixel_key(px, py);
+    return k;
+  }
+  Vec3 d(std::size_t k) const { return {dx[k], dy[k], dz[k]}; }
+};
+
+// Fills u and d for the batch's padded_size() entries: SampleSequence::number j of each pixel's sample s,
+// and PinholeCamera::direction with its first two. `baseline`: the code for CPUs without AVX2, which the
+// tests run too.
+void camera_sample_batch(const PinholeCamera& camera, std::uint64_t seed, int s, CameraSampleBatch& batch, bool baseline = false);
+
+}  // namespace facetfit
