@@ -36,6 +36,7 @@ MITSUBA_SCRIPT = r"""
 import json, sys, time
 import mitsuba as mi
 variant, spp, material, renders = sys.argv[1], int(sys.argv[2]), json.loads(sys.argv[3]), int(sys.argv[4])
+images = sys.argv[5] if len(sys.argv) > 5 else None  # where to write each render (a %%d for its seed), untimed
 mi.set_variant(variant)
 T = mi.ScalarTransform4f
 if material["type"] == "ggx":
@@ -60,8 +61,29 @@ for seed in range(renders):
     image = mi.render(scene, spp=spp, seed=seed)
     mi.Bitmap(image)  # forces the evaluation of the JIT variant
     times.append(time.perf_counter() - start)
+    if images:
+        mi.Bitmap(image).write(images %% seed)
 print("\nfacetfit-times " + json.dumps(times))  # Mitsuba leaves its loading line unterminated
 """ % {"size": SIZE}
+
+
+# Per-pixel noise from two renders of each renderer with different seeds, in the Mitsuba venv's python
+# (numpy, OpenEXR through mi.Bitmap): FACETFIT_A FACETFIT_B MITSUBA_A MITSUBA_B. Over the pixels the sphere
+# covers wholly (facetfit's alpha 1): the variance of one render, E[(a - b)^2] / 2 over pixels and channels,
+# and the mean, which two unbiased renderers share.
+NOISE_SCRIPT = r"""
+import json, sys
+import numpy as np
+import mitsuba as mi
+mi.set_variant("scalar_rgb")
+ff_a, ff_b, mi_a, mi_b = [np.array(mi.Bitmap(p), dtype=np.float64) for p in sys.argv[1:5]]
+inside = ff_a[..., 3] > 0.999
+out = {"pixels": int(inside.sum())}
+for name, a, b in (("facetfit", ff_a, ff_b), ("mitsuba", mi_a, mi_b)):
+    a, b = a[..., :3][inside], b[..., :3][inside]
+    out[name] = {"variance": float(np.mean((a - b) ** 2) / 2), "mean": float(np.mean(a + b) / 2)}
+print("\nfacetfit-noise " + json.dumps(out))
+"""
 
 
 def runs_at(spp):
@@ -73,13 +95,11 @@ def median(xs):
     return statistics.median(xs)
 
 
-def facetfit_run(binary, work, material, spp, prefix=(), environment=True, light=True):
-    """(render time it prints, whole process, peak memory in MiB), medians; without the environment or the
-    light where told (the stages of docs/render-speed.md)."""
-    prefix = list(prefix)
+def write_scene(work, material, spp, environment=True, light=True, seed=1):
+    """The scene in facetfit's format, as work/scene.json; without the environment or the light where told."""
     scene = {
         "camera": {"position": [0, 0.6, 4], "look_at": [0, 0, 0], "up": [0, 1, 0], "fov": 30, "width": SIZE, "height": SIZE},
-        "render": {"spp": spp, "seed": 1},
+        "render": {"spp": spp, "seed": seed},
         "lights": [{"type": "directional", "direction": [0.3, 1, 0.5], "irradiance": [3, 3, 3]}] if light else [],
         "materials": {"m": material},
         "objects": [{"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "m"}],
@@ -89,6 +109,14 @@ def facetfit_run(binary, work, material, spp, prefix=(), environment=True, light
     path = os.path.join(work, "scene.json")
     with open(path, "w") as f:
         json.dump(scene, f)
+    return path
+
+
+def facetfit_run(binary, work, material, spp, prefix=(), environment=True, light=True):
+    """(render time it prints, whole process, peak memory in MiB), medians; without the environment or the
+    light where told (the stages of docs/render-speed.md)."""
+    prefix = list(prefix)
+    path = write_scene(work, material, spp, environment, light)
     renders, processes, memory = [], [], []
     for _ in range(runs_at(spp)):
         start = time.perf_counter()
@@ -116,6 +144,21 @@ def mitsuba_run(python, variant, material, spp, env, prefix=()):
         processes.append(wall)
         memory.append(mib)
     return median(renders), median(processes), median(memory)
+
+
+def noise(facetfit, python, work, ff_material, mi_material, spp, env, variant):
+    """Both renderers' per-pixel noise and mean on one sphere (NOISE_SCRIPT), two seeds each."""
+    images = []
+    for seed in (1, 2):
+        images.append(os.path.join(work, "noise-facetfit-%d.exr" % seed))
+        subprocess.run([facetfit, "render", write_scene(work, ff_material, spp, seed=seed), "-o", images[-1]], check=True,
+                       capture_output=True)
+    pattern = os.path.join(work, "noise-mitsuba-%d.exr")
+    subprocess.run([python, "-c", MITSUBA_SCRIPT, variant, str(spp), json.dumps(mi_material), "2", pattern], check=True,
+                   capture_output=True, env=env)
+    out = subprocess.run([python, "-c", NOISE_SCRIPT] + images + [pattern % 0, pattern % 1], check=True, capture_output=True,
+                         text=True, env=env).stdout
+    return json.loads(out.split("facetfit-noise ")[-1])
 
 
 def profile(binary, work, material):
@@ -212,6 +255,11 @@ def main(facetfit, mitsuba_python, dst, rgl=None):
         ("and the directional light (an evaluation and a shadow ray per hit)", False, True),
         ("and the environment instead (a light sample, a BRDF sample, two evaluations, two shadow rays per hit)", True, False))]
     stages.append(("both (the scene above)", scaling[0][1]))
+    # Noise at 64 spp, on the spheres both renderers render themselves (not the proxies).
+    variant = "llvm_ad_rgb" if llvm else "scalar_rgb"
+    at64 = [row for row in rows if row[1] == 64]
+    noises = [(label, noise(facetfit, mitsuba_python, work, ff, mi_material, 64, env, variant), row)
+              for (label, ff, mi_material), row in zip(cases, at64) if not row[7]]
     profiles = [(label, profile(facetfit, work, ff)) for label, ff, _ in cases[:2]]
     startup = start_up(facetfit)
     report = (0, 0.0)
@@ -249,6 +297,24 @@ def main(facetfit, mitsuba_python, dst, rgl=None):
         out.write("| renderer | render, 1 CPU | render, %d CPUs | speed-up |\n|---|---|---|---|\n" % cpus)
         for name, one, all_ in scaling:
             out.write("| %s | %.3f s | %.3f s | %.2f |\n" % (name, one, all_, one / all_))
+        out.write("\n## Noise at equal samples\n\nA render's time is half of its cost; the other half is its noise. Two renders of each\n"
+                  "renderer at 64 spp with different seeds (Mitsuba: %s), over the pixels the sphere covers wholly\n"
+                  "(%d): the variance of one render per pixel and channel, E[(a - b)^2] / 2, and the mean of both. Variance\n"
+                  "falls as 1 / spp, so *time to equal noise* = (facetfit's render time x its variance) / (Mitsuba's x\n"
+                  "its): the ratio of the times the two need for the same noise. Per sample facetfit lights a hit by every\n"
+                  "light (the directional light's shadow ray each sample; the environment by a light sample and a BRDF\n"
+                  "sample, weighted by multiple importance sampling: render/renderer.cpp); Mitsuba's `direct` integrator\n"
+                  "draws one emitter sample, from one of the scene's emitters picked at random, and one BSDF sample. The\n"
+                  "table at the top compares equal samples, not equal noise, and stays the measure of the render's speed.\n\n"
+                  % (variant, noises[0][1]["pixels"] if noises else 0))
+        out.write("| sphere | facetfit variance | Mitsuba variance | variance ratio | facetfit mean | Mitsuba mean | render / Mitsuba (64 spp) | time to equal noise / Mitsuba |\n"
+                  "|---|---|---|---|---|---|---|---|\n")
+        for label, n, row in noises:
+            mitsuba_time = row[6][0] if row[6] else row[5][0]
+            ratio = n["facetfit"]["variance"] / n["mitsuba"]["variance"]
+            out.write("| %s | %.3g | %.3g | %.3f | %.4f | %.4f | %.2f | %.3f |\n" % (
+                label, n["facetfit"]["variance"], n["mitsuba"]["variance"], ratio, n["facetfit"]["mean"], n["mitsuba"]["mean"],
+                row[2] / mitsuba_time, row[2] / mitsuba_time * ratio))
         out.write("\n## Start-up\n\nA process that loads the render command and exits at once (`facetfit render --help`), median of %d: "
                   "%.3f s; the command plugin and the shared libraries it needs: %d (OpenImageIO, ~260 more, is a module of its own, "
                   "loaded only for images other than OpenEXR: io/image_file.h), "
@@ -264,7 +330,8 @@ def main(facetfit, mitsuba_python, dst, rgl=None):
                   "and for a LUT or a measured table's fitted LUT (`N_AVX2::SampleTabulatedBatch`, `N_AVX2::EvalTabulatedBatch`,\n"
                   "render/tabulated_batch.h), a MERL-layout table's f too (`N_AVX2::EvalMerlBatch`, render/merl_batch.h);\n"
                   "then `finish` (shadow rays and their values) in the tile loop. An RGL or UTIA file's own evaluation is\n"
-                  "still one pair at a time.\n")
+                  "still one pair at a time. The kernels are compiled for AVX2 and the baseline: an AVX-512 target made the\n"
+                  "GGX sphere slower (render/simd_targets.h).\n")
         out.write("\nBy stage: the GGX sphere at 64 spp on one CPU with parts of the scene left out (one render each, the\n"
                   "median of %d); the camera stage (the numbers and camera rays in SIMD lanes, render/camera_batch.h, the\n"
                   "sphere's hits, each hit's frame, the accumulation) is what every sample pays.\n\n"

@@ -82,7 +82,8 @@ def main(src, dst, startup_md=None):
         "Run time against error of the rendered result (LUT resolution x samples per pixel, Pareto front):",
         "[pareto.md](pareto.md). The reference renderer against Blender Cycles on the same scene: [cycles.md](cycles.md).",
         "Against Mitsuba 3 (scalar_rgb and llvm_ad_rgb) on the realref scene, with its profile (where the time goes),",
-        "scaling from one CPU to all, memory per render and the report's throughput: [render-speed.md](render-speed.md).",
+        "scaling from one CPU to all, memory per render, the noise of both at equal samples and the report's throughput:",
+        "[render-speed.md](render-speed.md).",
         "",
     ]
     if startup_md:
