@@ -42,7 +42,7 @@ void DrawCameraSamples(const PinholeCamera& camera, std::uint64_t seed, int s, C
   const D d;
   const DU du;
   const DI di;
-  const std::uint64_t seed_part = seed * 0x100000001B3ull ^ std::uint64_t(s) << 40;
+  const std::uint64_t seed_part = SampleSequence::start(seed, 0, s);
   const auto scale = hn::Set(d, 0x1.0p-53), one = hn::Set(d, 1.0);
   const auto to_sx = hn::Set(d, camera.to_sx), to_sy = hn::Set(d, camera.to_sy);
   const auto tan_half = hn::Set(d, camera.tan_half), aspect = hn::Set(d, camera.aspect);
@@ -50,8 +50,8 @@ void DrawCameraSamples(const PinholeCamera& camera, std::uint64_t seed, int s, C
     const VU start = hn::Xor(hn::Set(du, seed_part), hn::LoadU(du, batch.key.data() + k));
     for (int j = 0; j < kSampleNumbers; ++j) {
       VU z = start + hn::Set(du, std::uint64_t(j + 1) * SampleSequence::kStep);
-      z = mul(hn::Xor(z, hn::ShiftRight<30>(z)), 0xBF58476D1CE4E5B9ull);
-      z = mul(hn::Xor(z, hn::ShiftRight<27>(z)), 0x94D049BB133111EBull);
+      z = mul(hn::Xor(z, hn::ShiftRight<30>(z)), SampleSequence::kMix1);
+      z = mul(hn::Xor(z, hn::ShiftRight<27>(z)), SampleSequence::kMix2);
       z = hn::Xor(z, hn::ShiftRight<31>(z));
       hn::StoreU(hn::ConvertTo(d, hn::BitCast(di, hn::ShiftRight<11>(z))) * scale, d, batch.u[j].data() + k);
     }

@@ -17,17 +17,19 @@ constexpr int kSampleNumbers = 7;
 // depends on (seed, x, y, s) only, so an image does not depend on passes, tiles, threads or paths.
 struct SampleSequence {
   static constexpr std::uint64_t kStep = 0x9E3779B97F4A7C15ull;
+  static constexpr std::uint64_t kMix1 = 0xBF58476D1CE4E5B9ull, kMix2 = 0x94D049BB133111EBull;  // the finalizer's
   static std::uint64_t pixel_key(int x, int y) {
     return (std::uint64_t(y) * 73856093u + std::uint64_t(x) * 19349663u) * kStep;
   }
+  // Seed and sample index xor pixel_key: the lanes take start(seed, 0, s) once per batch.
   static std::uint64_t start(std::uint64_t seed, std::uint64_t pixel_key, int s) {
     return seed * 0x100000001B3ull ^ pixel_key ^ std::uint64_t(s) << 40;
   }
   // Number j of the sequence from `start`: its (j + 1)-th state, mixed; a double in [0, 1) from 53 bits.
   static double number(std::uint64_t start, int j) {
     std::uint64_t z = start + std::uint64_t(j + 1) * kStep;
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    z = (z ^ (z >> 30)) * kMix1;
+    z = (z ^ (z >> 27)) * kMix2;
     z ^= z >> 31;
     return double(z >> 11) * 0x1.0p-53;
   }

@@ -417,12 +417,8 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
     shading.requests.reserve(most), rays.reserve(most), values.reserve(most), blocked.reserve(most);
     // Each pixel's coordinates and its part of the sequences once per tile; per sample index, the numbers
     // and camera rays of all in SIMD lanes.
-    std::vector<int> xs(n), ys(n);
     CameraSampleBatch samples;
-    for (int k = 0; k < count; ++k) {
-      xs[std::size_t(k)] = tile.cols().begin() + k % tw, ys[std::size_t(k)] = tile.rows().begin() + k / tw;
-      samples.push(xs[std::size_t(k)], ys[std::size_t(k)]);
-    }
+    for (int k = 0; k < count; ++k) samples.push(tile.cols().begin() + k % tw, tile.rows().begin() + k / tw);
     for (int s = first; s < last; ++s) {
       camera_sample_batch(camera, seed, s, samples);
       for (std::size_t k = 0; k < n; ++k) camera_ray(samples.d(k), cameras[k]);
@@ -446,7 +442,7 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
       tracer.occluded(rays, blocked);
       for (std::size_t k = 0; k < n; ++k) {
         add_unblocked(blocked, values, planned[k].ray_first, planned[k].ray_last, planned[k].radiance);
-        accumulate(pixel_accum(xs[k], ys[k]), planned[k].radiance, planned[k].alpha);
+        accumulate(pixel_accum(int(samples.x[k]), int(samples.y[k])), planned[k].radiance, planned[k].alpha);
       }
     }
   };
