@@ -4,7 +4,7 @@
 // Two targets: AVX2 and the baseline. AVX3_DL, AVX3, SSE4 and SSSE3 are off (their bits in
 // hwy/detect_targets.h; each kernel file checks them against Highway's names). AVX3 (AVX-512, eight doubles a
 // vector) was tried on a CPU that has it: the GGX sphere of docs/render-speed.md rendered slower (64 spp
-// 0.22 -> 0.24 s, 1024 spp 3.44 -> 3.61 s, medians of alternating runs), so it stays off.
+// 0.22 -> 0.24 s, 1024 spp 3.44 -> 3.61 s, medians of alternating runs; a one-off probe), so it stays off.
 #pragma once
 
 #define HWY_DISABLED_TARGETS ((1LL << 7) | (1LL << 8) | (1LL << 11) | (1LL << 12))
