@@ -33,11 +33,19 @@ LLVM = "/usr/lib/x86_64-linux-gnu/libLLVM.so.19.1"
 # The Mitsuba side, run in the Mitsuba venv's python as its own process: VARIANT SPP MATERIAL_JSON RENDERS
 # (2 to time the second render; 1 for the whole process of one render).
 MITSUBA_SCRIPT = r"""
-import json, sys, time
+import json, os, sys, time
 import mitsuba as mi
 variant, spp, material, renders = sys.argv[1], int(sys.argv[2]), json.loads(sys.argv[3]), int(sys.argv[4])
 images = sys.argv[5] if len(sys.argv) > 5 else None  # where to write each render (a %%d for its seed), untimed
 mi.set_variant(variant)
+if os.environ.get("FACETFIT_LLVM_TARGET"):
+    # CPU:FEATURES:WIDTH for Dr.Jit's LLVM back end (jit_llvm_set_target in drjit-core's jit.h, exported with
+    # C++ linkage by this wheel), before any kernel compiles: the vector width Mitsuba's kernels get.
+    import ctypes, drjit
+    core = ctypes.CDLL(os.path.join(os.path.dirname(drjit.__file__), "libdrjit-core.so"))
+    set_target = getattr(core, "_Z19jit_llvm_set_targetPKcS0_j")
+    cpu, features, width = os.environ["FACETFIT_LLVM_TARGET"].split(":")
+    set_target(cpu.encode(), features.encode(), ctypes.c_uint32(int(width)))
 T = mi.ScalarTransform4f
 if material["type"] == "ggx":
     bsdf = {"type": "roughconductor", "distribution": "ggx", "alpha": material["alpha"], "material": "none",
@@ -249,6 +257,18 @@ def main(facetfit, mitsuba_python, dst, rgl=None):
                ("Mitsuba scalar_rgb", mitsuba_run(mitsuba_python, "scalar_rgb", ggx_mi, 64, env, one_cpu)[0], rows[0][5][0])]
     if llvm:
         scaling.append(("Mitsuba llvm_ad_rgb", mitsuba_run(mitsuba_python, "llvm_ad_rgb", ggx_mi, 64, env, one_cpu)[0], rows[0][6][0]))
+    # Mitsuba's GGX sphere with its kernels compiled for narrower vectors than the host's: how much of its
+    # lead is vector width (facetfit's kernels run four doubles, AVX2).
+    widths = []
+    flags = open("/proc/cpuinfo").read() if os.path.exists("/proc/cpuinfo") else ""
+    if llvm and " avx2" in flags:
+        avx2 = "haswell:+avx2,+fma,+f16c,+bmi,+bmi2,+popcnt,+lzcnt,+sse4.2:"
+        widths.append(("the host's (%s)" % ("AVX-512, 16 lanes" if " avx512f" in flags else "AVX2, 8 lanes"), rows[0][6][0]))
+        for label, target in (("AVX2, 8 lanes", avx2 + "8"), ("AVX2, 4 lanes", avx2 + "4")):
+            try:
+                widths.append((label, mitsuba_run(mitsuba_python, "llvm_ad_rgb", ggx_mi, 64, dict(env, FACETFIT_LLVM_TARGET=target))[0]))
+            except (subprocess.CalledProcessError, ValueError):
+                widths.append((label, None))
     # The GGX sphere's stages on one CPU: camera rays and hits alone, then each light alone, then both.
     stages = [(what, facetfit_run(facetfit, work, ggx_ff, 64, one_cpu, environment=e, light=l)[0]) for what, e, l in (
         ("camera rays and their hits alone (no light, no environment)", False, False),
@@ -297,6 +317,16 @@ def main(facetfit, mitsuba_python, dst, rgl=None):
         out.write("| renderer | render, 1 CPU | render, %d CPUs | speed-up |\n|---|---|---|---|\n" % cpus)
         for name, one, all_ in scaling:
             out.write("| %s | %.3f s | %.3f s | %.2f |\n" % (name, one, all_, one / all_))
+        if widths:
+            out.write("\n## Vector width\n\nMitsuba's llvm_ad_rgb variant compiles its kernels for the host's widest vectors: 16\n"
+                      "single-precision lanes with AVX-512, 8 with AVX2. facetfit's SIMD kernels run 4 double-precision lanes\n"
+                      "(AVX2: render/simd_targets.h) and the rest of its pipeline one sample at a time. The GGX sphere at 64 spp\n"
+                      "with Mitsuba's kernels compiled for narrower vectors (Dr.Jit's `jit_llvm_set_target`), against facetfit's\n"
+                      "render in the table at the top (%.3f s):\n\n| Mitsuba llvm_ad_rgb target | render | facetfit render / Mitsuba's |\n"
+                      "|---|---|---|\n" % rows[0][2])
+            for label, seconds in widths:
+                out.write("| %s | %s | %s |\n" % (label, "%.3f s" % seconds if seconds else "n/a",
+                                                   "%.2f" % (rows[0][2] / seconds) if seconds else "n/a"))
         out.write("\n## Noise at equal samples\n\nA render's time is half of its cost; the other half is its noise. Two renders of each\n"
                   "renderer at 64 spp with different seeds (Mitsuba: %s), over the pixels the sphere covers wholly\n"
                   "(%d): the variance of one render per pixel and channel, E[(a - b)^2] / 2, and the mean of both. Variance\n"
