@@ -85,7 +85,7 @@ void run_fit(const FitArgs& args, Context& ctx) {
 void add_fit_command(CLI::App& app, Context& ctx) {
   auto args = std::make_shared<FitArgs>();
   CLI::App* cmd = app.add_subcommand("fit", "Fit microfacet components to measured materials");
-  cmd->add_option("inputs", args->inputs, "MERL .binary files, folders, or builtin:NAME (builtin: for all)");
+  cmd->add_option("inputs", args->inputs, "MERL .binary, RGL .bsdf or UTIA .bin files, folders of them, or builtin:NAME (builtin: for all)");
   cmd->add_flag("--builtin", args->builtin, "Fit every built-in synthetic material");
   add_fit_settings(cmd, args->settings);
   cmd->add_flag("--json", args->json, "One JSON object per material on stdout");

@@ -115,7 +115,8 @@ void add_render_command(CLI::App& app, Context& ctx) {
   cmd->add_option("--height", args->height, "Image height (default: the scene's)")->check(CLI::Range(1, 16384));
   add_max_memory_option(cmd, args->max_memory);
   cmd->add_option("--material", args->material, "Default scene only: the sphere's material file")->capture_default_str();
-  cmd->add_option("--material-type", args->material_type, "Default scene only: measured, lut, ggx, beckmann or lsq (a measurement is baked first for the last four)")
+  cmd->add_option("--material-type", args->material_type, "Default scene only: measured, lut, ggx, beckmann or lsq (a measurement is baked first for the last four), "
+                  "analytic (a built-in's analytic model) or lambert (albedo 0.8)")
       ->check(CLI::IsMember({"measured", "lut", "ggx", "beckmann", "lsq", "analytic", "lambert"}))
       ->capture_default_str();
   cmd->callback([args, &ctx] { run_render(*args, ctx); });

@@ -14,7 +14,7 @@ NOTES = {
     "BM_Quadrature2D": "the 2D quadrature's kernel spectra (once per batch, shared by every material)",
     "BM_FresnelPass": "one pass over every bin of the table",
     "BM_Quadrature": "quadrature weights of one resolution (once per batch, shared by every material)",
-    "BM_RefineAlpha": "optional least-squares refinement of one alpha (`--refine`)",
+    "BM_RefineAlpha": "refinement of one alpha against the tabulated NDF (`refine_alpha`, fit/roughness.h; no command calls it)",
     "BM_TabulateAnalytic": "tabulate an analytic BRDF into MERL layout (tests, `convert builtin:`)",
     "BM_LoadUtia": "a UTIA file (anisotropic GGX) to the fits' table: read, azimuthal mean, tabulation in MERL layout (against BM_TabulateAnalytic)",
     "BM_FitUtia": "the fit of that table, the paper's method (refine:0) and the default (refine:1, with the anisotropic GGX and Beckmann lobes fitted at the file's node pairs), each with the 2D extraction of the file's back-scattering",

@@ -258,7 +258,7 @@ PYBIND11_MODULE(_facetfit, m) {
       .def("__repr__", [](const Measurement& x) { return "<facetfit.Measurement " + x.source + ">"; });
 
   m.def("load", &load, py::arg("source"), py::arg("merl_bins") = "start",
-        "Loads a measurement: a MERL .binary, an RGL .bsdf or builtin:NAME. Raises facetfit.Error naming the file.");
+        "Loads a measurement: a MERL .binary, an RGL .bsdf, a UTIA .bin or builtin:NAME. Raises facetfit.Error naming the file.");
   m.def("builtins", [] {
     std::vector<std::string> names;
     for (const std::string& s : expand_inputs({kBuiltinPrefix})) names.push_back(source_name(s));
