@@ -67,7 +67,7 @@ TEST(Merl, NearestLookupTruncatesLikeTheReferenceReader) {
   // Just inside bin (12, 34, 56) of each axis.
   const double th = std::pow((12 + 0.9) / 90.0, 2) * 0.5 * kPi, td = (34 + 0.9) / 90.0 * 0.5 * kPi,
                pd = (56 + 0.9) / 180.0 * kPi;
-  const auto [i, o] = from_half_diff(th, td, pd);
+  const auto [o, i] = from_half_diff(th, td, pd);
   const Rgb v = *table.eval(o, i);
   EXPECT_EQ(v, Rgb(12, 34, 56));
   // phi_d and phi_d + pi are the same bin (reciprocity).
@@ -81,7 +81,7 @@ TEST(Merl, LinearLookupInterpolatesAndSkipsMissingBins) {
       for (int k = 0; k < MerlTable::kPhiD; ++k) table.set(i, j, k, Rgb(i + 2.0 * j + 0.5 * k));
   // Halfway along theta_d between bins 40 and 41: the mean of the two.
   const double th = std::pow(30.0 / 90.0, 2) * 0.5 * kPi, pd = 50.0 / 180.0 * kPi;
-  auto [i, o] = from_half_diff(th, 40.5 / 90.0 * 0.5 * kPi, pd);
+  auto [o, i] = from_half_diff(th, 40.5 / 90.0 * 0.5 * kPi, pd);
   EXPECT_NEAR(table.eval(o, i)->r, 30 + 81.0 + 25, 1e-3);
   // With bin 41 missing, only bin 40 remains.
   table.set_missing(30, 41, 50);

@@ -116,8 +116,8 @@ TEST(HalfDiff, RoundTrip) {
   std::uniform_real_distribution<double> u(0.0, 1.0);
   for (int n = 0; n < 1000; ++n) {
     const double th = u(rng) * 0.5 * kPi, td = u(rng) * 0.5 * kPi, pd = u(rng) * 2.0 * kPi - kPi;
-    const auto [i, o] = from_half_diff(th, td, pd);
-    const HalfDiff hd = to_half_diff(i, o);
+    const auto [o, i] = from_half_diff(th, td, pd);
+    const HalfDiff hd = to_half_diff(o, i);
     EXPECT_NEAR(hd.theta_h, th, 1e-7);
     EXPECT_NEAR(hd.theta_d, td, 1e-7);
     if (td > 1e-3 && th > 1e-3) {

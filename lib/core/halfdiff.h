@@ -17,7 +17,7 @@ struct HalfDiff {
   double theta_h = 0, phi_h = 0, theta_d = 0, phi_d = 0;
 };
 
-inline HalfDiff to_half_diff(const Vec3& i, const Vec3& o) {
+inline HalfDiff to_half_diff(const Vec3& o, const Vec3& i) {
   Vec3 h = i + o;
   const double len = glm::length(h);
   h = len > 1e-12 ? h / len : Vec3(0, 0, 1);
@@ -35,14 +35,14 @@ inline HalfDiff to_half_diff(const Vec3& i, const Vec3& o) {
   return hd;
 }
 
-// The pair (i, o) at half/diff angles with phi_h = 0 (isotropic materials do not depend on phi_h).
+// The pair (o, i) at half/diff angles with phi_h = 0 (isotropic materials do not depend on phi_h).
 inline std::pair<Vec3, Vec3> from_half_diff(double theta_h, double theta_d, double phi_d) {
   const Vec3 d = spherical_direction(theta_d, phi_d);
   const double ct = std::cos(theta_h), st = std::sin(theta_h);
   const Vec3 i(ct * d.x + st * d.z, d.y, -st * d.x + ct * d.z);  // i = R_y(theta_h) d
   const Vec3 h(st, 0.0, ct);
   const Vec3 o = 2.0 * glm::dot(i, h) * h - i;  // mirror of i about h
-  return {i, o};
+  return {o, i};
 }
 
 }  // namespace facetfit

@@ -65,7 +65,7 @@ std::optional<FresnelCurve> fit_fresnel(const MerlTable& table, const TabulatedN
             for (int k = 0; k <= kP / 2; ++k) {
               const double mu_i = a - b * cos_p[k], mu_o = a + b * cos_p[k];
               const bool above = mu_i > 0.0 && mu_o > 0.0;
-              const double f1 = above ? d_h[i] * smith_g2_from_g1(smith, g1(mu_i), g1(mu_o)) / (4.0 * mu_i * mu_o) : 0.0;
+              const double f1 = above ? d_h[i] * smith_g2_from_g1(smith, g1(mu_o), g1(mu_i)) / (4.0 * mu_i * mu_o) : 0.0;
               model_row[k] = float(f1);
               above_row[k] = above ? 1.0f : 0.0f;
               if (k > 0 && k < kP / 2) {

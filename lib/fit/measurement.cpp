@@ -14,7 +14,7 @@ namespace {
 // cos(theta_o) here, see measurement.h) and the measured y c for the metric's cosine c, NaN where a
 // channel is missing. Returns the measure it added to the total, 0 for a bin left out (below the
 // horizon, nothing measured).
-double add_bin(MeasuredBins& bins, const Vec3& wi, const Vec3& wo, double cos_h, double cos_d, double measure,
+double add_bin(MeasuredBins& bins, const Vec3& wo, const Vec3& wi, double cos_h, double cos_d, double measure,
                const Rgb& reflected, double cosine) {
   if (wi.z <= 1e-6 || wo.z <= 1e-6) return 0.0;
   std::uint8_t valid = 0;
@@ -34,19 +34,19 @@ double add_bin(MeasuredBins& bins, const Vec3& wi, const Vec3& wo, double cos_h,
 }
 
 // A reciprocal table's bin: y c with c the mean cosine.
-double add_bin(MeasuredBins& bins, const Vec3& wi, const Vec3& wo, double cos_h, double cos_d, double measure, const Rgb& y) {
-  const double cosine = 0.5 * (wi.z + wo.z);
-  return add_bin(bins, wi, wo, cos_h, cos_d, measure, y * cosine, cosine);
+double add_bin(MeasuredBins& bins, const Vec3& wo, const Vec3& wi, double cos_h, double cos_d, double measure, const Rgb& y) {
+  const double cosine = 0.5 * (wo.z + wi.z);
+  return add_bin(bins, wo, wi, cos_h, cos_d, measure, y * cosine, cosine);
 }
 
 // The bin's two one-sided estimates, each with half its measure; one past the measured elevations is
 // left out.
-double add_one_sided(MeasuredBins& bins, const OneSidedMeasurement& source, const Vec3& wi, const Vec3& wo, double cos_h,
+double add_one_sided(MeasuredBins& bins, const OneSidedMeasurement& source, const Vec3& wo, const Vec3& wi, double cos_h,
                      double cos_d, double measure) {
   if (wi.z <= 1e-6 || wo.z <= 1e-6) return 0.0;
   double added = 0.0;
   for (const auto& [p, q] : {std::pair{wo, wi}, std::pair{wi, wo}})
-    if (const std::optional<Rgb> t = source.one_sided(p, q)) added += add_bin(bins, wi, wo, cos_h, cos_d, 0.5 * measure, *t, q.z);
+    if (const std::optional<Rgb> t = source.one_sided(p, q)) added += add_bin(bins, wo, wi, cos_h, cos_d, 0.5 * measure, *t, q.z);
   return added;
 }
 
@@ -70,9 +70,9 @@ MeasuredBins sample_bins(const std::vector<MeasuredSample>& samples, std::uint64
   for (std::size_t k = 0; k < samples.size(); ++k) {
     if (std::uint64_t(k) * 0x9E3779B97F4A7C15ull > kept) continue;
     const MeasuredSample& s = samples[k];
-    const HalfDiff hd = to_half_diff(s.i, s.o);
+    const HalfDiff hd = to_half_diff(s.o, s.i);
     MeasuredBins::Row row{hd.theta_h, hd.theta_d, bins.size(), bins.size()};
-    total += add_bin(bins, s.i, s.o, std::cos(hd.theta_h), std::cos(hd.theta_d), s.measure, s.f);
+    total += add_bin(bins, s.o, s.i, std::cos(hd.theta_h), std::cos(hd.theta_d), s.measure, s.f);
     row.end = bins.size();
     if (row.end > row.begin) bins.rows.push_back(row);
   }
@@ -98,15 +98,15 @@ MeasuredBins measured_bins(const MerlTable& table, int stride_d, int stride_phi)
       const double measure = 4.0 * std::cos(theta_d_mid) * std::sin(theta_d_mid) * h_measure;
       MeasuredBins::Row row{MerlTable::theta_h(i), MerlTable::theta_d(j), bins.size(), bins.size()};
       for (int k = 0; k < MerlTable::kPhiD; k += stride_phi) {
-        const auto [wi, wo] = from_half_diff(MerlTable::theta_h(i), MerlTable::theta_d(j), MerlTable::phi_d(k));
+        const auto [wo, wi] = from_half_diff(MerlTable::theta_h(i), MerlTable::theta_d(j), MerlTable::phi_d(k));
         const double cos_h = std::cos(MerlTable::theta_h(i)), cos_d = std::cos(MerlTable::theta_d(j));
         if (one_sided) {
-          total += add_one_sided(bins, *one_sided, wi, wo, cos_h, cos_d, measure);
+          total += add_one_sided(bins, *one_sided, wo, wi, cos_h, cos_d, measure);
           continue;
         }
         Rgb v;
         for (int c = 0; c < 3; ++c) v[c] = table.value(c, i, j, k);  // missing: NaN (MerlTable::missing)
-        total += add_bin(bins, wi, wo, cos_h, cos_d, measure, v);
+        total += add_bin(bins, wo, wi, cos_h, cos_d, measure, v);
       }
       row.end = bins.size();
       if (row.end > row.begin) bins.rows.push_back(row);
@@ -132,8 +132,8 @@ MeasuredBins measured_bins(const HalfDiffLattice& lattice, int stride) {
       // Strided over the whole (phi_h, phi_d) square, so every azimuth of the half vector is kept.
       for (int a = (h + d) % stride; a < L::kPhiH * L::kPhiD; a += stride) {
         const int ph = a / L::kPhiD, pd = a % L::kPhiD;
-        const auto [wi, wo] = L::directions(h, ph, d, pd);
-        total += add_bin(bins, wi, wo, std::cos(L::theta_h(h)), std::cos(L::theta_d(d)), L::measure(h, d),
+        const auto [wo, wi] = L::directions(h, ph, d, pd);
+        total += add_bin(bins, wo, wi, std::cos(L::theta_h(h)), std::cos(L::theta_d(d)), L::measure(h, d),
                          lattice.value[L::index(h, ph, d, pd)]);
       }
       row.end = bins.size();

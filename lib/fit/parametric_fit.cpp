@@ -258,7 +258,7 @@ double anisotropic_lobe(NdfType type, Smith smith, double alpha_x, double alpha_
   const Ndf ndf{type, alpha_x, alpha_y};
   const TurnedFrame axes(angle);
   const Vec3 ti = axes.to_frame(i), to = axes.to_frame(o);
-  return ndf.D(glm::normalize(ti + to)) * smith_g2(smith, ndf.lambda(ti), ndf.lambda(to)) / (4.0 * i.z * o.z);
+  return ndf.D(glm::normalize(ti + to)) * smith_g2(smith, ndf.lambda(to), ndf.lambda(ti)) / (4.0 * i.z * o.z);
 }
 
 // The anisotropic model's residuals over one row of bins (3 per bin). Parameter blocks: body (3), shape

@@ -155,7 +155,7 @@ void pass_terms(const MeasuredBins& bins, Smith smith, const LobeFit& lobe, std:
   g.resize(bins.size()), coat.resize(bins.size());
   for (std::size_t k = 0; k < bins.size(); ++k) {
     const double mi = bins.i[k].z, mo = bins.o[k].z;
-    g[k] = smith_g2_from_g1(smith, g1(mi), g1(mo)) / (4.0 * mi * mo);
+    g[k] = smith_g2_from_g1(smith, g1(mo), g1(mi)) / (4.0 * mi * mo);
     coat[k] = lobe.coat.eval(bins.o[k], bins.i[k]);
   }
 }

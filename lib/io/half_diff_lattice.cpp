@@ -27,9 +27,9 @@ double HalfDiffLattice::measure(int h, int d) {
 }
 
 std::pair<Vec3, Vec3> HalfDiffLattice::directions(int h, int ph, int d, int pd) {
-  const auto [i, o] = from_half_diff(theta_h(h), theta_d(d), phi_d(pd));
+  const auto [o, i] = from_half_diff(theta_h(h), theta_d(d), phi_d(pd));
   const TurnedFrame half(phi_h(ph));  // the pair at phi_h = 0, turned to the half vector's azimuth
-  return {half.from_frame(i), half.from_frame(o)};
+  return {half.from_frame(o), half.from_frame(i)};
 }
 
 HalfDiffLattice HalfDiffLattice::of(const Brdf& source) {
@@ -39,7 +39,7 @@ HalfDiffLattice HalfDiffLattice::of(const Brdf& source) {
     const int h = hp / kPhiH, ph = hp % kPhiH;
     for (int d = 0; d < kThetaD; ++d)
       for (int pd = 0; pd < kPhiD; ++pd) {
-        const auto [i, o] = directions(h, ph, d, pd);
+        const auto [o, i] = directions(h, ph, d, pd);
         if (i.z <= 1e-6 || o.z <= 1e-6) continue;
         if (const auto f = source.eval(o, i)) lattice.value[index(h, ph, d, pd)] = *f;
       }

@@ -34,7 +34,7 @@ struct HalfDiffLattice {
   // The cell's measure in (theta_h, phi_h, theta_d, phi_d), 4 cos(theta_d) sin(theta_d) sin(theta_h)
   // dtheta_h dphi_h dtheta_d dphi_d (the Jacobian of the parameterization) at its centre.
   static double measure(int h, int d);
-  // The node's directions (i, o); either may lie below the horizon.
+  // The node's directions (o, i); either may lie below the horizon.
   static std::pair<Vec3, Vec3> directions(int h, int ph, int d, int pd);
 
   // The source at every node (both directions above the horizon; other nodes NaN), in parallel.

@@ -43,8 +43,8 @@ struct BinCoords {
   double h, d, p;
 };
 
-BinCoords bin_coords(const Vec3& i, const Vec3& o) {
-  const HalfDiff hd = to_half_diff(i, o);
+BinCoords bin_coords(const Vec3& o, const Vec3& i) {
+  const HalfDiff hd = to_half_diff(o, i);
   double phi_d = hd.phi_d;
   if (phi_d < 0.0) phi_d += kPi;  // reciprocity: period pi
   if (phi_d >= kPi) phi_d -= kPi;
@@ -205,7 +205,7 @@ MerlTable MerlTable::tabulate(const Brdf& brdf, BinPoint at) {
   tbb::parallel_for(0, kThetaH, [&](int i) {
     for (int j = 0; j < kThetaD; ++j) {
       for (int k = 0; k < kPhiD; ++k) {
-        const auto [wi, wo] = from_half_diff(theta_h(i + offset), theta_d(j + offset), phi_d(k + offset));
+        const auto [wo, wi] = from_half_diff(theta_h(i + offset), theta_d(j + offset), phi_d(k + offset));
         if (wi.z <= 0.0 || wo.z <= 0.0) continue;  // stays missing: no measurement below the horizon
         const auto f = brdf.eval(wo, wi);
         if (!f || !std::isfinite(f->r) || !std::isfinite(f->g) || !std::isfinite(f->b)) continue;
@@ -239,7 +239,7 @@ void MerlTable::write(const std::string& path) const {
 
 std::optional<Rgb> MerlTable::eval(const Vec3& o, const Vec3& i) const {
   if (i.z <= 0.0 || o.z <= 0.0) return Rgb(0.0);
-  const BinCoords x = bin_coords(i, o);
+  const BinCoords x = bin_coords(o, i);
   return lookup_ == Lookup::nearest ? eval_nearest(x.h, x.d, x.p) : eval_linear(x.h, x.d, x.p);
 }
 

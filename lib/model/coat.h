@@ -27,7 +27,7 @@ struct Coat {
     const Vec3 h = glm::normalize(i + o);
     const Ndf ndf = Ndf::isotropic(NdfType::ggx, alpha);
     const double f = fresnel_schlick(Rgb(f0), clamp(glm::dot(i, h), 0.0, 1.0)).r;
-    return f * ndf.D(h) * smith_g2(Smith::correlated, ndf.lambda(i), ndf.lambda(o)) / (4.0 * i.z * o.z);
+    return f * ndf.D(h) * smith_g2(Smith::correlated, ndf.lambda(o), ndf.lambda(i)) / (4.0 * i.z * o.z);
   }
 
   // A direction i for o from the coat's visible normals (model/ggx_visible.h), and its density.

@@ -10,16 +10,16 @@
 namespace facetfit {
 
 enum class Smith {
-  // G2(i, o) = 1 / (1 + max(Lambda_i, Lambda_o)) = min(G1(i), G1(o)): fully direction-correlated.
+  // G2(o, i) = 1 / (1 + max(Lambda_o, Lambda_i)) = min(G1(o), G1(i)): fully direction-correlated.
   // It is the Smith form with G2(k, k) = G1(k), the back-scattering assumption of Dupuy et al. 2015.
   masking,
-  // Height-correlated: G2 = 1 / (1 + Lambda_i + Lambda_o). pbrt-v4 and Cycles render with it.
+  // Height-correlated: G2 = 1 / (1 + Lambda_o + Lambda_i). pbrt-v4 and Cycles render with it.
   correlated,
-  // Uncorrelated: G2 = G1(i) G1(o).
+  // Uncorrelated: G2 = G1(o) G1(i).
   separable,
 };
 
-inline double smith_g2(Smith smith, double lambda_i, double lambda_o) {
+inline double smith_g2(Smith smith, double lambda_o, double lambda_i) {
   switch (smith) {
     case Smith::masking: return 1.0 / (1.0 + std::max(lambda_i, lambda_o));
     case Smith::correlated: return 1.0 / (1.0 + lambda_i + lambda_o);
@@ -29,7 +29,7 @@ inline double smith_g2(Smith smith, double lambda_i, double lambda_o) {
 }
 
 // The same G2 from the two G1 values (G1 in [0, 1]; 0 at the horizon), without dividing by zero.
-inline double smith_g2_from_g1(Smith smith, double g1_i, double g1_o) {
+inline double smith_g2_from_g1(Smith smith, double g1_o, double g1_i) {
   switch (smith) {
     case Smith::masking: return std::min(g1_i, g1_o);
     case Smith::correlated: {

@@ -125,7 +125,7 @@ std::vector<TensorField> microfacet_tensor_fields(const Ndf& ndf, Smith smith, d
           // the horizon; beyond it the table holds that line's continuation (-G2 of o mirrored), so
           // that interpolating across the horizon stays exact instead of averaging with zeros.
           const Vec3 mirrored(o.x, o.y, std::max(std::abs(o.z), 1e-9));
-          const double g2 = smith_g2(smith, ndf.lambda(axes.to_frame(i)), ndf.lambda(axes.to_frame(mirrored)));
+          const double g2 = smith_g2(smith, ndf.lambda(axes.to_frame(mirrored)), ndf.lambda(axes.to_frame(i)));
           plane[y * n + x] = float((o.z >= 0.0 ? g2 : -g2) * ndf.sigma(axes.to_frame(i)) / std::max(i.z, 1e-9));
         }
       for (int ch = 0; ch < 3; ++ch) rgb.insert(rgb.end(), plane.begin(), plane.end());
