@@ -1,7 +1,11 @@
 // The facetfit command line: the app every command registers on, and the settings they share.
 #include <tbb/global_control.h>
 
+#include <cerrno>
+#include <cmath>
 #include <cstdio>
+#include <cstring>
+#include <iostream>
 #include <memory>
 
 #include "commands.h"
@@ -20,7 +24,24 @@ void report_settings(const Context& ctx, const std::string& command, const FitOp
                tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
 }
 
-void add_max_memory_option(CLI::App* cmd, std::uint64_t& bytes) {
+CLI::Validator finite_in(double lo, double hi) {
+  return CLI::Validator(
+      [lo, hi](std::string& text) -> std::string {
+        double v = 0.0;
+        std::size_t used = 0;
+        try {
+          v = std::stod(text, &used);
+        } catch (const std::exception&) {
+          used = 0;
+        }
+        if (used != text.size() || !std::isfinite(v) || v < lo || v > hi)
+          return "'" + text + "' is not a finite number in [" + CLI::detail::to_string(lo) + ", " + CLI::detail::to_string(hi) + "]";
+        return "";
+      },
+      "FINITE in [" + CLI::detail::to_string(lo) + " - " + CLI::detail::to_string(hi) + "]");
+}
+
+void add_max_memory_option(CLI::App* cmd, std::uint64_t& bytes, const std::string& what) {
   cmd->add_option_function<std::string>(
          "--max-memory",
          [&bytes](const std::string& text) {
@@ -28,7 +49,7 @@ void add_max_memory_option(CLI::App* cmd, std::uint64_t& bytes) {
            if (!parsed) throw CLI::ValidationError("--max-memory", "'" + text + "' is not a size such as 512M or 4G");
            bytes = *parsed;
          },
-         "Memory a render's image and environment map may take, e.g. 512M or 4G (default: half of this machine's, " +
+         "Memory " + what + " may take, e.g. 512M or 4G (default: half of this machine's, " +
              format_bytes(default_memory_budget()) + ")");
 }
 
@@ -41,8 +62,11 @@ void add_fit_settings(CLI::App* cmd, FitSettings& s) {
       ->check(CLI::Range(4, 4096))
       ->capture_default_str();
   cmd->add_option("--iteration-tolerance", s.iteration_tolerance, "Power-iteration stop: relative L1 change of the NDF")
+      ->check(finite_in(0.0, 1.0))
       ->capture_default_str();
-  cmd->add_option("--max-iterations", s.max_iterations, "Power-iteration limit")->capture_default_str();
+  cmd->add_option("--max-iterations", s.max_iterations, "Power-iteration limit")
+      ->check(CLI::Range(1, 1000000))
+      ->capture_default_str();
   cmd->add_option("--refine", s.refine,
                   "full: refine body, NDF and Fresnel, and fit GGX and Beckmann, on the whole measurement; "
                   "none: the paper's method alone (power iteration on back-scattering, Fresnel pass, moment alphas)")
@@ -91,7 +115,7 @@ int run_app(int argc, char** argv, void (*register_more)(CLI::App& app, Context&
            if (n > 0) threads = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, std::size_t(n));
          },
          "Threads to use (default: all cores)")
-      ->check(CLI::PositiveNumber)
+      ->check(CLI::Range(1, 4096))
       ->trigger_on_parse();
   Context ctx;
   app.add_flag_callback("-q,--quiet", [&ctx] { ctx.verbosity = Verbosity::quiet; }, "Print only results, warnings and errors");
@@ -113,6 +137,13 @@ int run_app(int argc, char** argv, void (*register_more)(CLI::App& app, Context&
     return 1;
   } catch (const std::exception& e) {
     report_error(std::string("internal: ") + e.what());
+    return 1;
+  }
+  // Results go to standard output: a full disk or a closed file there must not pass for success.
+  errno = 0;
+  std::cout.flush();
+  if (std::fflush(stdout) != 0 || std::ferror(stdout) || !std::cout) {
+    report_error(std::string("cannot write to standard output") + (errno ? std::string(": ") + std::strerror(errno) : ""));
     return 1;
   }
   return ctx.status;

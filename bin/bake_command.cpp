@@ -187,11 +187,12 @@ void add_bake_command(CLI::App& app, Context& ctx) {
   CLI::App* cmd = app.add_subcommand("bake", "Bake LUT textures (DIR/NAME.exr) and sidecars (DIR/NAME.json, DIR/index.json)");
   cmd->add_option("inputs", args->inputs, "Material files, folders, globs, builtin:NAME (builtin: for all)");
   cmd->add_option("-o,--output", args->out_dir, "Output folder (created if missing)")->required();
-  cmd->add_option("-j,--jobs", args->jobs, "Materials baked at once (default: all cores)");
+  cmd->add_option("-j,--jobs", args->jobs, "Materials baked at once (default: all cores)")->check(CLI::Range(1, 1024));
   cmd->add_flag("--force", args->force, "Bake even where the cache says the outputs are current");
   cmd->add_option("--scene", args->scene, "Bake only the materials this scene references");
   cmd->add_option("--tolerance", args->tolerance,
                   "NDF error (relative L1) within which the parametric fit is the recommended representation")
+      ->check(finite_in(0.0, 1e30))  // what a LUT reader accepts (lut/lut.cpp)
       ->capture_default_str();
   cmd->add_flag("--eval-only", args->eval_only, "Leave out the sampling tables");
   add_fit_settings(cmd, args->settings);

@@ -17,6 +17,7 @@
 #include "color/image_diff.h"
 #include "commands.h"
 #include "core/error.h"
+#include "core/memory_budget.h"
 #include "io/image_file.h"
 
 namespace facetfit::cli {
@@ -58,17 +59,23 @@ struct Image {
 
 std::string size_text(int width, int height) { return std::to_string(width) + " x " + std::to_string(height); }
 
-// Every channel of the first subimage as float, with its spec.
-std::vector<float> read_all(const std::string& path, ImageSpec& spec) {
+// Every channel of the first subimage as float, with its spec. The header's size is checked against what
+// is `left` of the memory budget first (a small file can claim a huge image): its pixels as read, their
+// RGB copy and alpha, and the Delta E per pixel.
+std::vector<float> read_all(const std::string& path, ImageSpec& spec, std::uint64_t& left) {
   ImageReader in = ImageReader::open(path);
   spec = in.spec();
+  const std::uint64_t pixels = std::uint64_t(spec.width) * std::uint64_t(spec.height);
+  const std::uint64_t need = pixels * (4 * (std::uint64_t(spec.channels.size()) + 4) + 8);
+  check_memory(path, "its " + size_text(spec.width, spec.height) + " image (diff --max-memory)", need, left);
+  left -= need;
   return in.read_pixels();
 }
 
 // Channels by name, never by position: EXR stores them sorted by name (A, B, G, R).
-Image read_image(const std::string& path) {
+Image read_image(const std::string& path, std::uint64_t& left) {
   ImageSpec spec;
-  const std::vector<float> all = read_all(path, spec);
+  const std::vector<float> all = read_all(path, spec, left);
   const int a = spec.channel_index("A");
   Image image;
   image.width = spec.width;
@@ -87,9 +94,9 @@ Image read_image(const std::string& path) {
 }
 
 // The --mask image: a pixel counts where its first channel is > 0.5.
-std::vector<bool> read_mask(const std::string& path, int width, int height) {
+std::vector<bool> read_mask(const std::string& path, int width, int height, std::uint64_t& left) {
   ImageSpec spec;
-  const std::vector<float> all = read_all(path, spec);
+  const std::vector<float> all = read_all(path, spec, left);
   if (spec.width != width || spec.height != height)
     fail(path, "mask is " + size_text(spec.width, spec.height) + ", the images are " + size_text(width, height));
   std::vector<bool> mask(std::size_t(width) * std::size_t(height));
@@ -109,6 +116,7 @@ std::vector<bool> coverage_mask(const Image& a, const Image& b) {
 struct DiffArgs {
   std::string a, b, mask, heatmap;
   bool json = false;
+  std::uint64_t max_memory = 0;
 };
 
 void run_diff(const DiffArgs& args, Context& ctx) {
@@ -119,11 +127,12 @@ void run_diff(const DiffArgs& args, Context& ctx) {
     return;
   }
   try {
-    Image a = read_image(args.a);
-    Image b = read_image(args.b);
+    std::uint64_t left = args.max_memory > 0 ? args.max_memory : default_memory_budget();
+    Image a = read_image(args.a, left);
+    Image b = read_image(args.b, left);
     if (a.width != b.width || a.height != b.height)
       fail(args.b, "is " + size_text(b.width, b.height) + " but " + args.a + " is " + size_text(a.width, a.height));
-    const std::vector<bool> mask = args.mask.empty() ? coverage_mask(a, b) : read_mask(args.mask, a.width, a.height);
+    const std::vector<bool> mask = args.mask.empty() ? coverage_mask(a, b) : read_mask(args.mask, a.width, a.height, left);
     const int width = a.width, height = a.height;
     const bool a_display = a.display_referred, b_display = b.display_referred;
     const ImageDiff d = image_delta_e(std::move(a.rgb), a_display, std::move(b.rgb), b_display, mask, DisplayTransform());
@@ -163,6 +172,7 @@ void add_diff_command(CLI::App& app, Context& ctx) {
   cmd->add_option("--heatmap", args->heatmap,
                   "Write a PNG of per-pixel Delta E 2000 (viridis from 0 to 10, saturating; black outside the mask)");
   cmd->add_flag("--json", args->json, "As one JSON object {\"mean\", \"max\", \"pixels\"}");
+  add_max_memory_option(cmd, args->max_memory, "the images (and mask) read");
   cmd->callback([args, &ctx] { run_diff(*args, ctx); });
 }
 

@@ -37,9 +37,13 @@ void add_fit_settings(CLI::App* cmd, FitSettings& settings);
 // The FitOptions they name, or nullopt after reporting a usage error (status 2).
 std::optional<FitOptions> fit_options(const FitSettings& settings, int& status);
 
-// --max-memory SIZE ("4G", "512M"): what a render's image and environment map may take (default half of
-// the machine's memory); a bad size is a usage error.
-void add_max_memory_option(CLI::App* cmd, std::uint64_t& bytes);
+// A check for a real-valued option: a finite number in [lo, hi] (CLI::Range lets NaN through: every
+// comparison with it is false).
+CLI::Validator finite_in(double lo, double hi);
+
+// --max-memory SIZE ("4G", "512M"): what `what` may take (default half of the machine's memory); a bad size
+// is a usage error.
+void add_max_memory_option(CLI::App* cmd, std::uint64_t& bytes, const std::string& what = "a render's image and environment map");
 
 void add_fit_command(CLI::App& app, Context& ctx);
 void add_convert_command(CLI::App& app, Context& ctx);

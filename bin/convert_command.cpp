@@ -4,6 +4,7 @@
 
 #include "commands.h"
 #include "core/error.h"
+#include "io/atomic_file.h"
 #include "io/input.h"
 #include "io/utia.h"
 #include "model/builtin.h"
@@ -19,6 +20,8 @@ void add_convert_command(CLI::App& app, Context& ctx) {
   cmd->callback([input, output, &ctx] {
     try {
       const std::string extension = std::filesystem::path(*output).extension().string();
+      // Temporaries of converts killed mid-write (their processes are gone) go first, as bake and render do.
+      remove_stale_temporaries(std::filesystem::absolute(*output).parent_path().string());
       if (extension == ".bin") {
         UtiaBrdf::tabulate(*load_brdf(*input)).write(*output);
       } else if (extension == ".binary") {

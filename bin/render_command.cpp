@@ -2,6 +2,7 @@
 #include <tbb/global_control.h>
 #include <unistd.h>
 
+#include <cctype>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -10,6 +11,7 @@
 #include "color/image_diff.h"
 #include "core/error.h"
 #include "io/atomic_file.h"
+#include "io/input.h"
 #include "lut/bake.h"
 #include "render/environment.h"
 #include "render/renderer.h"
@@ -33,18 +35,55 @@ struct RenderArgs {
   std::uint64_t max_memory = 0;
 };
 
+// The file a path names, for comparing two paths: a link and its target, "a/../b" and "b" are one file.
+fs::path file_key(const std::string& path) {
+  std::error_code ec;
+  const fs::path canonical = fs::weakly_canonical(fs::absolute(path), ec);
+  return ec ? fs::absolute(path).lexically_normal() : canonical;
+}
+
+// The outputs (flag, path), checked before any work, since a render can take minutes: each can be
+// written (its folder exists; it is not a folder), the image is an EXR, and no two name the same file.
+void check_outputs(const std::vector<std::pair<std::string, std::string>>& outputs) {
+  for (std::size_t a = 0; a < outputs.size(); ++a) {
+    const auto& [flag, path] = outputs[a];
+    if (path.empty()) continue;
+    std::error_code ec;
+    if (fs::is_directory(path, ec)) fail(path, "cannot write " + flag + ": it is a folder");
+    const fs::path dir = fs::absolute(path).parent_path();
+    if (!fs::is_directory(dir, ec)) fail(path, "cannot write " + flag + ": folder " + dir.string() + " does not exist");
+    for (std::size_t b = 0; b < a; ++b)
+      if (!outputs[b].second.empty() && file_key(outputs[b].second) == file_key(path))
+        fail(path, outputs[b].first + " and " + flag + " name the same file");
+  }
+  std::string ext = fs::path(outputs.front().second).extension().string();
+  for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+  if (ext != ".exr") fail(outputs.front().second, "-o writes a linear OpenEXR image: give it a .exr name");
+}
+
+// No output may overwrite what the scene reads (its file, environment map, materials, textures, meshes).
+void check_outputs_spare_inputs(const std::vector<std::pair<std::string, std::string>>& outputs, const SceneDesc& scene,
+                                const std::string& scene_file) {
+  std::vector<std::string> inputs;
+  if (!scene_file.empty()) inputs.push_back(scene_file);
+  if (!scene.environment.file.empty()) inputs.push_back(resolve(scene, scene.environment.file));
+  for (const auto& [name, m] : scene.materials) {
+    if (!m.file.empty() && !is_builtin(m.file)) inputs.push_back(resolve(scene, m.file));
+    if (!m.stretch_texture.empty()) inputs.push_back(resolve(scene, m.stretch_texture));
+  }
+  for (const ObjectDesc& o : scene.objects)
+    if (!o.file.empty()) inputs.push_back(resolve(scene, o.file));
+  for (const auto& [flag, path] : outputs)
+    for (const std::string& input : inputs)
+      if (!path.empty() && file_key(path) == file_key(input)) fail(path, flag + " would overwrite an input of the scene");
+}
+
 void run_render(const RenderArgs& args, Context& ctx) {
   int& status = ctx.status;
   try {
-    if (!args.save_sky.empty()) {  // the built-in sky as a lat-long EXR, for other renderers
-      const Environment sky = Environment::sky();
-      RenderedImage img;
-      img.width = sky.width();
-      img.height = sky.height();
-      for (std::size_t p = 0; p < sky.pixels().size() / 3; ++p)
-        img.rgba.insert(img.rgba.end(), {sky.pixels()[3 * p], sky.pixels()[3 * p + 1], sky.pixels()[3 * p + 2], 1.0f});
-      write_exr(args.save_sky, img, {{"environment", "builtin sky"}});
-    }
+    const std::vector<std::pair<std::string, std::string>> outputs = {
+        {"-o", args.output}, {"--png", args.png}, {"--save-sky", args.save_sky}};
+    check_outputs(outputs);
     SceneDesc scene;
     // A measurement rendered as one of the LUT's representations is baked first, into a temporary folder.
     std::unique_ptr<fs::path, void (*)(fs::path*)> baked_dir(nullptr, [](fs::path* p) {
@@ -68,6 +107,16 @@ void run_render(const RenderArgs& args, Context& ctx) {
       scene = default_scene(subject);
     } else {
       scene = parse_scene(args.scene);
+    }
+    check_outputs_spare_inputs(outputs, scene, args.scene);
+    if (!args.save_sky.empty()) {  // the built-in sky as a lat-long EXR, for other renderers
+      const Environment sky = Environment::sky();
+      RenderedImage img;
+      img.width = sky.width();
+      img.height = sky.height();
+      for (std::size_t p = 0; p < sky.pixels().size() / 3; ++p)
+        img.rgba.insert(img.rgba.end(), {sky.pixels()[3 * p], sky.pixels()[3 * p + 1], sky.pixels()[3 * p + 2], 1.0f});
+      write_exr(args.save_sky, img, {{"environment", "builtin sky"}});
     }
     if (args.width > 0) scene.camera.width = args.width;
     if (args.height > 0) scene.camera.height = args.height;

@@ -167,7 +167,9 @@ void add_report_command(CLI::App& app, Context& ctx) {
       ->capture_default_str();
   cmd->add_flag("--fail-on-regression", args->fail_on_regression, "Exit 3 when a material got worse than in the previous report");
   cmd->add_flag("--force", args->force, "Render even the materials whose previous entry is current");
-  cmd->add_option("--tolerance", args->tolerance, "Representation tolerance of the bake")->capture_default_str();
+  cmd->add_option("--tolerance", args->tolerance, "Representation tolerance of the bake")
+      ->check(finite_in(0.0, 1e30))
+      ->capture_default_str();
   add_fit_settings(cmd, args->settings);
   cmd->add_option("--farm", args->farm, "Split the report into shards run by: local (processes on this machine) or slurm (a job array and a merge job)")
       ->check(CLI::IsMember({"local", "slurm"}));

@@ -4,7 +4,12 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <chrono>
 #include <cstdio>
+#include <fstream>
+#include <iterator>
+#include <string>
+#include <thread>
 
 #include "io/atomic_file.h"
 #include "lut/bake.h"
@@ -60,6 +65,28 @@ TEST(AtomicFile, TemporariesOfLiveWritersAreKept) {
   EXPECT_EQ(remove_stale_temporaries(dir.path().string()), 0);  // this process is alive
   EXPECT_TRUE(std::filesystem::exists(out.temp_path()));
   EXPECT_EQ(std::filesystem::path(out.temp_path()).extension(), ".exr");  // image writers pick the format by it
+}
+
+// A writer killed with its shell stays a zombie until its new parent reaps it: it writes nothing more,
+// so its temporary goes (the bake kill test left one on a loaded machine).
+TEST(AtomicFile, TemporariesOfZombieWritersAreRemoved) {
+  TempDir dir;
+  const pid_t pid = ::fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) ::_exit(0);
+  // Not reaped yet: a zombie once it has exited.
+  for (int k = 0; k < 200 && std::filesystem::exists("/proc/" + std::to_string(pid)); ++k) {
+    std::ifstream stat("/proc/" + std::to_string(pid) + "/stat");
+    std::string text((std::istreambuf_iterator<char>(stat)), std::istreambuf_iterator<char>());
+    if (text.find(") Z") != std::string::npos) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  const std::string temporary = dir.file(".x.tmp-" + std::to_string(pid) + "-0000abcd.exr");
+  test::write_bytes(temporary, "half");
+  EXPECT_EQ(remove_stale_temporaries(dir.path().string()), 1);
+  EXPECT_FALSE(std::filesystem::exists(temporary));
+  int status = 0;
+  ::waitpid(pid, &status, 0);
 }
 
 }  // namespace

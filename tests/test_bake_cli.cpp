@@ -2,6 +2,7 @@
 // cache, scenes, metadata.
 #include <gtest/gtest.h>
 #include <signal.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -467,6 +468,71 @@ TEST(Cli, FileNamesThatAreNotUtf8AreWrittenNotRefused) {
   const RunResult bake = facetfit("bake --refine none -o " + dir.file("luts") + " " + name);
   EXPECT_EQ(bake.status, 0) << bake.err;
   EXPECT_EQ(read_json(dir.file("luts") + "/index.json")["materials"].size(), 1u);
+}
+
+}  // namespace
+}  // namespace facetfit
+
+namespace facetfit {
+namespace {
+
+// Hostile input found by a robustness audit: each gets one error line and a nonzero exit, at once.
+TEST(Cli, HostileInputsGetOneLineAndAnExitStatus) {
+  TempDir dir;
+  const auto one_line = [](const RunResult& r, const std::string& says) {
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_NE(r.err.find(says), std::string::npos) << r.err;
+  };
+  // A FIFO named like a MERL file: open() would wait for a writer forever (timeout: a regression fails,
+  // it does not hang the suite).
+  ASSERT_EQ(::mkfifo(dir.file("f.binary").c_str(), 0600), 0);
+  RunResult r = test::run_command("timeout 60 " + std::string(FACETFIT_CLI) + " -q convert " + dir.file("f.binary") + " -o " +
+                                  dir.file("x.binary"));
+  EXPECT_EQ(r.status, 1);
+  one_line(r, "f.binary: not a regular file");
+  // A material list for bake --scene nested past the limit (100,000 levels overflowed the stack).
+  test::write_bytes(dir.file("deep.json"), std::string(100000, '[') + std::string(100000, ']'));
+  r = facetfit("bake --scene " + dir.file("deep.json") + " -o " + dir.file("out"));
+  EXPECT_EQ(r.status, 1);
+  one_line(r, "deep.json: nested more than 32 levels deep");
+  // Results that cannot be written are a failure, not a success with a lost result.
+  r = test::run_command("{ " + std::string(FACETFIT_CLI) + " list-builtins >/dev/full; }");
+  EXPECT_EQ(r.status, 1);
+  one_line(r, "cannot write to standard output");
+  // A tolerance a LUT reader would refuse is refused when given.
+  for (const char* bad : {"nan", "-1", "inf"}) {
+    r = facetfit(std::string("bake builtin:red-plastic -o ") + dir.file("luts") + " --tolerance " + bad);
+    EXPECT_EQ(r.status, 2) << bad;
+    one_line(r, "is not a finite number");
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir.file("luts")));
+  // Outputs checked before the render: two flags naming one file, a missing folder, a non-EXR image, and
+  // a scene's own environment map.
+  const std::string small = " --width 8 --height 8 --spp 1";
+  r = facetfit("render -o " + dir.file("y.exr") + " --save-sky " + dir.file("y.exr") + small);
+  EXPECT_EQ(r.status, 1);
+  one_line(r, "-o and --save-sky name the same file");
+  r = facetfit("render -o " + dir.file("no/y.exr") + small);
+  EXPECT_EQ(r.status, 1);
+  one_line(r, "does not exist");
+  r = facetfit("render -o " + dir.file("y.png") + small);
+  EXPECT_EQ(r.status, 1);
+  one_line(r, "give it a .exr name");
+  ASSERT_EQ(facetfit("render -o " + dir.file("env.exr") + small).status, 0);
+  test::write_bytes(dir.file("s.json"), R"({"environment": {"file": "env.exr"}, "materials": {"m": {"type": "lambert"}},
+      "objects": [{"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "m"}]})");
+  r = facetfit("render " + dir.file("s.json") + " -o " + dir.file("env.exr") + small);
+  EXPECT_EQ(r.status, 1);
+  one_line(r, "-o would overwrite an input of the scene");
+  // A small file whose header claims a huge image is refused before its pixels are read.
+  r = facetfit("diff " + dir.file("env.exr") + " " + dir.file("env.exr") + " --max-memory 1K");
+  EXPECT_EQ(r.status, 1);
+  one_line(r, "env.exr: its 8 x 8 image (diff --max-memory) needs");
+  // CIELAB coordinates whose squares overflow inside the formula (1e308 gave 0).
+  test::write_bytes(dir.file("huge.txt"), "1e308 1e308 1e308 0 0 0\n");
+  r = facetfit("deltae <" + dir.file("huge.txt"));
+  EXPECT_EQ(r.status, 1);
+  one_line(r, "outside +-1e6");
 }
 
 }  // namespace

@@ -276,6 +276,17 @@ TEST(Lut, BadFilesGetOneClearLine) {
     EXPECT_NE(e.find(std::string("facetfit:") + name + " is "), std::string::npos) << name << ": " << e;
     EXPECT_EQ(e.find('\n'), std::string::npos) << e;
   }
+  // Negative NDF entries (pixels scaled by -1, as an audit's oiiotool --mulc -1) are no lobe.
+  {
+    auto in = OIIO::ImageInput::open(dir.file("good.exr"));
+    OIIO::ImageSpec spec = in->spec();
+    std::vector<float> px(std::size_t(spec.width) * std::size_t(spec.height) * std::size_t(spec.nchannels));
+    ASSERT_TRUE(in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, px.data()));
+    for (float& v : px) v = -v;
+    auto out = OIIO::ImageOutput::create(dir.file("negative.exr"));
+    ASSERT_TRUE(out->open(dir.file("negative.exr"), spec) && out->write_image(OIIO::TypeDesc::FLOAT, px.data()) && out->close());
+  }
+  EXPECT_NE(error_of([&] { read_lut(dir.file("negative.exr")); }).find("column 0: D must be >= 0 and sigma > 0"), std::string::npos);
 }
 
 }  // namespace

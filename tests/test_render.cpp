@@ -538,7 +538,7 @@ TEST(Render, BadScenesGetOneClearLine) {
   test::write_bytes(dir.file("a.json"), R"({"objects": [{"type": "sphere", "material": "nope"}]})");
   EXPECT_NE(test::error_of([&] { parse_scene(dir.file("a.json")); }).find("undefined material \"nope\""), std::string::npos);
   test::write_bytes(dir.file("b.json"), "[1, 2");
-  EXPECT_NE(test::error_of([&] { parse_scene(dir.file("b.json")); }).find("b.json: not a JSON object"), std::string::npos);
+  EXPECT_NE(test::error_of([&] { parse_scene(dir.file("b.json")); }).find("b.json: not valid JSON"), std::string::npos);
   test::write_bytes(dir.file("c.json"),
                     R"({"materials": {"m": {"type": "measured", "file": "missing.binary"}}, "objects": [{"type": "sphere", "material": "m"}]})");
   const std::string missing = test::error_of([&] { render(parse_scene(dir.file("c.json"))); });
@@ -603,6 +603,19 @@ TEST(Render, ObjMeshes) {
   p.clear();
   idx.clear();
   EXPECT_NE(test::error_of([&] { read_obj(dir.file("bad.obj"), p, idx); }).find("line 2: vertex index out of range"), std::string::npos);
+  // Lines are bounded as they are read (a file of NULs is one endless line), coordinates as a scene's.
+  test::write_bytes(dir.file("nul.obj"), std::string(1 << 17, '\0'));
+  EXPECT_NE(test::error_of([&] { read_obj(dir.file("nul.obj"), p, idx); }).find("line 1 is longer than 64 KiB"), std::string::npos);
+  test::write_bytes(dir.file("far.obj"), "v 0 0 0\nv 1e39 0 0\nv 0 1 0\nf 1 2 3");
+  EXPECT_NE(test::error_of([&] { read_obj(dir.file("far.obj"), p, idx); }).find("line 2: vertex coordinate outside +-1e6"),
+            std::string::npos);
+  // The last line needs no newline.
+  test::write_bytes(dir.file("last.obj"), "v -1 -1 0\r\nv 1 -1 0\n\nv 1 1 0\nf 1 2 3");
+  p.clear();
+  idx.clear();
+  read_obj(dir.file("last.obj"), p, idx);
+  EXPECT_EQ(p.size(), 9u);
+  EXPECT_EQ(idx, (std::vector<unsigned>{0, 1, 2}));
 }
 
 }  // namespace

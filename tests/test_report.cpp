@@ -116,6 +116,16 @@ TEST(Report, ShardsMergeIntoTheWholeReport) {
   EXPECT_EQ(m["database_mean_delta_e"], full["database_mean_delta_e"]);
   EXPECT_NE(test::error_of([&] { merge_reports({merged.file("nope")}, merged.path().string()); }).find("not a facetfit report"),
             std::string::npos);
+  // A shard twice or one missing is refused before anything is written.
+  TempDir refused;
+  const std::string out = (refused.path() / "m").string();
+  EXPECT_NE(test::error_of([&] { merge_reports({part1.path().string(), part1.path().string()}, out); }).find("(a part given twice?)"),
+            std::string::npos);
+  EXPECT_NE(test::error_of([&] { merge_reports({part2.path().string()}, out); }).find("shard 1/2 of its split is not among the parts"),
+            std::string::npos);
+  EXPECT_NE(test::error_of([&] { merge_reports({part1.path().string(), merged.path().string()}, out); }).find("is also in"),
+            std::string::npos);
+  EXPECT_FALSE(std::filesystem::exists(out));
 }
 
 }  // namespace

@@ -118,6 +118,8 @@ std::array<double, 6> parse_lab_pair(const std::string& line, const std::string&
     double x = 0;
     const auto [ptr, ec] = std::from_chars(first, last, x);
     if (ec != std::errc() || ptr != last || !std::isfinite(x)) fail(what, "'" + excerpt(token) + "' is not a finite number");
+    // Squares of larger values overflow inside the formula (1e308 gave a Delta E of 0).
+    if (std::abs(x) > 1e6) fail(what, "'" + excerpt(token) + "' is outside +-1e6: not a CIELAB coordinate");
     v[count++] = x;
     i = end;
   }

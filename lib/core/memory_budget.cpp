@@ -38,7 +38,9 @@ std::optional<std::uint64_t> parse_byte_size(const std::string& text) {
 std::string format_bytes(std::uint64_t bytes) {
   char text[64];
   if (bytes >= (std::uint64_t(1) << 30)) std::snprintf(text, sizeof text, "%.1f GiB", double(bytes) / double(std::uint64_t(1) << 30));
-  else std::snprintf(text, sizeof text, "%.1f MiB", double(bytes) / double(std::uint64_t(1) << 20));
+  else if (bytes >= (std::uint64_t(1) << 20)) std::snprintf(text, sizeof text, "%.1f MiB", double(bytes) / double(std::uint64_t(1) << 20));
+  else if (bytes >= 1024) std::snprintf(text, sizeof text, "%.1f KiB", double(bytes) / 1024.0);
+  else std::snprintf(text, sizeof text, "%llu bytes", static_cast<unsigned long long>(bytes));
   return text;
 }
 

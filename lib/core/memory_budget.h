@@ -15,7 +15,7 @@ std::uint64_t default_memory_budget();
 // nullopt for anything else or zero.
 std::optional<std::uint64_t> parse_byte_size(const std::string& text);
 
-// "12.3 MiB", "4.0 GiB".
+// "512 bytes", "2.5 KiB", "12.3 MiB", "4.0 GiB".
 std::string format_bytes(std::uint64_t bytes);
 
 // Throws Error("<what>: <needing> needs <need>, over the memory budget of <budget>") when need > budget.

@@ -10,6 +10,7 @@
 #include <cstring>
 #include <filesystem>
 #include <random>
+#include <string>
 
 #include "core/error.h"
 
@@ -77,13 +78,33 @@ long temporary_owner(const std::string& file) {
 
 }  // namespace
 
+namespace {
+
+// Whether process `pid` still runs: it exists and is not a zombie (a writer killed with its shell is
+// reparented and stays a zombie until its new parent reaps it, which on a loaded machine can come after
+// the next run has started).
+bool is_running(long pid) {
+  if (::kill(pid_t(pid), 0) != 0) return false;
+  std::FILE* f = std::fopen(("/proc/" + std::to_string(pid) + "/stat").c_str(), "r");
+  if (!f) return true;  // no /proc: trust kill()
+  char buffer[512] = {};
+  const std::size_t n = std::fread(buffer, 1, sizeof buffer - 1, f);
+  std::fclose(f);
+  // "pid (comm) S ...": the state follows the last ')' (comm may hold parentheses and spaces).
+  const char* close = std::strrchr(buffer, ')');
+  if (n == 0 || !close || close[1] != ' ') return true;
+  return close[2] != 'Z' && close[2] != 'X';
+}
+
+}  // namespace
+
 int remove_stale_temporaries(const std::string& dir) {
   int removed = 0;
   std::error_code ec;
   for (const auto& entry : fs::directory_iterator(dir, ec)) {
     const long pid = temporary_owner(entry.path().filename().string());
     if (pid <= 0) continue;
-    if (::kill(pid_t(pid), 0) == 0) continue;  // its writer is still running
+    if (is_running(pid)) continue;  // its writer is still writing
     if (fs::remove(entry.path(), ec)) ++removed;
   }
   return removed;

@@ -131,6 +131,8 @@ MerlTable MerlTable::read(const std::string& path, BinPoint at) {
   const auto status = fs::status(path, ec);
   if (!fs::exists(status)) fail(path, "cannot open: no such file");
   if (fs::is_directory(status)) fail(path, "is a folder, not a MERL .binary file");
+  // A FIFO or a device: open() would wait for a writer forever, and a size means nothing.
+  if (!fs::is_regular_file(status)) fail(path, "not a regular file");
   const FileDescriptor file{::open(path.c_str(), O_RDONLY | O_CLOEXEC)};
   const int fd = file.fd;
   if (fd < 0) fail(path, std::string("cannot open: ") + std::strerror(errno));

@@ -371,6 +371,10 @@ Lut read_lut(const std::string& path) {
   for (int x = 0; x < nodes; ++x) {
     ndf.ndf.push_back(get(LutLayout::kNdfRow, x, 0));
     ndf.sigma.push_back(get(LutLayout::kSigmaRow, x, 0));
+    // A negative density or projected area is no lobe (an edited file): refused, as for the anisotropic rows.
+    if (!(ndf.ndf.back() >= 0.0 && ndf.sigma.back() > 0.0))
+      fail(path, "rows " + std::to_string(LutLayout::kNdfRow) + " and " + std::to_string(LutLayout::kSigmaRow) + ", column " +
+                     std::to_string(x) + ": D must be >= 0 and sigma > 0");
   }
   for (int x = 0; x < FresnelCurve::kSize; ++x)
     lut.tables.fresnel.value[std::size_t(x)] = Rgb(get(LutLayout::kFresnelRow, x, 0), get(LutLayout::kFresnelRow, x, 1),

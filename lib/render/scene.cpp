@@ -142,21 +142,24 @@ MaterialDesc parse_material(const std::string& name, const json& j, const std::s
   return m;
 }
 
-}  // namespace
-
-SceneDesc parse_scene(const std::string& path) {
+// A scene file's text: a regular file (a FIFO would block the read forever) of bounded size (a scene is
+// kilobytes; a material list for bake --scene, at most megabytes).
+std::string read_scene_text(const std::string& path) {
+  constexpr std::uintmax_t kMaxBytes = std::uintmax_t(64) << 20;
   require_regular_file(path);
+  std::error_code ec;
+  if (const std::uintmax_t size = fs::file_size(path, ec); !ec && size > kMaxBytes)
+    fail(path, "scene is " + std::to_string(size >> 20) + " MiB; the limit is 64 MiB");
   std::ifstream in(path);
   if (!in) fail(path, "cannot open scene");
   std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   if (in.bad()) fail(path, "cannot read scene");
-  std::string base_dir = fs::path(path).parent_path().string();
-  return parse_scene_text(text, path, base_dir.empty() ? "." : base_dir);
+  return text;
 }
 
-SceneDesc parse_scene_text(const std::string& text, const std::string& path, const std::string& base_dir) {
-  // Nesting is bounded as it is read: a scene is 4 levels deep, and a deeply nested document would only
-  // exhaust the stack of everything that later copies or destroys it.
+// Nesting is bounded as it is read: a scene is 4 levels deep, and a deeply nested document would only
+// exhaust the stack of everything that later copies or destroys it.
+json parse_bounded_json(const std::string& text, const std::string& path) {
   constexpr int kMaxDepth = 32;
   bool too_deep = false;
   const json::parser_callback_t depth_limit = [&](int depth, json::parse_event_t, json&) {
@@ -167,9 +170,22 @@ SceneDesc parse_scene_text(const std::string& text, const std::string& path, con
   try {
     j = json::parse(text, depth_limit, true);
   } catch (const json::exception& e) {
-    fail(path, std::string("not a JSON object: ") + e.what());
+    fail(path, std::string("not valid JSON: ") + e.what());
   }
   if (too_deep) fail(path, "nested more than 32 levels deep");
+  return j;
+}
+
+}  // namespace
+
+SceneDesc parse_scene(const std::string& path) {
+  const std::string text = read_scene_text(path);
+  std::string base_dir = fs::path(path).parent_path().string();
+  return parse_scene_text(text, path, base_dir.empty() ? "." : base_dir);
+}
+
+SceneDesc parse_scene_text(const std::string& text, const std::string& path, const std::string& base_dir) {
+  const json j = parse_bounded_json(text, path);
   if (!j.is_object()) fail(path, "not a JSON object");
   SceneDesc s;
   s.base_dir = base_dir;
@@ -276,10 +292,7 @@ SceneDesc default_scene(const MaterialDesc& subject) {
 }
 
 std::vector<std::string> scene_materials(const std::string& scene_path) {
-  std::ifstream in(scene_path);
-  if (!in) fail(scene_path, "cannot open scene");
-  const json scene = json::parse(in, nullptr, false);
-  if (scene.is_discarded()) fail(scene_path, "not valid JSON");
+  const json scene = parse_bounded_json(read_scene_text(scene_path), scene_path);
   std::vector<std::string> out;
   const auto add = [&out](const std::string& file) {
     if (std::find(out.begin(), out.end(), file) == out.end()) out.push_back(file);
@@ -300,7 +313,11 @@ std::vector<std::string> scene_materials(const std::string& scene_path) {
     std::string file;
     if (item.is_string()) file = item.get<std::string>();
     else if (item.is_object() && item.contains("file") && item["file"].is_string()) file = item["file"].get<std::string>();
-    else fail(scene_path, "material entry " + json_text(item) + " is neither a path nor an object with \"file\"");
+    else {
+      const std::string text = json_text(item);
+      fail(scene_path, "material entry " + (text.size() > 60 ? text.substr(0, 57) + "..." : text) +
+                           " is neither a path nor an object with \"file\"");
+    }
     add(resolve_source(base, file));
   }
   return out;

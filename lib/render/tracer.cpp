@@ -194,14 +194,25 @@ void read_obj(const std::string& path, std::vector<float>& positions, std::vecto
   if (!in) fail(path, "cannot open mesh");
   std::string line;
   std::size_t line_no = 0;
-  while (std::getline(in, line)) {
+  // Lines are bounded as they are read: a file of NULs is one endless line (2 GiB of them took 6 GiB).
+  constexpr std::streamsize kMaxLine = 1 << 16;
+  while (in.peek() != std::char_traits<char>::eof()) {
     ++line_no;
+    line.resize(std::size_t(kMaxLine));
+    in.getline(line.data(), kMaxLine);
+    if (in.fail() && !in.eof()) fail(path, "line " + std::to_string(line_no) + " is longer than 64 KiB");
+    line.resize(std::size_t(std::max<std::streamsize>(in.gcount() - (in.eof() ? 0 : 1), 0)));
+    in.clear(in.rdstate() & ~std::ios::failbit);
     std::istringstream ls(line);
     std::string tag;
     ls >> tag;
     if (tag == "v") {
       double x, y, z;
       if (!(ls >> x >> y >> z)) fail(path, "line " + std::to_string(line_no) + ": bad vertex");
+      // The scene's coordinate limit (docs/scene-format.md): beyond it Embree's float arithmetic loses
+      // the triangle, which then silently vanishes from the image.
+      if (!(std::abs(x) <= 1e6 && std::abs(y) <= 1e6 && std::abs(z) <= 1e6))
+        fail(path, "line " + std::to_string(line_no) + ": vertex coordinate outside +-1e6");
       positions.insert(positions.end(), {float(x), float(y), float(z)});
     } else if (tag == "f") {
       std::vector<unsigned> face;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -321,26 +322,56 @@ json run_report(const ReportOptions& o) {
 }
 
 json merge_reports(const std::vector<std::string>& parts, const std::string& out_dir) {
+  // Every part is read and checked before anything is written: a refused merge leaves no output. No
+  // material may come from two parts (a shard given twice), and the shards of a K/N split must all be
+  // there; a farm's parts are whole reports of disjoint lists (1/1) and cannot be checked for that.
+  std::vector<json> reports;
+  std::map<std::string, std::string> from_part;  // material name -> the part holding it
+  std::map<int, std::vector<int>> shards_of;      // N -> the K given
+  for (const std::string& part : parts) {
+    const fs::path file = fs::path(part) / "report.json";
+    std::error_code ec;
+    if (!fs::exists(file, ec)) fail(part, "no report.json (not a facetfit report folder)");
+    const json r = read_json_file(file.string());
+    if (!r.is_object() || !r.contains("materials") || !r["materials"].is_array())
+      fail(file.string(), "not a facetfit report (unreadable JSON or no \"materials\" list)");
+    if (!reports.empty() && reports.front()["settings"] != r["settings"])
+      fail(file.string(), "rendered with other settings than " + parts.front());
+    for (const json& m : r["materials"]) {
+      const std::string name = m.value("name", std::string());
+      if (const auto [at, added] = from_part.emplace(name, part); !added)
+        fail(part, "material " + name + " is also in " + at->second + " (a part given twice?)");
+    }
+    int k = 0, n = 0;
+    if (std::sscanf(r.value("shard", std::string()).c_str(), "%d/%d", &k, &n) == 2 && n > 1 && k >= 1 && k <= n)
+      shards_of[n].push_back(k);
+    reports.push_back(r);
+  }
+  for (auto& [n, ks] : shards_of) {
+    std::sort(ks.begin(), ks.end());
+    for (int k = 1; k <= n; ++k)
+      if (!std::binary_search(ks.begin(), ks.end(), k))
+        fail(parts.front(), "shard " + std::to_string(k) + "/" + std::to_string(n) + " of its split is not among the parts");
+  }
+
   std::error_code ec;
   fs::create_directories(fs::path(out_dir) / "images", ec);
   const json previous = read_json_file((fs::path(out_dir) / "report.json").string());
   json merged;
   merged["materials"] = json::array();
   merged["failures"] = json::array();
-  for (const std::string& part : parts) {
-    const json r = read_json_file((fs::path(part) / "report.json").string());
-    if (!r.is_object() || !r.contains("materials")) fail(part, "no report.json (not a facetfit report folder)");
-    if (merged.contains("settings") && merged["settings"] != r["settings"]) fail(part, "rendered with other settings than the first part");
+  for (std::size_t p = 0; p < parts.size(); ++p) {
+    const json& r = reports[p];
     merged["facetfit_version"] = r["facetfit_version"];
     merged["settings"] = r["settings"];
     for (const json& m : r["materials"]) {
       merged["materials"].push_back(m);
-      const fs::path from = fs::path(part) / "images" / m["name"].get<std::string>();
+      const fs::path from = fs::path(parts[p]) / "images" / m["name"].get<std::string>();
       fs::copy(from, fs::path(out_dir) / "images" / m["name"].get<std::string>(),
                fs::copy_options::recursive | fs::copy_options::overwrite_existing, ec);
       if (ec) fail(from.string(), "cannot copy images: " + ec.message());
     }
-    for (const json& f : r["failures"]) merged["failures"].push_back(f);
+    for (const json& f : r.value("failures", json::array())) merged["failures"].push_back(f);
   }
   std::sort(merged["materials"].begin(), merged["materials"].end(),
             [](const json& a, const json& b) { return a["name"].get<std::string>() < b["name"].get<std::string>(); });
