@@ -168,7 +168,15 @@ void add_render_command(CLI::App& app, Context& ctx) {
                   "analytic (a built-in's analytic model) or lambert (albedo 0.8)")
       ->check(CLI::IsMember({"measured", "lut", "ggx", "beckmann", "lsq", "analytic", "lambert"}))
       ->capture_default_str();
-  cmd->callback([args, &ctx] { run_render(*args, ctx); });
+  cmd->callback([args, cmd, &ctx] {
+    // They shape the default scene only: with a scene of one's own they would be silently ignored.
+    if (!args->scene.empty() && (cmd->count("--material") > 0 || cmd->count("--material-type") > 0)) {
+      report_error("--material and --material-type shape the default scene, not " + args->scene + " (see facetfit render --help)");
+      ctx.status = 2;
+      return;
+    }
+    run_render(*args, ctx);
+  });
 }
 
 }  // namespace facetfit::cli

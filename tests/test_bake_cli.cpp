@@ -524,6 +524,10 @@ TEST(Cli, HostileInputsGetOneLineAndAnExitStatus) {
   r = facetfit("render " + dir.file("s.json") + " -o " + dir.file("env.exr") + small);
   EXPECT_EQ(r.status, 1);
   one_line(r, "-o would overwrite an input of the scene");
+  // Flags of the default scene given with a scene of one's own would be ignored.
+  r = facetfit("render " + dir.file("s.json") + " --material builtin:red-plastic -o " + dir.file("t.exr") + small);
+  EXPECT_EQ(r.status, 2);
+  one_line(r, "shape the default scene");
   // A small file whose header claims a huge image is refused before its pixels are read.
   r = facetfit("diff " + dir.file("env.exr") + " " + dir.file("env.exr") + " --max-memory 1K");
   EXPECT_EQ(r.status, 1);
