@@ -331,6 +331,14 @@ TEST(Lut, HostileOpenExrHeadersAreRefusedBeforeOpenExrAllocates) {
     const std::string e = error_of([&] { read_lut(dir.file("bad.exr")); });
     EXPECT_NE(e.find(dir.file("bad.exr") + ": OpenEXR header: " + message), std::string::npos) << e;
   }
+  // A data window changed after writing implies an offset table of another length; OpenEXR would decode
+  // the chunks as if they matched it, without an error (an audit's 512 x 256 map read as 65536 x 1).
+  std::string taller = good;
+  const std::int32_t y_max = 39;  // 40 rows: three chunks of 16 where the file has one
+  std::memcpy(&taller[taller.find(std::string("dataWindow") + '\0' + "box2i" + '\0') + 11 + 6 + 4 + 12], &y_max, 4);
+  test::write_bytes(dir.file("taller.exr"), taller);
+  const std::string e = error_of([&] { read_lut(dir.file("taller.exr")); });
+  EXPECT_NE(e.find(dir.file("taller.exr") + ": OpenEXR: chunk"), std::string::npos) << e;
   EXPECT_NO_THROW(read_lut(dir.file("good.exr")));
 }
 

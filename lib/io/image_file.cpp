@@ -155,6 +155,25 @@ bool check_exr_header(const std::string& path) {
   if (chunks > (file_size - header_end) / 8)
     fail(path, "OpenEXR header: a " + std::to_string(width) + " x " + std::to_string(height) + " image needs " +
                    std::to_string(chunks) + " chunks, more than the file's " + std::to_string(file_size) + " bytes can hold");
+  // A scanline file's chunks follow its offset table, every offset inside the file. A data window changed
+  // after writing implies a table of another length, and OpenEXR then decodes chunks of other sizes
+  // without an error: a 512 x 256 map whose window said 65536 x 1 read as one line of garbage.
+  if (!tiled && (magic[5] & 0x08) == 0) {
+    const std::uint64_t table_end = header_end + 8 * chunks;
+    std::uint64_t first = file_size;
+    for (std::uint64_t c = 0; c < chunks; ++c) {
+      std::uint64_t offset = 0;
+      if (!in.read(reinterpret_cast<char*>(&offset), 8)) fail(path, "OpenEXR: truncated chunk offset table");
+      if (offset < table_end || offset >= file_size)
+        fail(path, "OpenEXR: chunk " + std::to_string(c) + "'s offset " + std::to_string(offset) +
+                       " is outside the file's chunks (an incomplete file, or a data window that does not match its data)");
+      first = std::min(first, offset);
+    }
+    if (first != table_end)
+      fail(path, "OpenEXR: the chunks start at byte " + std::to_string(first) + ", not right after the " + std::to_string(chunks) +
+                     "-entry offset table the data window implies (byte " + std::to_string(table_end) +
+                     "): the data window does not match the data");
+  }
   return true;
 }
 
