@@ -537,6 +537,15 @@ TEST(Render, BadScenesGetOneClearLine) {
   test::TempDir dir;
   test::write_bytes(dir.file("a.json"), R"({"objects": [{"type": "sphere", "material": "nope"}]})");
   EXPECT_NE(test::error_of([&] { parse_scene(dir.file("a.json")); }).find("undefined material \"nope\""), std::string::npos);
+  // A misspelt key is an error, not a silent default (the audit's "fvo" rendered at the default 30 degrees).
+  test::write_bytes(dir.file("typo.json"), R"({"camera": {"fvo": 60}, "materials": {"m": {"type": "lambert"}},
+      "objects": [{"type": "sphere", "material": "m"}]})");
+  const std::string typo = test::error_of([&] { parse_scene(dir.file("typo.json")); });
+  EXPECT_NE(typo.find("typo.json: camera: unknown key \"fvo\" (known: position, look_at, up, fov, width, height)"), std::string::npos)
+      << typo;
+  test::write_bytes(dir.file("two.json"), R"({"environment": {"builtin": "sky", "constant": [1, 1, 1]}, "materials": {"m": {"type": "lambert"}},
+      "objects": [{"type": "sphere", "material": "m"}]})");
+  EXPECT_NE(test::error_of([&] { parse_scene(dir.file("two.json")); }).find("environment takes one of"), std::string::npos);
   test::write_bytes(dir.file("b.json"), "[1, 2");
   EXPECT_NE(test::error_of([&] { parse_scene(dir.file("b.json")); }).find("b.json: not valid JSON"), std::string::npos);
   test::write_bytes(dir.file("c.json"),

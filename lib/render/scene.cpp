@@ -88,8 +88,24 @@ T get_integer(const json& j, const char* key, T fallback, long double lo, long d
   return static_cast<T>(x);
 }
 
+// Every key of object `j` is one of `known`: a misspelt key ("fvo") is an error, not a silent default
+// (Mitsuba 3 refuses unreferenced properties the same way).
+void known_keys(const json& j, std::initializer_list<const char*> known, const std::string& where, const std::string& path) {
+  if (!j.is_object()) fail(path, where + " must be an object");
+  for (const auto& item : j.items()) {
+    if (std::any_of(known.begin(), known.end(), [&](const char* k) { return item.key() == k; })) continue;
+    std::string list;
+    for (const char* k : known) list += std::string(list.empty() ? "" : ", ") + k;
+    const std::string key = item.key().size() > 40 ? item.key().substr(0, 37) + "..." : item.key();
+    fail(path, where + ": unknown key \"" + key + "\" (known: " + list + ")");
+  }
+}
+
 MaterialDesc parse_material(const std::string& name, const json& j, const std::string& path) {
   if (!j.is_object()) fail(path, "material " + name + " must be an object");
+  known_keys(j, {"type", "file", "alpha", "f0", "f82", "fresnel", "slices", "proposal", "smith", "albedo", "tangent", "anisotropic",
+                 "stretch", "rotation", "stretch_texture"},
+             "material " + name, path);
   MaterialDesc m;
   m.type = get<std::string>(j, "type", "", path);
   if (m.type != "measured" && m.type != "lut" && m.type != "ggx" && m.type != "beckmann" && m.type != "lsq" &&
@@ -187,10 +203,12 @@ SceneDesc parse_scene(const std::string& path) {
 SceneDesc parse_scene_text(const std::string& text, const std::string& path, const std::string& base_dir) {
   const json j = parse_bounded_json(text, path);
   if (!j.is_object()) fail(path, "not a JSON object");
+  known_keys(j, {"camera", "render", "environment", "lights", "materials", "objects"}, "the scene", path);
   SceneDesc s;
   s.base_dir = base_dir;
   if (j.contains("camera")) {
     const json& c = j["camera"];
+    known_keys(c, {"position", "look_at", "up", "fov", "width", "height"}, "camera", path);
     if (c.contains("position")) s.camera.position = position(c["position"], "camera.position", path);
     if (c.contains("look_at")) s.camera.look_at = position(c["look_at"], "camera.look_at", path);
     if (c.contains("up")) s.camera.up = direction(c["up"], "camera.up", path);
@@ -205,11 +223,15 @@ SceneDesc parse_scene_text(const std::string& text, const std::string& path, con
       fail(path, "camera.up must not be parallel to the view direction");
   }
   if (j.contains("render")) {
+    known_keys(j["render"], {"spp", "seed"}, "render", path);
     s.spp = get_integer<int>(j["render"], "spp", s.spp, 1, 1 << 20, path);
     s.seed = get_integer<std::uint64_t>(j["render"], "seed", s.seed, 0, 18446744073709551615.0L, path);
   }
   if (j.contains("environment")) {
     const json& e = j["environment"];
+    known_keys(e, {"file", "constant", "builtin", "scale"}, "environment", path);
+    if (int(e.contains("file")) + int(e.contains("constant")) + int(e.contains("builtin")) > 1)
+      fail(path, "environment takes one of \"file\", \"constant\" and \"builtin\"");
     s.environment.scale = get<double>(e, "scale", 1.0, path);
     if (!(s.environment.scale >= 0.0 && s.environment.scale <= 1e30)) fail(path, "environment.scale must be a finite number >= 0");
     if (e.contains("file")) {
@@ -234,10 +256,12 @@ SceneDesc parse_scene_text(const std::string& text, const std::string& path, con
     LightDesc d;
     const std::string type = get<std::string>(l, "type", "", path);
     if (type == "directional") {
+      known_keys(l, {"type", "direction", "irradiance"}, "directional light", path);
       d.kind = LightDesc::Kind::directional;
       d.vector = direction(l.value("direction", json()), "directional light direction", path);
       d.value = nonnegative(l.value("irradiance", json()), "directional light irradiance", path);
     } else if (type == "point") {
+      known_keys(l, {"type", "position", "intensity"}, "point light", path);
       d.kind = LightDesc::Kind::point;
       d.vector = position(l.value("position", json()), "point light position", path);
       d.value = nonnegative(l.value("intensity", json()), "point light intensity", path);
@@ -251,17 +275,20 @@ SceneDesc parse_scene_text(const std::string& text, const std::string& path, con
     ObjectDesc d;
     const std::string type = get<std::string>(o, "type", "", path);
     if (type == "sphere") {
+      known_keys(o, {"type", "center", "radius", "material"}, "sphere", path);
       d.kind = ObjectDesc::Kind::sphere;
       d.center = position(o.value("center", json::array({0, 0, 0})), "sphere center", path);
       d.radius = get<double>(o, "radius", 1.0, path);
       if (!(d.radius > 0.0 && d.radius <= kMaxCoordinate)) fail(path, "sphere radius must be in (0, 1e6]");
     } else if (type == "plane") {
+      known_keys(o, {"type", "point", "normal", "size", "material"}, "plane", path);
       d.kind = ObjectDesc::Kind::plane;
       d.point = position(o.value("point", json::array({0, 0, 0})), "plane point", path);
       d.normal = direction(o.value("normal", json::array({0, 1, 0})), "plane normal", path);
       d.size = get<double>(o, "size", 10.0, path);
       if (!(d.size > 0.0 && d.size <= kMaxCoordinate)) fail(path, "plane size must be in (0, 1e6]");
     } else if (type == "mesh") {
+      known_keys(o, {"type", "file", "material"}, "mesh", path);
       d.kind = ObjectDesc::Kind::mesh;
       d.file = get<std::string>(o, "file", "", path);
       if (d.file.empty()) fail(path, "mesh needs a \"file\"");
