@@ -552,6 +552,8 @@ TEST(Render, BadScenesGetOneClearLine) {
                     R"({"materials": {"m": {"type": "measured", "file": "missing.binary"}}, "objects": [{"type": "sphere", "material": "m"}]})");
   const std::string missing = test::error_of([&] { render(parse_scene(dir.file("c.json"))); });
   EXPECT_NE(missing.find("missing.binary: cannot open"), std::string::npos) << missing;
+  // ... and the scene key that referenced it.
+  EXPECT_NE(missing.find("(material \"m\" in " + dir.file("c.json") + ")"), std::string::npos) << missing;
   // Values the ray tracer cannot take are refused with one line naming them (each of these aborted
   // Embree or overflowed the stack before).
   const std::string sphere = R"("materials": {"m": {"type": "lambert"}}, "objects": [{"type": "sphere", "material": "m")";

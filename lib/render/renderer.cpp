@@ -58,19 +58,29 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
   };
   std::vector<std::optional<StretchTexture>> stretch_textures;
   std::uint64_t left = budget - image_bytes;  // for the textures and the environment map together
+  // An error in a file the scene references names the key that referenced it, after the file's own line.
+  const auto referenced_by = [&desc](const std::string& key, const auto& load) {
+    try {
+      return load();
+    } catch (const Error& e) {
+      throw Error(std::string(e.what()) + " (" + key + (desc.source.empty() ? "" : " in " + desc.source) + ")");
+    }
+  };
   std::map<std::string, int> material_index;
   for (const ObjectDesc& o : desc.objects) {
     if (material_index.count(o.material)) continue;
     material_index[o.material] = int(materials.size());
     const MaterialDesc& m = desc.materials.at(o.material);
-    materials.push_back(load_material(desc, m));
+    materials.push_back(referenced_by("material \"" + o.material + "\"", [&] { return load_material(desc, m); }));
     tangents.push_back(m.tangent);
     stretch_textures.emplace_back();
     if (!m.stretch_texture.empty()) {
       const auto* lobe = dynamic_cast<const TabulatedMicrofacet*>(&materials.back()->brdf());
       const auto* anisotropic = dynamic_cast<const TabulatedAnisotropic*>(&materials.back()->brdf());
       if (!lobe && !anisotropic) fail(m.file, "a stretch_texture needs a tabulated lobe");
-      stretch_textures.back() = StretchTexture{Texture::load(resolve(desc, m.stretch_texture), left), lobe, anisotropic, m.stretch};
+      stretch_textures.back() = StretchTexture{
+          referenced_by("material \"" + o.material + "\" stretch_texture", [&] { return Texture::load(resolve(desc, m.stretch_texture), left); }),
+          lobe, anisotropic, m.stretch};
       left -= stretch_textures.back()->texture.bytes();
     }
   }
@@ -80,7 +90,7 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
     case EnvironmentDesc::Kind::builtin_sky: env = Environment::sky(); break;
     case EnvironmentDesc::Kind::constant: env = Environment::constant(desc.environment.constant * desc.environment.scale); break;
     case EnvironmentDesc::Kind::file: {
-      Environment loaded = Environment::load(resolve(desc, desc.environment.file), left);
+      Environment loaded = referenced_by("environment file", [&] { return Environment::load(resolve(desc, desc.environment.file), left); });
       if (desc.environment.scale != 1.0) {
         std::vector<float> px = loaded.pixels();
         for (float& v : px) v *= float(desc.environment.scale);
@@ -91,7 +101,7 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
     }
   }
 
-  const Tracer tracer(desc);
+  const Tracer tracer = referenced_by("a mesh object", [&] { return Tracer(desc); });
   std::vector<int> object_material;  // per object
   for (const ObjectDesc& o : desc.objects) object_material.push_back(material_index.at(o.material));
 

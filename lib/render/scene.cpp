@@ -206,6 +206,7 @@ SceneDesc parse_scene_text(const std::string& text, const std::string& path, con
   known_keys(j, {"camera", "render", "environment", "lights", "materials", "objects"}, "the scene", path);
   SceneDesc s;
   s.base_dir = base_dir;
+  s.source = path;
   if (j.contains("camera")) {
     const json& c = j["camera"];
     known_keys(c, {"position", "look_at", "up", "fov", "width", "height"}, "camera", path);

@@ -81,6 +81,7 @@ struct SceneDesc {
   std::map<std::string, MaterialDesc> materials;
   std::vector<ObjectDesc> objects;
   std::string base_dir = ".";  // where relative file names resolve
+  std::string source;          // the scene file (or what stands for it), named in errors; empty: made in code
 };
 
 // Throws Error("<path>: <problem>") for unreadable or inconsistent scenes.
