@@ -83,25 +83,6 @@ double ciede2000(const Lab& x, const Lab& y, double kL, double kC, double kH) {
   return std::sqrt(std::max(0.0, l * l + c * c + h * h + r_t * c * h));
 }
 
-}  // namespace facetfit
-
-namespace facetfit {
-
-namespace {
-
-// A token as a message may show it: printable ASCII, others as '?', at most 24 characters.
-std::string excerpt(const std::string& token) {
-  std::string out;
-  for (std::size_t k = 0; k < token.size() && k < 24; ++k) {
-    const unsigned char c = static_cast<unsigned char>(token[k]);
-    out += c >= 0x20 && c < 0x7f ? char(c) : '?';
-  }
-  if (token.size() > 24) out += "...";
-  return out;
-}
-
-}  // namespace
-
 std::array<double, 6> parse_lab_pair(const std::string& line, const std::string& what) {
   std::array<double, 6> v{};
   std::size_t count = 0, i = 0;
@@ -117,9 +98,9 @@ std::array<double, 6> parse_lab_pair(const std::string& line, const std::string&
     const char* last = token.data() + token.size();
     double x = 0;
     const auto [ptr, ec] = std::from_chars(first, last, x);
-    if (ec != std::errc() || ptr != last || !std::isfinite(x)) fail(what, "'" + excerpt(token) + "' is not a finite number");
+    if (ec != std::errc() || ptr != last || !std::isfinite(x)) fail(what, "'" + excerpt(token, 24) + "' is not a finite number");
     // Squares of larger values overflow inside the formula (1e308 gave a Delta E of 0).
-    if (std::abs(x) > 1e6) fail(what, "'" + excerpt(token) + "' is outside +-1e6: not a CIELAB coordinate");
+    if (std::abs(x) > 1e6) fail(what, "'" + excerpt(token, 24) + "' is outside +-1e6: not a CIELAB coordinate");
     v[count++] = x;
     i = end;
   }

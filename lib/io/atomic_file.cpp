@@ -76,10 +76,6 @@ long temporary_owner(const std::string& file) {
   return pid;
 }
 
-}  // namespace
-
-namespace {
-
 // Whether process `pid` still runs: it exists and is not a zombie (a writer killed with its shell is
 // reparented and stays a zombie until its new parent reaps it, which on a loaded machine can come after
 // the next run has started).

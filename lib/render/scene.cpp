@@ -96,8 +96,7 @@ void known_keys(const json& j, std::initializer_list<const char*> known, const s
     if (std::any_of(known.begin(), known.end(), [&](const char* k) { return item.key() == k; })) continue;
     std::string list;
     for (const char* k : known) list += std::string(list.empty() ? "" : ", ") + k;
-    const std::string key = item.key().size() > 40 ? item.key().substr(0, 37) + "..." : item.key();
-    fail(path, where + ": unknown key \"" + key + "\" (known: " + list + ")");
+    fail(path, where + ": unknown key \"" + excerpt(item.key(), 37) + "\" (known: " + list + ")");
   }
 }
 
@@ -341,11 +340,7 @@ std::vector<std::string> scene_materials(const std::string& scene_path) {
     std::string file;
     if (item.is_string()) file = item.get<std::string>();
     else if (item.is_object() && item.contains("file") && item["file"].is_string()) file = item["file"].get<std::string>();
-    else {
-      const std::string text = json_text(item);
-      fail(scene_path, "material entry " + (text.size() > 60 ? text.substr(0, 57) + "..." : text) +
-                           " is neither a path nor an object with \"file\"");
-    }
+    else fail(scene_path, "material entry " + excerpt(json_text(item), 57) + " is neither a path nor an object with \"file\"");
     add(resolve_source(base, file));
   }
   return out;
