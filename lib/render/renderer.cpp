@@ -1,6 +1,7 @@
 #include "render/renderer.h"
 
 #include <tbb/blocked_range2d.h>
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
 #include <chrono>
@@ -20,6 +21,7 @@
 #include "render/shading_batch.h"
 #include "render/texture.h"
 #include "render/tracer.h"
+#include "render/wavefront.h"
 
 namespace facetfit {
 
@@ -133,78 +135,48 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
     ray.tnear = 0.0, ray.tfar = std::numeric_limits<double>::infinity();
   };
 
-  // Shading at a hit is planned, sampled, evaluated, then finished. plan() draws the light directions of
-  // the shadow rays and queues, per material, the BRDF sample directions to draw; sample() draws them;
-  // evaluate() makes the evaluations of f (and the density) every shadow ray's value needs; finish() turns
-  // each into its shadow ray and value. The middle steps are one call per material, in SIMD lanes (GGX, LUT, MERL),
-  // for one sample on the one-ray path and for a whole tile on the stream path; a model without lanes is
-  // sampled and evaluated inside plan().
-  struct Request {
-    // none: a BRDF sample that found no direction.
-    enum class Kind : std::uint8_t { environment_light, brdf_sample, light, pending_sample, none };
-    Kind kind;
-    std::uint32_t material;  // whose batches
-    std::size_t slot;        // of its evaluation (pending_sample: of its direction)
-    Vec3 d;                  // the shadow ray's direction and length
-    double tfar;
-    double cos_i;            // of the light direction in the local frame
-    Rgb radiance;            // what arrives along d if nothing blocks it
-    double light_pdf;        // the environment's density of d, for multiple importance sampling
-    // Built in place (emplace_back), as a Ray (render/tracer.h).
-    Request(Kind k, int m, std::size_t s, const Vec3& direction, double length, double cosine, const Rgb& arriving, double density)
-        : kind(k), material(std::uint32_t(m)), slot(s), d(direction), tfar(length), cos_i(cosine), radiance(arriving), light_pdf(density) {}
-  };
-  // The value of a shadow ray if nothing blocks it, from the evaluation at its direction (cosine cos_i in
-  // the local frame), the radiance arriving along it and the environment's density there; none for a BRDF
-  // sample of zero density (as ShadingModel::sample).
-  const auto shadow_value = [](typename Request::Kind kind, const ShadingModel::Evaluation& e, double cos_i, const Rgb& radiance,
-                               double light_pdf) -> std::optional<Rgb> {
-    switch (kind) {
-      case Request::Kind::environment_light: return e.f * radiance * (cos_i * power_heuristic(light_pdf, e.pdf) / light_pdf);
-      case Request::Kind::brdf_sample:
-        if (!(e.pdf > 0.0)) return std::nullopt;
-        return e.f * (cos_i / e.pdf) * radiance * power_heuristic(e.pdf, light_pdf);
-      case Request::Kind::light: return e.f * radiance * cos_i;
-      case Request::Kind::pending_sample:
-      case Request::Kind::none: break;
-    }
-    return std::nullopt;
-  };
-  // Per sample: what shading found, the requests [first, last) it made and its shadow rays [ray_first,
-  // ray_last), made by plan() where it evaluated at once (`deferred` false) and by finish() otherwise.
+  // Shading at a hit yields its shadow rays and their values, in slot order: the environment's light
+  // sample and a BRDF sample (each weighted against the other by multiple importance sampling), then each
+  // light. plan() makes them for one hit, evaluating one pair at a time: the one-ray path for every hit,
+  // the stream path for a lobe textured per hit and for models without SIMD lanes (queuing their work
+  // would only add the queue's cost). The stream path makes the slots of a tile's other hits material by
+  // material in SIMD lanes (render/wavefront.h).
   struct Planned {
     Rgb radiance;
     double alpha;
     Vec3 p, o;  // the hit and the direction toward the camera in its local frame (set by place())
     Vec3 origin;
     Frame frame{Vec3(0.0, 0.0, 1.0)};
-    std::size_t first, last;
-    std::size_t ray_first, ray_last;
-    bool deferred;
+    std::size_t ray_first, ray_last;  // plan()'s shadow rays
   };
-  struct Shading {
-    // Per material.
-    std::vector<SampleBatch> samples;
-    std::vector<EvaluationBatch> evaluations;
-    std::vector<Request> requests;
-    // plan()'s textured lobe and model, while it shades one hit.
-    std::optional<TabulatedMicrofacet> textured_lobe;
-    std::optional<TabulatedAnisotropic> textured_anisotropic;
-    std::optional<ShadingModel> textured;
-    explicit Shading(std::size_t materials) : samples(materials), evaluations(materials) {}
-    void clear() {
-      for (SampleBatch& b : samples) b.clear();
-      for (EvaluationBatch& b : evaluations) b.clear();
-      requests.clear();
-    }
+  // plan()'s textured lobe and model, while it shades one hit: in the tile's scratch space, not locals
+  // (GCC cleared the empty optionals' 216 bytes at every hit: perf, 8% of plan() on a GGX sphere).
+  struct Textured {
+    std::optional<TabulatedMicrofacet> lobe;
+    std::optional<TabulatedAnisotropic> anisotropic;
+    std::optional<ShadingModel> model;
   };
   const double infinity = std::numeric_limits<double>::infinity();
+  // Per material: whether the stream path shades its hits in lanes.
+  std::vector<char> in_lanes;
+  for (std::size_t m = 0; m < materials.size(); ++m) in_lanes.push_back(materials[m]->has_lanes() && !stretch_textures[m]);
+  std::vector<LaneLight> lane_lights;
+  for (const LightDesc& light : desc.lights)
+    lane_lights.push_back({light.kind == LightDesc::Kind::directional, light.vector.x, light.vector.y, light.vector.z, light.value.r,
+                           light.value.g, light.value.b});
 
-  // The camera ray's hit, its shading frame and the shadow rays' origin. Apart from plan(): on the stream
-  // path a loop of its own over the tile, whose square roots and divisions overlap from one hit to the next
-  // (inside plan() each waited on the last: perf put 11% of a GGX render on them).
+  // The camera ray's hit, its shading frame and the shadow rays' origin; the radiance of a ray that hits
+  // nothing. On the stream path a loop of its own over the tile, whose square roots and divisions overlap
+  // from one hit to the next (inside plan() each waited on the last: perf put 11% of a GGX render on them).
   const auto place = [&](const Hit& hit, const Vec3& dir, Planned& planned) {
-    if (!hit.found()) return;
+    planned.radiance = Rgb(0.0);
+    planned.alpha = 1.0;
+    planned.ray_first = planned.ray_last = 0;
+    if (!hit.found()) {
+      planned.radiance = env ? env->radiance(dir) : Rgb(0.0);
+      planned.alpha = 0.0;
+      return;
+    }
     const ObjectDesc& object = desc.objects[std::size_t(hit.object)];
     const Vec3 p = cam.position + hit.t * dir;
     Vec3 n = object.kind == ObjectDesc::Kind::sphere ? glm::normalize(p - object.center) : glm::normalize(hit.ng);
@@ -215,76 +187,51 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
     planned.o = planned.frame.to_local(-dir);
     planned.origin = p + eps * n;
   };
-  // Plans the camera ray's hit, placed by place(), with u[2..6]; `light_d`, where not null, is the
-  // environment's sample drawn with u[2..3] beforehand (a constant environment's, in SIMD lanes on the
-  // stream path).
-  const auto plan = [&](const Hit& hit, const Vec3& dir, const double* u, const Vec3* light_d, Shading& shading, Planned& planned,
+  // The shadow rays of a hit placed by place(), with u[2..6], and their values; `light_d`, where not null,
+  // is the environment's sample drawn with u[2..3] beforehand (a constant environment's, in SIMD lanes on
+  // the stream path).
+  const auto plan = [&](const Hit& hit, const double* u, const Vec3* light_d, Textured& textured, Planned& planned,
                         std::vector<Ray>& rays, std::vector<Rgb>& values) {
-    planned.radiance = Rgb(0.0);
-    planned.alpha = 1.0;
-    planned.first = planned.last = shading.requests.size();
     planned.ray_first = planned.ray_last = rays.size();
-    planned.deferred = false;
-    if (!hit.found()) {
-      planned.radiance = env ? env->radiance(dir) : Rgb(0.0);
-      planned.alpha = 0.0;
-      return;
-    }
+    if (!hit.found()) return;
     const ObjectDesc& object = desc.objects[std::size_t(hit.object)];
     const int material = object_material[std::size_t(hit.object)];
     const Vec3 p = planned.p, o = planned.o;
     const Frame& frame = planned.frame;
-    // A stretch_texture reshapes the lobe here: a copy sharing its tables, held in the tile's scratch
-    // space (the shading model refers to it without owning it). Not a local: GCC cleared the empty
-    // optionals' 216 bytes at every hit (perf: 8% of plan() on a GGX sphere).
-    std::optional<TabulatedMicrofacet>& textured_lobe = shading.textured_lobe;
-    std::optional<TabulatedAnisotropic>& textured_anisotropic = shading.textured_anisotropic;
-    std::optional<ShadingModel>& textured = shading.textured;
-    textured.reset();
+    // A stretch_texture reshapes the lobe here: a copy sharing its tables (the shading model refers to it
+    // without owning it).
+    textured.model.reset();
     if (const auto& st = stretch_textures[std::size_t(material)]) {
       const Rgb scale = st->texture.lookup(texture_coordinates(object, p));
       const auto clamped = [](double a, double b) { return clamp(a * b, Stretch::kMin, Stretch::kMax); };
       const Stretch stretch(clamped(st->stretch.x, scale.r), clamped(st->stretch.y, scale.g), st->stretch.rotation());
       const auto unowned = [](const auto& lobe) { return std::shared_ptr<const std::decay_t<decltype(lobe)>>(std::shared_ptr<void>(), &lobe); };
       if (st->lobe) {
-        const auto lobe = unowned(textured_lobe.emplace(st->lobe->stretched(stretch)));
-        textured.emplace(lobe, lobe);
+        const auto lobe = unowned(textured.lobe.emplace(st->lobe->stretched(stretch)));
+        textured.model.emplace(lobe, lobe);
       } else {
-        const auto lobe = unowned(textured_anisotropic.emplace(st->anisotropic->stretched(stretch)));
-        textured.emplace(lobe, lobe);
+        const auto lobe = unowned(textured.anisotropic.emplace(st->anisotropic->stretched(stretch)));
+        textured.model.emplace(lobe, lobe);
       }
     }
-    const ShadingModel& model = textured ? *textured : *materials[std::size_t(material)];
-    // Evaluated and sampled at once, its shadow rays made here: a lobe textured here (this call owns it),
-    // and a model without SIMD lanes (queuing its work would only add the queue's cost: 6% more
-    // instructions on a LUT sphere).
-    const bool at_once = textured || !model.has_lanes();
-    planned.deferred = !at_once;
-    const auto request = [&](typename Request::Kind kind, const Vec3& i, const Vec3& d, double tfar, const Rgb& radiance,
-                             double light_pdf) {
-      const bool density = kind != Request::Kind::light;
-      if (at_once) {
-        if (const auto value = shadow_value(kind, model.eval(o, i, density), i.z, radiance, light_pdf)) {
-          rays.emplace_back(planned.origin, d, eps, tfar);
-          values.push_back(*value);
-        }
-        return;
-      }
-      const std::size_t slot = shading.evaluations[std::size_t(material)].push(o, i, density);
-      shading.requests.emplace_back(kind, material, slot, d, tfar, i.z, radiance, light_pdf);
+    const ShadingModel& model = textured.model ? *textured.model : *materials[std::size_t(material)];
+    const auto cast = [&](const Vec3& d, double tfar, const Rgb& value) {
+      rays.emplace_back(planned.origin, d, eps, tfar);
+      values.push_back(value);
     };
     if (env && o.z > 0.0) {
       // Light sampling, weighted against the BRDF's proposal.
       const Environment::Sample ls = light_d ? env->lookup(*light_d) : env->sample(u[0], u[1]);
       const Vec3 il = frame.to_local(ls.d);
-      if (il.z > 0.0 && ls.pdf > 0.0) request(Request::Kind::environment_light, il, ls.d, infinity, ls.radiance, ls.pdf);
-      // BRDF sampling, weighted against the environment's: drawn by sample() unless at once.
-      if (!at_once) {
-        const std::size_t slot = shading.samples[std::size_t(material)].push(o, u[2], u[3], u[4]);
-        shading.requests.emplace_back(Request::Kind::pending_sample, material, slot, Vec3(0.0), infinity, 0.0, Rgb(0.0), 0.0);
-      } else if (const auto i = model.sample_direction(o, u[2], u[3], u[4])) {
-        const Environment::Sample e = env->lookup(frame.to_world(*i));  // its d: the world direction
-        request(Request::Kind::brdf_sample, *i, e.d, infinity, e.radiance, e.pdf);
+      if (il.z > 0.0 && ls.pdf > 0.0) {
+        const ShadingModel::Evaluation e = model.eval(o, il, true);
+        cast(ls.d, infinity, e.f * ls.radiance * (il.z * power_heuristic(ls.pdf, e.pdf) / ls.pdf));
+      }
+      // BRDF sampling, weighted against the environment's.
+      if (const auto i = model.sample_direction(o, u[2], u[3], u[4])) {
+        const Environment::Sample at = env->lookup(frame.to_world(*i));  // its d: the world direction
+        const ShadingModel::Evaluation e = model.eval(o, *i, true);
+        if (e.pdf > 0.0) cast(at.d, infinity, e.f * (i->z / e.pdf) * at.radiance * power_heuristic(e.pdf, at.pdf));
       }
     }
     for (const LightDesc& light : desc.lights) {
@@ -301,54 +248,7 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
         dist *= 1.0 - 1e-6;
       }
       const Vec3 il = frame.to_local(d);
-      if (il.z > 0.0 && o.z > 0.0) request(Request::Kind::light, il, d, dist, e, 0.0);
-    }
-    planned.last = shading.requests.size();
-    planned.ray_last = rays.size();
-  };
-  // Draws the BRDF sample directions plan() queued, and queues their evaluations: in SIMD lanes where a
-  // material has them, unless `simd` is false.
-  const auto sample = [&](const std::vector<Planned>& planned, Shading& shading, bool simd) {
-    bool any = false;  // a tile of models without lanes queued none: no pass over its requests
-    for (std::size_t m = 0; m < materials.size(); ++m) {
-      if (shading.samples[m].size() == 0) continue;
-      materials[m]->sample_directions(shading.samples[m], simd);
-      any = true;
-    }
-    if (!any) return;
-    for (const Planned& p : planned)
-      for (std::size_t q = p.first; q < p.last; ++q) {
-        Request& r = shading.requests[q];
-        if (r.kind != Request::Kind::pending_sample) continue;
-        const SampleBatch& b = shading.samples[r.material];
-        if (b.found[r.slot] == 0.0) {
-          r.kind = Request::Kind::none;
-          continue;
-        }
-        const Vec3 i = b.i(r.slot);
-        r.kind = Request::Kind::brdf_sample;
-        const Environment::Sample e = env->lookup(p.frame.to_world(i));
-        r.d = e.d, r.radiance = e.radiance, r.light_pdf = e.pdf, r.cos_i = i.z;
-        r.slot = shading.evaluations[r.material].push(b.o(r.slot), i);
-      }
-  };
-  // Evaluates what plan() and sample() queued.
-  const auto evaluate = [&](Shading& shading, bool simd) {
-    for (std::size_t m = 0; m < materials.size(); ++m)
-      if (shading.evaluations[m].size() > 0) materials[m]->eval(shading.evaluations[m], simd);
-  };
-  // Appends the shadow rays of a deferred sample and their values, in the order of its requests.
-  const auto finish = [&](Planned& planned, const Shading& shading, std::vector<Ray>& rays, std::vector<Rgb>& values) {
-    if (!planned.deferred) return;
-    planned.ray_first = rays.size();
-    for (std::size_t q = planned.first; q < planned.last; ++q) {
-      const Request& r = shading.requests[q];
-      if (r.kind == Request::Kind::none) continue;
-      const EvaluationBatch& b = shading.evaluations[r.material];
-      if (const auto value = shadow_value(r.kind, {b.f(r.slot), b.pdf[r.slot]}, r.cos_i, r.radiance, r.light_pdf)) {
-        rays.emplace_back(planned.origin, r.d, eps, r.tfar);
-        values.push_back(*value);
-      }
+      if (il.z > 0.0 && o.z > 0.0) cast(d, dist, model.eval(o, il, false).f * e * il.z);
     }
     planned.ray_last = rays.size();
   };
@@ -382,9 +282,8 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
   const auto render_tile_scalar = [&](const tbb::blocked_range2d<int>& tile, int first, int last) {
     std::vector<Ray> rays;
     std::vector<Rgb> values;
-    std::vector<char> blocked;
-    Shading shading(materials.size());
-    std::vector<Planned> planned(1);
+    Textured textured;
+    Planned planned;
     for (int y = tile.rows().begin(); y < tile.rows().end(); ++y)
       for (int x = tile.cols().begin(); x < tile.cols().end(); ++x)
         for (int s = first; s < last; ++s) {
@@ -392,42 +291,66 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
           sample_numbers(x, y, s, u);
           Ray ray;
           camera_ray(camera.direction(x, y, u[0], u[1]), ray);
-          rays.clear(), values.clear(), blocked.clear();
-          shading.clear();
+          rays.clear(), values.clear();
           const Hit hit = tracer.intersect(ray);
-          place(hit, ray.dir, planned[0]);
-          plan(hit, ray.dir, u + 2, nullptr, shading, planned[0], rays, values);
-          sample(planned, shading, false);
-          evaluate(shading, false);
-          finish(planned[0], shading, rays, values);
-          for (const Ray& r : rays) blocked.push_back(tracer.occluded(r));
-          add_unblocked(blocked, values, 0, rays.size(), planned[0].radiance);
-          accumulate(pixel_accum(x, y), planned[0].radiance, planned[0].alpha);
+          place(hit, ray.dir, planned);
+          plan(hit, u + 2, nullptr, textured, planned, rays, values);
+          for (std::size_t q = 0; q < rays.size(); ++q)
+            if (!tracer.occluded(rays[q])) planned.radiance += values[q];
+          accumulate(pixel_accum(x, y), planned.radiance, planned.alpha);
         }
   };
+  // Per material shaded in lanes, a tile's hits for one sample index and their slots.
+  struct Wave {
+    HitBatch hits;
+    SampleBatch samples;
+    ShadowBatch shadows;
+    SlotRanges ranges;
+    std::vector<std::uint32_t> ray;  // per entry of shadows that casts one: its index in the tile's rays
+  };
+  // A thread's space for the tiles it renders, kept from tile to tile: allocated per tile, its columns'
+  // pages were mapped and unmapped again and again, and unmapping stops the other threads (TLB shootdowns:
+  // perf put 16% of a two-thread GGX render in the kernel).
+  struct TileSpace {
+    std::vector<Ray> cameras;
+    std::vector<Hit> hits;
+    std::vector<Planned> planned;
+    std::vector<Ray> rays;
+    std::vector<Rgb> values;  // of plan()'s rays
+    std::vector<char> blocked;
+    Textured textured;
+    std::vector<Wave> waves;
+    SphereSampleBatch light_samples;
+    CameraSampleBatch samples;
+  };
+  tbb::enumerable_thread_specific<TileSpace> tile_spaces;
   // Every pixel of the tile at once, one sample index after the other: camera rays, shading, then shadow
   // rays, as streams (Embree's for triangles; coherent camera rays travel together) and evaluations in
   // batches.
   const auto render_tile_streams = [&](const tbb::blocked_range2d<int>& tile, int first, int last) {
     const int tw = int(tile.cols().size()), count = tw * int(tile.rows().size());
     const std::size_t n = std::size_t(count);
-    std::vector<Ray> cameras(n);
-    std::vector<Hit> hits;
-    std::vector<Planned> planned(n);
-    std::vector<Ray> rays;
-    std::vector<Rgb> values;
-    std::vector<char> blocked;
-    Shading shading(materials.size());
+    TileSpace& space = tile_spaces.local();
+    std::vector<Ray>& cameras = space.cameras;
+    std::vector<Hit>& hits = space.hits;
+    std::vector<Planned>& planned = space.planned;
+    std::vector<Ray>& rays = space.rays;
+    std::vector<Rgb>& values = space.values;
+    std::vector<char>& blocked = space.blocked;
+    Textured& textured = space.textured;
+    std::vector<Wave>& waves = space.waves;
+    cameras.resize(n), planned.resize(n), waves.resize(materials.size());
     // A constant environment's light samples, drawn in SIMD lanes for the whole tile.
     const bool sphere_lanes = env && env->is_constant();
-    SphereSampleBatch light_samples;
+    SphereSampleBatch& light_samples = space.light_samples;
     // At most two environment rays and one per light per sample: room for all from the start, so that the
     // first sample of a tile does not grow them piece by piece.
     const std::size_t most = n * (2 + desc.lights.size());
-    shading.requests.reserve(most), rays.reserve(most), values.reserve(most), blocked.reserve(most);
+    rays.reserve(most), values.reserve(most), blocked.reserve(most);
     // Each pixel's coordinates and its part of the sequences once per tile; per sample index, the numbers
     // and camera rays of all in SIMD lanes.
-    CameraSampleBatch samples;
+    CameraSampleBatch& samples = space.samples;
+    samples.clear();
     for (int k = 0; k < count; ++k) samples.push(tile.cols().begin() + k % tw, tile.rows().begin() + k / tw);
     for (int s = first; s < last; ++s) {
       camera_sample_batch(camera, seed, s, samples);
@@ -438,20 +361,77 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
         for (std::size_t k = 0; k < n; ++k) light_samples.push(samples.u[2][k], samples.u[3][k]);
         sample_uniform_sphere_batch(light_samples);
       }
-      for (std::size_t k = 0; k < n; ++k) place(hits[k], cameras[k].dir, planned[k]);
-      shading.clear();
+      for (Wave& w : waves) w.hits.clear();
       rays.clear(), values.clear();
       for (std::size_t k = 0; k < n; ++k) {
-        const Vec3 light_d = sphere_lanes ? light_samples.d(k) : Vec3(0.0);
-        const double u[5] = {samples.u[2][k], samples.u[3][k], samples.u[4][k], samples.u[5][k], samples.u[6][k]};
-        plan(hits[k], cameras[k].dir, u, sphere_lanes ? &light_d : nullptr, shading, planned[k], rays, values);
+        Planned& pk = planned[k];
+        place(hits[k], cameras[k].dir, pk);
+        if (!hits[k].found()) continue;
+        const std::size_t material = std::size_t(object_material[std::size_t(hits[k].object)]);
+        if (!in_lanes[material]) {
+          const Vec3 light_d = sphere_lanes ? light_samples.d(k) : Vec3(0.0);
+          const double u[5] = {samples.u[2][k], samples.u[3][k], samples.u[4][k], samples.u[5][k], samples.u[6][k]};
+          plan(hits[k], u, sphere_lanes ? &light_d : nullptr, textured, pk, rays, values);
+          continue;
+        }
+        HitBatch& h = waves[material].hits;
+        const std::size_t j = h.push();
+        const Frame& f = pk.frame;
+        h.tx[j] = f.t.x, h.ty[j] = f.t.y, h.tz[j] = f.t.z, h.bx[j] = f.b.x, h.by[j] = f.b.y, h.bz[j] = f.b.z;
+        h.nx[j] = f.n.x, h.ny[j] = f.n.y, h.nz[j] = f.n.z;
+        h.ox[j] = pk.o.x, h.oy[j] = pk.o.y, h.oz[j] = pk.o.z;
+        h.px[j] = pk.p.x, h.py[j] = pk.p.y, h.pz[j] = pk.p.z;
+        h.origin_x[j] = pk.origin.x, h.origin_y[j] = pk.origin.y, h.origin_z[j] = pk.origin.z;
+        if (env) {
+          const Environment::Sample ls = sphere_lanes ? env->lookup(light_samples.d(k)) : env->sample(samples.u[2][k], samples.u[3][k]);
+          h.lx[j] = ls.d.x, h.ly[j] = ls.d.y, h.lz[j] = ls.d.z, h.light_pdf[j] = ls.pdf;
+          h.light_r[j] = ls.radiance.r, h.light_g[j] = ls.radiance.g, h.light_b[j] = ls.radiance.b;
+          h.u1[j] = samples.u[4][k], h.u2[j] = samples.u[5][k], h.u3[j] = samples.u[6][k];
+        }
+        h.owner[j] = double(k);
       }
-      sample(planned, shading, true);
-      evaluate(shading, true);
-      for (Planned& p : planned) finish(p, shading, rays, values);
+      for (std::size_t m = 0; m < materials.size(); ++m) {
+        Wave& w = waves[m];
+        if (w.hits.size() == 0) continue;
+        light_slots(w.hits, bool(env), lane_lights, w.shadows, w.ranges, w.samples);
+        if (env) {
+          materials[m]->sample_directions(w.samples, true);
+          const std::size_t brdf_begin = w.shadows.size();
+          brdf_slots(w.hits, w.samples, sphere_lanes ? env->lookup(Vec3(0.0, 0.0, 1.0)).radiance : Rgb(0.0), w.shadows);
+          if (!sphere_lanes)
+            for (std::size_t e = brdf_begin; e < w.shadows.size(); ++e) {
+              const Environment::Sample ls = env->lookup({w.shadows.dx[e], w.shadows.dy[e], w.shadows.dz[e]});
+              w.shadows.arriving_r[e] = ls.radiance.r, w.shadows.arriving_g[e] = ls.radiance.g, w.shadows.arriving_b[e] = ls.radiance.b;
+              w.shadows.light_pdf[e] = ls.pdf;
+            }
+        }
+        materials[m]->eval(w.shadows, true);
+        shadow_values(w.shadows, w.ranges);
+        const ShadowBatch& b = w.shadows;
+        w.ray.resize(b.size());
+        for (std::size_t e = 0; e < b.size(); ++e) {
+          if (b.casts[e] == 0.0) continue;
+          w.ray[e] = std::uint32_t(rays.size());
+          const std::size_t owner = std::size_t(b.owner[e]);
+          rays.emplace_back(planned[owner].origin, Vec3(b.dx[e], b.dy[e], b.dz[e]), eps, b.tfar[e]);
+        }
+      }
       tracer.occluded(rays, blocked);
+      // The lanes' rays, added to their hits slot by slot: environment light, BRDF sample, lights, which is
+      // each hit's order of slots.
+      for (const Wave& w : waves) {
+        if (w.hits.size() == 0) continue;
+        const ShadowBatch& b = w.shadows;
+        const auto add = [&](std::size_t begin, std::size_t end) {
+          for (std::size_t e = begin; e < end; ++e)
+            if (b.casts[e] != 0.0 && !blocked[w.ray[e]]) planned[std::size_t(b.owner[e])].radiance += Rgb(b.value_r[e], b.value_g[e], b.value_b[e]);
+        };
+        add(0, w.ranges.lights_begin);
+        add(w.ranges.brdf_begin, b.size());
+        add(w.ranges.lights_begin, w.ranges.brdf_begin);
+      }
       for (std::size_t k = 0; k < n; ++k) {
-        add_unblocked(blocked, values, planned[k].ray_first, planned[k].ray_last, planned[k].radiance);
+        if (planned[k].ray_last > planned[k].ray_first) add_unblocked(blocked, values, planned[k].ray_first, planned[k].ray_last, planned[k].radiance);
         accumulate(pixel_accum(int(samples.x[k]), int(samples.y[k])), planned[k].radiance, planned[k].alpha);
       }
     }

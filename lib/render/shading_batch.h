@@ -31,6 +31,13 @@ class Columns {
     if (size_ == capacity_) grow(capacity_ += 4 * kPadding);
     return size_++;
   }
+  // Room for n entries (columns of at least n's padded size), for kernels that write entries in place.
+  template <class Grow>
+  void ensure(std::size_t n, const Grow& grow) {
+    const std::size_t padded = (n + kPadding - 1) / kPadding * kPadding;
+    if (padded > capacity_) grow(capacity_ = padded);
+  }
+  void set_size(std::size_t n) { size_ = n; }
   static void resize(std::initializer_list<std::vector<double>*> columns, std::size_t n, double fill) {
     for (std::vector<double>* c : columns) c->resize(n, fill);
   }
@@ -52,16 +59,19 @@ struct EvaluationBatch : Columns {
   std::vector<double> ox, oy, oz, ix, iy, iz, with_pdf;  // in (with_pdf: 1 or 0)
   std::vector<double> r, g, b, pdf;                      // out
   std::size_t push(const Vec3& o, const Vec3& i, bool density = true) {
-    const std::size_t k = next([this](std::size_t n) {
-      resize({&ox, &oy, &ix, &iy, &with_pdf, &r, &g, &b, &pdf}, n, 0.0);
-      resize({&oz, &iz}, n, 1.0);  // up
-    });
+    const std::size_t k = next([this](std::size_t n) { grow(n); });
     ox[k] = o.x, oy[k] = o.y, oz[k] = o.z, ix[k] = i.x, iy[k] = i.y, iz[k] = i.z, with_pdf[k] = density ? 1.0 : 0.0;
     return k;
   }
   Vec3 o(std::size_t k) const { return {ox[k], oy[k], oz[k]}; }
   Vec3 i(std::size_t k) const { return {ix[k], iy[k], iz[k]}; }
   Rgb f(std::size_t k) const { return {r[k], g[k], b[k]}; }
+
+ protected:
+  void grow(std::size_t n) {
+    resize({&ox, &oy, &ix, &iy, &with_pdf, &r, &g, &b, &pdf}, n, 0.0);
+    resize({&oz, &iz}, n, 1.0);  // up
+  }
 };
 
 // A direction i drawn for o with the numbers (u1, u2, u3); `found` 1 or 0 (none: o or i below the
@@ -70,16 +80,24 @@ struct SampleBatch : Columns {
   std::vector<double> ox, oy, oz, u1, u2, u3;  // in
   std::vector<double> ix, iy, iz, found;       // out
   std::size_t push(const Vec3& o, double a, double b, double c) {
-    const std::size_t k = next([this](std::size_t n) {
-      resize({&ox, &oy, &ix, &iy, &found}, n, 0.0);
-      resize({&oz, &iz}, n, 1.0);  // up
-      resize({&u1, &u2, &u3}, n, 0.5);
-    });
+    const std::size_t k = next([this](std::size_t n) { grow(n); });
     ox[k] = o.x, oy[k] = o.y, oz[k] = o.z, u1[k] = a, u2[k] = b, u3[k] = c;
     return k;
   }
+  // n entries, whose inputs the caller writes in place.
+  void resize_to(std::size_t n) {
+    ensure(n, [this](std::size_t m) { grow(m); });
+    set_size(n);
+  }
   Vec3 o(std::size_t k) const { return {ox[k], oy[k], oz[k]}; }
   Vec3 i(std::size_t k) const { return {ix[k], iy[k], iz[k]}; }
+
+ private:
+  void grow(std::size_t n) {
+    resize({&ox, &oy, &ix, &iy, &found}, n, 0.0);
+    resize({&oz, &iz}, n, 1.0);  // up
+    resize({&u1, &u2, &u3}, n, 0.5);
+  }
 };
 
 }  // namespace facetfit

@@ -1,0 +1,231 @@
+// Compiled once per SIMD target by Highway's foreach_target (this file includes itself), as
+// render/ggx_batch.cpp.
+#include "render/simd_targets.h"  // before any of Highway's headers
+#undef HWY_TARGET_INCLUDE
+#define HWY_TARGET_INCLUDE "render/wavefront.cpp"
+#include <hwy/foreach_target.h>  // before highway.h
+
+#include <hwy/highway.h>
+
+#include <cstdint>
+#include <limits>
+
+#include "render/wavefront.h"
+
+HWY_BEFORE_NAMESPACE();
+namespace facetfit {
+namespace HWY_NAMESPACE {
+namespace hn = hwy::HWY_NAMESPACE;
+
+namespace {
+
+using D = hn::ScalableTag<double>;
+using V = hn::Vec<D>;
+using M = hn::Mask<D>;
+
+struct Vec3V {
+  V x, y, z;
+};
+
+// A hit's shading frame, as Frame (core/frame.h) holds it.
+struct FrameV {
+  Vec3V t, b, n;
+  Vec3V to_local(const Vec3V& v) const {
+    return {v.x * t.x + v.y * t.y + v.z * t.z, v.x * b.x + v.y * b.y + v.z * b.z, v.x * n.x + v.y * n.y + v.z * n.z};
+  }
+  Vec3V to_world(const Vec3V& v) const {
+    return {v.x * t.x + v.y * b.x + v.z * n.x, v.x * t.y + v.y * b.y + v.z * n.y, v.x * t.z + v.y * b.z + v.z * n.z};
+  }
+};
+
+V load(D d, const std::vector<double>& column, std::size_t k) { return hn::LoadU(d, column.data() + k); }
+
+FrameV frame_at(D d, const HitBatch& h, std::size_t k) {
+  return {{load(d, h.tx, k), load(d, h.ty, k), load(d, h.tz, k)},
+          {load(d, h.bx, k), load(d, h.by, k), load(d, h.bz, k)},
+          {load(d, h.nx, k), load(d, h.ny, k), load(d, h.nz, k)}};
+}
+
+// Appends the lanes of `m` as entries of `out` from position `at`: one evaluation (o, i, with_pdf) and
+// its shadow ray (direction, length, arriving radiance, environment density, owner). Returns the count.
+struct Entry {
+  Vec3V o, i, d;
+  V with_pdf, tfar, arriving_r, arriving_g, arriving_b, light_pdf, owner;
+};
+// The lanes of mask bits m moved to the front, in order: Highway's CompressStore copies a 256-byte table
+// onto the stack at every call (hwy 1.0.3; perf: half of a render). A vector holds at most 4 doubles
+// (AVX2; render/simd_targets.h).
+struct CompressTable {
+  std::int64_t index[16][4];
+};
+constexpr CompressTable kCompress = [] {
+  CompressTable t{};
+  for (int m = 0; m < 16; ++m) {
+    int at = 0;
+    for (int lane = 0; lane < 4; ++lane)
+      if (m & (1 << lane)) t.index[m][at++] = lane;
+  }
+  return t;
+}();
+
+// (Functions, not lambdas: GCC compiles a lambda without the target's attributes, so it cannot inline the
+// SIMD code and passes every vector through memory.)
+HWY_INLINE std::size_t append(D d, M m, const Entry& e, ShadowBatch& out, std::size_t at) {
+  static_assert(hn::MaxLanes(D()) <= 4, "kCompress holds 4 lanes");
+  std::uint8_t bits[8] = {};
+  hn::StoreMaskBits(d, m, bits);
+  const auto to_front = hn::SetTableIndices(d, kCompress.index[bits[0] & 15]);
+  const auto put = [&](V v, std::vector<double>& column) HWY_ATTR { hn::StoreU(hn::TableLookupLanes(v, to_front), d, column.data() + at); };
+  put(e.o.x, out.ox), put(e.o.y, out.oy), put(e.o.z, out.oz);
+  put(e.i.x, out.ix), put(e.i.y, out.iy), put(e.i.z, out.iz), put(e.with_pdf, out.with_pdf);
+  put(e.d.x, out.dx), put(e.d.y, out.dy), put(e.d.z, out.dz), put(e.tfar, out.tfar);
+  put(e.arriving_r, out.arriving_r), put(e.arriving_g, out.arriving_g), put(e.arriving_b, out.arriving_b);
+  put(e.light_pdf, out.light_pdf), put(e.owner, out.owner);
+  return hn::CountTrue(d, m);
+}
+
+// The lanes from k on that hold one of the batch's `count` entries (the padding past them may repeat an
+// earlier tile's).
+HWY_INLINE M real(D d, std::size_t k, std::size_t count) { return hn::Iota(d, double(k)) < hn::Set(d, double(count)); }
+
+HWY_INLINE V power_heuristic(V a, V b) { return (a * a) / (a * a + b * b); }
+
+}  // namespace
+
+void LightSlots(const HitBatch& hits, bool environment, const std::vector<LaneLight>& lights, ShadowBatch& out, SlotRanges& ranges,
+                SampleBatch& samples) {
+  const D d;
+  const std::size_t n = hits.padded_size(), lanes = hn::Lanes(d);
+  const V zero = hn::Zero(d), one = hn::Set(d, 1.0), infinity = hn::Set(d, std::numeric_limits<double>::infinity());
+  // Every slot of every hit, and a vector's worth past the last for the stores.
+  out.clear();
+  out.reserve(n * (1 + lights.size()) + lanes);
+  std::size_t size = 0;
+  if (environment)
+    for (std::size_t k = 0; k < n; k += lanes) {
+      const FrameV frame = frame_at(d, hits, k);
+      const Vec3V o{load(d, hits.ox, k), load(d, hits.oy, k), load(d, hits.oz, k)};
+      const Vec3V l{load(d, hits.lx, k), load(d, hits.ly, k), load(d, hits.lz, k)};
+      const V pdf = load(d, hits.light_pdf, k);
+      const Vec3V il = frame.to_local(l);
+      const M lit = hn::And(real(d, k, hits.size()), hn::And(o.z > zero, hn::And(il.z > zero, pdf > zero)));
+      size += append(d, lit,
+                     {o, il, l, one, infinity, load(d, hits.light_r, k), load(d, hits.light_g, k), load(d, hits.light_b, k), pdf,
+                      load(d, hits.owner, k)},
+                     out, size);
+    }
+  ranges.lights_begin = size;
+  ranges.light_begin.clear();
+  for (const LaneLight& light : lights) {
+    ranges.light_begin.push_back(size);
+    const V vx = hn::Set(d, light.x), vy = hn::Set(d, light.y), vz = hn::Set(d, light.z);
+    const V r = hn::Set(d, light.r), g = hn::Set(d, light.g), b = hn::Set(d, light.b);
+    for (std::size_t k = 0; k < n; k += lanes) {
+      const FrameV frame = frame_at(d, hits, k);
+      const Vec3V o{load(d, hits.ox, k), load(d, hits.oy, k), load(d, hits.oz, k)};
+      Entry e{o, {}, {vx, vy, vz}, zero, infinity, r, g, b, zero, load(d, hits.owner, k)};
+      if (!light.directional) {
+        // Toward the point from the hit, its irradiance falling as the squared distance, the ray stopping
+        // just short of it.
+        const V to_x = vx - load(d, hits.px, k), to_y = vy - load(d, hits.py, k), to_z = vz - load(d, hits.pz, k);
+        const V dist = hn::Sqrt(to_x * to_x + to_y * to_y + to_z * to_z), inv2 = one / (dist * dist);
+        e.d = {to_x / dist, to_y / dist, to_z / dist};
+        e.arriving_r = r * inv2, e.arriving_g = g * inv2, e.arriving_b = b * inv2;
+        e.tfar = dist * hn::Set(d, 1.0 - 1e-6);
+      }
+      e.i = frame.to_local(e.d);
+      size += append(d, hn::And(real(d, k, hits.size()), hn::And(e.i.z > zero, o.z > zero)), e, out, size);
+    }
+  }
+  ranges.brdf_begin = size;
+  out.set_size(size);
+  samples.clear();
+  if (!environment) return;
+  // The BRDF samples' inputs are the hits' own columns.
+  samples.resize_to(hits.size());
+  for (std::size_t k = 0; k < n; k += lanes) {
+    hn::StoreU(load(d, hits.ox, k), d, samples.ox.data() + k), hn::StoreU(load(d, hits.oy, k), d, samples.oy.data() + k);
+    hn::StoreU(load(d, hits.oz, k), d, samples.oz.data() + k);
+    hn::StoreU(load(d, hits.u1, k), d, samples.u1.data() + k), hn::StoreU(load(d, hits.u2, k), d, samples.u2.data() + k);
+    hn::StoreU(load(d, hits.u3, k), d, samples.u3.data() + k);
+  }
+}
+
+void BrdfSlots(const HitBatch& hits, const SampleBatch& samples, const Rgb& radiance, ShadowBatch& out) {
+  const D d;
+  const std::size_t n = hits.padded_size(), lanes = hn::Lanes(d);
+  const V zero = hn::Zero(d), one = hn::Set(d, 1.0), infinity = hn::Set(d, std::numeric_limits<double>::infinity());
+  std::size_t size = out.size();
+  out.reserve(size + n + lanes);
+  const V r = hn::Set(d, radiance.r), g = hn::Set(d, radiance.g), b = hn::Set(d, radiance.b), pdf = hn::Set(d, 1.0 / (4.0 * kPi));
+  for (std::size_t k = 0; k < n; k += lanes) {
+    const FrameV frame = frame_at(d, hits, k);
+    const Vec3V o{load(d, samples.ox, k), load(d, samples.oy, k), load(d, samples.oz, k)};
+    const Vec3V i{load(d, samples.ix, k), load(d, samples.iy, k), load(d, samples.iz, k)};
+    const M found = hn::And(real(d, k, hits.size()), load(d, samples.found, k) != zero);
+    size += append(d, found, {o, i, frame.to_world(i), one, infinity, r, g, b, pdf, load(d, hits.owner, k)}, out, size);
+  }
+  out.set_size(size);
+}
+
+void ShadowValues(ShadowBatch& batch, const SlotRanges& ranges) {
+  const D d;
+  const std::size_t lanes = hn::Lanes(d), n = batch.padded_size();
+  const V zero = hn::Zero(d), one = hn::Set(d, 1.0);
+  for (std::size_t k = 0; k < n; k += lanes) {
+    // Which slot each lane holds: the ranges are contiguous, so compare the lane's index with their starts.
+    const V index = hn::Iota(d, double(k));
+    const M env_light = index < hn::Set(d, double(ranges.lights_begin));
+    const M brdf = index >= hn::Set(d, double(ranges.brdf_begin));
+    const V pdf = load(d, batch.pdf, k), light_pdf = load(d, batch.light_pdf, k), cos_i = load(d, batch.iz, k);
+    // environment light: f L cos w(light, brdf) / p_light; BRDF sample: f cos / p_brdf L w(brdf, light);
+    // light: f E cos
+    const V env_factor = cos_i * power_heuristic(light_pdf, pdf) / hn::IfThenElse(env_light, light_pdf, one);
+    const M has_density = pdf > zero;
+    const V brdf_factor = cos_i / hn::IfThenElse(has_density, pdf, one);
+    const V brdf_weight = power_heuristic(pdf, light_pdf);
+    const V f[3] = {load(d, batch.r, k), load(d, batch.g, k), load(d, batch.b, k)};
+    const V arriving[3] = {load(d, batch.arriving_r, k), load(d, batch.arriving_g, k), load(d, batch.arriving_b, k)};
+    double* value[3] = {batch.value_r.data(), batch.value_g.data(), batch.value_b.data()};
+    for (int c = 0; c < 3; ++c) {
+      const V light_value = f[c] * arriving[c] * cos_i;
+      const V env_value = f[c] * arriving[c] * env_factor;
+      const V brdf_value = f[c] * brdf_factor * arriving[c] * brdf_weight;
+      hn::StoreU(hn::IfThenElse(env_light, env_value, hn::IfThenElse(brdf, brdf_value, light_value)), d, value[c] + k);
+    }
+    hn::StoreU(hn::IfThenElse(hn::AndNot(has_density, brdf), zero, one), d, batch.casts.data() + k);
+  }
+}
+
+// NOLINTNEXTLINE(google-readability-namespace-comments)
+}  // namespace HWY_NAMESPACE
+}  // namespace facetfit
+HWY_AFTER_NAMESPACE();
+
+#if HWY_ONCE
+namespace facetfit {
+
+void light_slots(const HitBatch& hits, bool environment, const std::vector<LaneLight>& lights, ShadowBatch& out, SlotRanges& ranges,
+                 SampleBatch& samples, bool baseline) {
+#if HWY_TARGETS & HWY_AVX2
+  if (!baseline && cpu_has_avx2()) return N_AVX2::LightSlots(hits, environment, lights, out, ranges, samples);
+#endif
+  HWY_STATIC_DISPATCH(LightSlots)(hits, environment, lights, out, ranges, samples);
+}
+
+void brdf_slots(const HitBatch& hits, const SampleBatch& samples, const Rgb& radiance, ShadowBatch& out, bool baseline) {
+#if HWY_TARGETS & HWY_AVX2
+  if (!baseline && cpu_has_avx2()) return N_AVX2::BrdfSlots(hits, samples, radiance, out);
+#endif
+  HWY_STATIC_DISPATCH(BrdfSlots)(hits, samples, radiance, out);
+}
+
+void shadow_values(ShadowBatch& batch, const SlotRanges& ranges, bool baseline) {
+#if HWY_TARGETS & HWY_AVX2
+  if (!baseline && cpu_has_avx2()) return N_AVX2::ShadowValues(batch, ranges);
+#endif
+  HWY_STATIC_DISPATCH(ShadowValues)(batch, ranges);
+}
+
+}  // namespace facetfit
+#endif

@@ -1,0 +1,90 @@
+// Direct lighting of many hits on one material at once, in SIMD lanes (Google Highway, as
+// render/ggx_batch.h): the shadow rays a hit casts and their values, made slot by slot over a tile's hits
+// instead of one hit at a time. One hit at a time, making the requests, the BRDF samples' directions and the
+// shadow rays' values took half of a GGX sphere's render (docs/render-speed.md).
+//
+// Per hit the slots are, in this order: the environment's light sample, the BRDF sample (both with an
+// environment), then each light. A slot that lights nothing (below the horizon, no direction found) casts
+// no ray. The renderer adds a hit's unblocked rays in slot order, as its one-ray-at-a-time path does.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "render/shading_batch.h"
+
+namespace facetfit {
+
+// A tile's hits on one material for one sample index, in columns: the shading frame, the direction toward
+// the camera in it, the hit and the shadow rays' origin, the environment's light sample (its world
+// direction, density and radiance) and the BRDF sample's numbers.
+struct HitBatch : Columns {
+  std::vector<double> tx, ty, tz, bx, by, bz, nx, ny, nz;
+  std::vector<double> ox, oy, oz;
+  std::vector<double> px, py, pz;
+  std::vector<double> origin_x, origin_y, origin_z;
+  std::vector<double> lx, ly, lz, light_pdf, light_r, light_g, light_b;
+  std::vector<double> u1, u2, u3;
+  std::vector<double> owner;  // the hit's index in the tile (exact in a double)
+  std::size_t push() {
+    return next([this](std::size_t n) {
+      resize({&tx, &ty, &bx, &by, &nx, &ny, &ox, &oy, &px, &py, &pz, &origin_x, &origin_y, &origin_z, &lx, &ly, &light_r, &light_g,
+              &light_b, &owner},
+             n, 0.0);
+      resize({&tz, &bz, &nz, &oz, &lz, &light_pdf}, n, 1.0);
+      resize({&u1, &u2, &u3}, n, 0.5);
+    });
+  }
+};
+
+// A light as the lanes read it: directional (vector toward it) or a point (its position), and what it
+// sends (irradiance, or intensity at unit distance).
+struct LaneLight {
+  bool directional;
+  double x, y, z;
+  double r, g, b;
+};
+
+// The evaluations the slots need (the EvaluationBatch a material's eval() fills) and, per evaluation, its
+// shadow ray and what arrives along it: the world direction, the ray's length, the radiance if nothing
+// blocks it, the environment's density of the direction (0 for a light) and the hit it belongs to.
+// Afterwards value (r, g, b) and whether the slot casts a ray at all.
+struct ShadowBatch : EvaluationBatch {
+  std::vector<double> dx, dy, dz, tfar, arriving_r, arriving_g, arriving_b, light_pdf, owner;
+  std::vector<double> value_r, value_g, value_b, casts;
+  // Room for n entries written in place by the lanes; size() stays.
+  void reserve(std::size_t n) {
+    ensure(n, [this](std::size_t m) {
+      grow(m);
+      resize({&dx, &dy, &dz, &tfar, &arriving_r, &arriving_g, &arriving_b, &light_pdf, &owner, &value_r, &value_g, &value_b, &casts}, m,
+             0.0);
+    });
+  }
+  void set_size(std::size_t n) { Columns::set_size(n); }
+};
+
+// The ranges of a ShadowBatch's entries by slot: the environment's light samples [0, lights_begin), the
+// lights' [lights_begin, brdf_begin) light by light (light j's from light_begin[j]), the BRDF samples'
+// [brdf_begin, size()).
+struct SlotRanges {
+  std::size_t lights_begin = 0, brdf_begin = 0;
+  std::vector<std::size_t> light_begin;
+};
+
+// Appends to `out` (emptied first) the evaluations of the environment's light samples (`environment`) and of
+// the lights, for the hits' padded_size() entries, and the ranges; then fills `samples` (emptied first) with
+// the BRDF samples to draw (`environment`), one per hit.
+void light_slots(const HitBatch& hits, bool environment, const std::vector<LaneLight>& lights, ShadowBatch& out, SlotRanges& ranges,
+                 SampleBatch& samples, bool baseline = false);
+
+// Appends the BRDF samples found (`samples`, drawn for `hits`) as evaluations with their world directions,
+// arriving `radiance` at density 1 / 4 pi: a constant environment's (the caller replaces both under a map).
+void brdf_slots(const HitBatch& hits, const SampleBatch& samples, const Rgb& radiance, ShadowBatch& out, bool baseline = false);
+
+// The value of each entry's shadow ray from its evaluation (ShadowBatch::r, g, b, pdf), as the one-hit
+// path computes it: multiple importance sampling by the power heuristic for the environment's light and
+// BRDF samples, a light's value times the cosine; casts 0 for a BRDF sample of zero density.
+void shadow_values(ShadowBatch& batch, const SlotRanges& ranges, bool baseline = false);
+
+}  // namespace facetfit
