@@ -4,6 +4,7 @@
 #include <cmath>
 #include <functional>
 #include <iostream>
+#include <limits>
 #include <random>
 
 #include "fit/fit.h"
@@ -22,8 +23,10 @@
 #include "render/ggx_batch.h"
 #include "render/merl_batch.h"
 #include "render/shading.h"
+#include "render/sphere_batch.h"
 #include "render/tabulated_batch.h"
 #include "render/texture.h"
+#include "render/tracer.h"
 #include "support/tensor_file.h"
 #include "test_util.h"
 
@@ -161,6 +164,68 @@ TEST(Tracer, SphereRootsStayAccurateFarAwayAndAtGrazingAngles) {
   // behind it are still found.
   EXPECT_TRUE(std::isinf(intersect_sphere(c, 1.0, Ray{Vec3(0, 0, 5), Vec3(0, 0.6, 0.8)})));
   EXPECT_NEAR(intersect_sphere(c, 1.0, Ray{Vec3(0, 0, 5), Vec3(0, 0, 1), -10.0}), -6.0, 1e-12);
+}
+
+// The lanes answer each ray as intersect_sphere does: the same sphere, the same blocking and t to rounding
+// (GCC fuses the AVX2 code's multiply-adds), for rays from outside, inside, on the surface leaving it
+// (shadow rays, tnear > 0), grazing, bounded by tfar; both SIMD targets, and batch sizes that leave
+// partial vectors.
+TEST(Tracer, SpheresInLanesEqualTheClosedForm) {
+  SphereSet spheres;
+  const std::vector<std::pair<Vec3, double>> list = {{Vec3(0, 0, 0), 1.0}, {Vec3(1.5, 0.2, -0.3), 0.5}, {Vec3(-2, 1, 1), 0.25}};
+  for (const auto& [c, r] : list) spheres.cx.push_back(c.x), spheres.cy.push_back(c.y), spheres.cz.push_back(c.z), spheres.radius.push_back(r);
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const auto direction = [&] {
+    Vec3 v;
+    do v = Vec3(u(rng), u(rng), u(rng));
+    while (glm::length(v) < 0.1 || glm::length(v) > 1.0);
+    return glm::normalize(v);
+  };
+  for (const std::size_t n : {1, 3, 4, 5, 17, 400}) {
+    RayBatch rays;
+    std::vector<Ray> scalar;
+    for (std::size_t k = 0; k < n; ++k) {
+      Ray r;
+      switch (k % 4) {
+        case 0: r = Ray(3.0 * direction(), direction()); break;                        // from outside, anywhere
+        case 1: r = Ray(0.5 * direction(), direction(), 0.0, 0.5 + 2.0 * std::abs(u(rng))); break;  // inside, bounded
+        case 2: {                                                                        // leaving the unit sphere
+          const Vec3 n0 = direction();
+          Vec3 d = direction();
+          if (glm::dot(d, n0) < 0.0) d = -d;
+          r = Ray(n0 * (1.0 + 2e-4), d, 2e-4);
+          break;
+        }
+        default: r = Ray(Vec3(-5, 1.0 - 1e-7 * std::abs(u(rng)), 0), Vec3(1, 0, 0)); break;  // grazing
+      }
+      scalar.push_back(r);
+      rays.push(r.origin, r.dir, r.tnear, r.tfar);
+    }
+    for (const bool baseline : {false, true}) {
+      std::vector<double> t;
+      std::vector<int> which;
+      std::vector<char> blocked(n, 0);
+      nearest_spheres(spheres, rays, t, which, baseline);
+      blocked_by_spheres(spheres, rays, blocked, baseline);
+      for (std::size_t k = 0; k < n; ++k) {
+        double best = std::numeric_limits<double>::infinity();
+        int nearest = -1;
+        bool any = false;
+        Ray bounded = scalar[k];
+        for (std::size_t s = 0; s < list.size(); ++s) {
+          const double ts = intersect_sphere(list[s].first, list[s].second, bounded);
+          if (ts < bounded.tfar) bounded.tfar = best = ts, nearest = int(s);
+          any = any || std::isfinite(intersect_sphere(list[s].first, list[s].second, scalar[k]));
+        }
+        EXPECT_EQ(which[k], nearest) << n << " " << k << " " << baseline;
+        if (nearest >= 0) {
+          EXPECT_NEAR(t[k], best, 1e-14 * best) << n << " " << k << " " << baseline;
+        }
+        EXPECT_EQ(bool(blocked[k]), any) << n << " " << k << " " << baseline;
+      }
+    }
+  }
 }
 
 TEST(Tracer, SpheresAndTrianglesTogether) {

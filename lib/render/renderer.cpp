@@ -306,13 +306,13 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
     SampleBatch samples;
     ShadowBatch shadows;
     SlotRanges ranges;
-    std::vector<std::uint32_t> ray;  // per entry of shadows that casts one: its index in the tile's rays
+    std::vector<char> blocked;  // per entry of shadows
   };
   // A thread's space for the tiles it renders, kept from tile to tile: allocated per tile, its columns'
   // pages were mapped and unmapped again and again, and unmapping stops the other threads (TLB shootdowns:
   // perf put 16% of a two-thread GGX render in the kernel).
   struct TileSpace {
-    std::vector<Ray> cameras;
+    RayBatch cameras;
     std::vector<Hit> hits;
     std::vector<Planned> planned;
     std::vector<Ray> rays;
@@ -331,7 +331,7 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
     const int tw = int(tile.cols().size()), count = tw * int(tile.rows().size());
     const std::size_t n = std::size_t(count);
     TileSpace& space = tile_spaces.local();
-    std::vector<Ray>& cameras = space.cameras;
+    RayBatch& cameras = space.cameras;
     std::vector<Hit>& hits = space.hits;
     std::vector<Planned>& planned = space.planned;
     std::vector<Ray>& rays = space.rays;
@@ -339,7 +339,12 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
     std::vector<char>& blocked = space.blocked;
     Textured& textured = space.textured;
     std::vector<Wave>& waves = space.waves;
-    cameras.resize(n), planned.resize(n), waves.resize(materials.size());
+    planned.resize(n), waves.resize(materials.size());
+    cameras.reserve(n), cameras.set_size(n);
+    const std::size_t padded = cameras.padded_size();
+    std::fill_n(cameras.ox.begin(), padded, cam.position.x), std::fill_n(cameras.oy.begin(), padded, cam.position.y);
+    std::fill_n(cameras.oz.begin(), padded, cam.position.z), std::fill_n(cameras.tnear.begin(), padded, 0.0);
+    std::fill_n(cameras.tfar.begin(), padded, infinity);
     // A constant environment's light samples, drawn in SIMD lanes for the whole tile.
     const bool sphere_lanes = env && env->is_constant();
     SphereSampleBatch& light_samples = space.light_samples;
@@ -354,7 +359,8 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
     for (int k = 0; k < count; ++k) samples.push(tile.cols().begin() + k % tw, tile.rows().begin() + k / tw);
     for (int s = first; s < last; ++s) {
       camera_sample_batch(camera, seed, s, samples);
-      for (std::size_t k = 0; k < n; ++k) camera_ray(samples.d(k), cameras[k]);
+      std::copy_n(samples.dx.begin(), padded, cameras.dx.begin()), std::copy_n(samples.dy.begin(), padded, cameras.dy.begin());
+      std::copy_n(samples.dz.begin(), padded, cameras.dz.begin());
       tracer.intersect(cameras, hits, true);
       if (sphere_lanes) {
         light_samples.clear();
@@ -365,7 +371,7 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
       rays.clear(), values.clear();
       for (std::size_t k = 0; k < n; ++k) {
         Planned& pk = planned[k];
-        place(hits[k], cameras[k].dir, pk);
+        place(hits[k], samples.d(k), pk);
         if (!hits[k].found()) continue;
         const std::size_t material = std::size_t(object_material[std::size_t(hits[k].object)]);
         if (!in_lanes[material]) {
@@ -393,28 +399,21 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
       for (std::size_t m = 0; m < materials.size(); ++m) {
         Wave& w = waves[m];
         if (w.hits.size() == 0) continue;
-        light_slots(w.hits, bool(env), lane_lights, w.shadows, w.ranges, w.samples);
+        light_slots(w.hits, bool(env), lane_lights, eps, w.shadows, w.ranges, w.samples);
         if (env) {
           materials[m]->sample_directions(w.samples, true);
           const std::size_t brdf_begin = w.shadows.size();
-          brdf_slots(w.hits, w.samples, sphere_lanes ? env->lookup(Vec3(0.0, 0.0, 1.0)).radiance : Rgb(0.0), w.shadows);
+          brdf_slots(w.hits, w.samples, sphere_lanes ? env->lookup(Vec3(0.0, 0.0, 1.0)).radiance : Rgb(0.0), eps, w.shadows);
           if (!sphere_lanes)
             for (std::size_t e = brdf_begin; e < w.shadows.size(); ++e) {
-              const Environment::Sample ls = env->lookup({w.shadows.dx[e], w.shadows.dy[e], w.shadows.dz[e]});
+              const Environment::Sample ls = env->lookup({w.shadows.rays.dx[e], w.shadows.rays.dy[e], w.shadows.rays.dz[e]});
               w.shadows.arriving_r[e] = ls.radiance.r, w.shadows.arriving_g[e] = ls.radiance.g, w.shadows.arriving_b[e] = ls.radiance.b;
               w.shadows.light_pdf[e] = ls.pdf;
             }
         }
         materials[m]->eval(w.shadows, true);
         shadow_values(w.shadows, w.ranges);
-        const ShadowBatch& b = w.shadows;
-        w.ray.resize(b.size());
-        for (std::size_t e = 0; e < b.size(); ++e) {
-          if (b.casts[e] == 0.0) continue;
-          w.ray[e] = std::uint32_t(rays.size());
-          const std::size_t owner = std::size_t(b.owner[e]);
-          rays.emplace_back(planned[owner].origin, Vec3(b.dx[e], b.dy[e], b.dz[e]), eps, b.tfar[e]);
-        }
+        tracer.occluded(w.shadows.rays, w.blocked);
       }
       tracer.occluded(rays, blocked);
       // The lanes' rays, added to their hits slot by slot: environment light, BRDF sample, lights, which is
@@ -424,7 +423,8 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
         const ShadowBatch& b = w.shadows;
         const auto add = [&](std::size_t begin, std::size_t end) {
           for (std::size_t e = begin; e < end; ++e)
-            if (b.casts[e] != 0.0 && !blocked[w.ray[e]]) planned[std::size_t(b.owner[e])].radiance += Rgb(b.value_r[e], b.value_g[e], b.value_b[e]);
+            if (b.casts[e] != 0.0 && !w.blocked[e])
+              planned[std::size_t(w.hits.owner[std::size_t(b.row[e])])].radiance += Rgb(b.value_r[e], b.value_g[e], b.value_b[e]);
         };
         add(0, w.ranges.lights_begin);
         add(w.ranges.brdf_begin, b.size());

@@ -64,6 +64,8 @@ Tracer::Tracer(const SceneDesc& desc) {
     const ObjectDesc& o = desc.objects[k];
     if (o.kind == ObjectDesc::Kind::sphere) {
       spheres_.push_back({o.center, o.radius, int(k)});
+      sphere_set_.cx.push_back(o.center.x), sphere_set_.cy.push_back(o.center.y), sphere_set_.cz.push_back(o.center.z);
+      sphere_set_.radius.push_back(o.radius);
       continue;
     }
     if (!triangles_) {
@@ -158,28 +160,56 @@ bool Tracer::occluded(const Ray& ray) const {
   return r.tfar < 0.0f;  // Embree sets tfar to -inf where something blocks the ray
 }
 
+namespace {
+
+RayBatch ray_batch(const std::vector<Ray>& rays) {
+  RayBatch batch;
+  for (const Ray& r : rays) batch.push(r.origin, r.dir, r.tnear, r.tfar);
+  return batch;
+}
+
+Ray ray_at(const RayBatch& rays, std::size_t k) {
+  return Ray(Vec3(rays.ox[k], rays.oy[k], rays.oz[k]), Vec3(rays.dx[k], rays.dy[k], rays.dz[k]), rays.tnear[k], rays.tfar[k]);
+}
+
+}  // namespace
+
 void Tracer::intersect(const std::vector<Ray>& rays, std::vector<Hit>& hits, bool coherent) const {
-  hits.resize(rays.size());
-  for (std::size_t k = 0; k < rays.size(); ++k) hits[k] = nearest_sphere(rays[k]);
-  if (!triangles_ || rays.empty()) return;
-  std::vector<RTCRayHit> rh(rays.size());
-  for (std::size_t k = 0; k < rays.size(); ++k) rh[k] = embree_ray_hit(rays[k], hits[k]);
+  intersect(ray_batch(rays), hits, coherent);
+}
+
+void Tracer::occluded(const std::vector<Ray>& rays, std::vector<char>& blocked) const { occluded(ray_batch(rays), blocked); }
+
+void Tracer::intersect(const RayBatch& rays, std::vector<Hit>& hits, bool coherent) const {
+  const std::size_t n = rays.size();
+  hits.assign(n, Hit{});
+  if (!spheres_.empty()) {
+    std::vector<double> t;
+    std::vector<int> sphere;
+    nearest_spheres(sphere_set_, rays, t, sphere);
+    for (std::size_t k = 0; k < n; ++k)
+      if (sphere[k] >= 0) hits[k].t = t[k], hits[k].object = spheres_[std::size_t(sphere[k])].object;
+  }
+  if (!triangles_ || n == 0) return;
+  std::vector<RTCRayHit> rh(n);
+  for (std::size_t k = 0; k < n; ++k) rh[k] = embree_ray_hit(ray_at(rays, k), hits[k]);
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);
   if (coherent) ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
   rtcIntersect1M(triangles_->scene, &ctx, rh.data(), unsigned(rh.size()), sizeof(RTCRayHit));
-  for (std::size_t k = 0; k < rays.size(); ++k) take_triangle_hit(rh[k], triangles_->object, hits[k]);
+  for (std::size_t k = 0; k < n; ++k) take_triangle_hit(rh[k], triangles_->object, hits[k]);
 }
 
-void Tracer::occluded(const std::vector<Ray>& rays, std::vector<char>& blocked) const {
-  blocked.resize(rays.size());
-  for (std::size_t k = 0; k < rays.size(); ++k) blocked[k] = blocked_by_sphere(rays[k]);
-  if (!triangles_ || rays.empty()) return;
+void Tracer::occluded(const RayBatch& rays, std::vector<char>& blocked) const {
+  const std::size_t n = rays.size();
+  blocked.assign(n, 0);
+  if (!spheres_.empty()) blocked_by_spheres(sphere_set_, rays, blocked);
+  if (!triangles_ || n == 0) return;
   // Only the rays no sphere blocks go to Embree.
   std::vector<RTCRay> open;
   std::vector<std::size_t> which;
-  for (std::size_t k = 0; k < rays.size(); ++k)
-    if (!blocked[k]) open.push_back(embree_ray(rays[k])), which.push_back(k);
+  for (std::size_t k = 0; k < n; ++k)
+    if (!blocked[k]) open.push_back(embree_ray(ray_at(rays, k))), which.push_back(k);
   if (open.empty()) return;
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);

@@ -13,6 +13,7 @@
 
 #include "core/vec.h"
 #include "render/scene.h"
+#include "render/sphere_batch.h"
 
 namespace facetfit {
 
@@ -54,6 +55,10 @@ class Tracer {
   // together, as camera rays do). Each result equals the one-ray query's up to Embree's float rounding.
   void intersect(const std::vector<Ray>& rays, std::vector<Hit>& hits, bool coherent) const;
   void occluded(const std::vector<Ray>& rays, std::vector<char>& blocked) const;
+  // The same for rays in columns, the spheres in SIMD lanes (render/sphere_batch.h): what the renderer's
+  // stream path asks.
+  void intersect(const RayBatch& rays, std::vector<Hit>& hits, bool coherent) const;
+  void occluded(const RayBatch& rays, std::vector<char>& blocked) const;
 
  private:
   struct Sphere {
@@ -65,6 +70,7 @@ class Tracer {
   Hit nearest_sphere(const Ray& ray) const;
   bool blocked_by_sphere(const Ray& ray) const;
   std::vector<Sphere> spheres_;
+  SphereSet sphere_set_;  // the same spheres in columns, for the lanes
   std::unique_ptr<Embree> triangles_;  // null: no triangles in the scene
 };
 

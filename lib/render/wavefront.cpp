@@ -47,10 +47,11 @@ FrameV frame_at(D d, const HitBatch& h, std::size_t k) {
 }
 
 // Appends the lanes of `m` as entries of `out` from position `at`: one evaluation (o, i, with_pdf) and
-// its shadow ray (direction, length, arriving radiance, environment density, owner). Returns the count.
+// its shadow ray (origin, direction, tnear, length), the arriving radiance, the environment density and the
+// hit's row. Returns the count.
 struct Entry {
   Vec3V o, i, d;
-  V with_pdf, tfar, arriving_r, arriving_g, arriving_b, light_pdf, owner;
+  V with_pdf, tfar, arriving_r, arriving_g, arriving_b, light_pdf, row;
 };
 // The lanes of mask bits m moved to the front, in order: Highway's CompressStore copies a 256-byte table
 // onto the stack at every call (hwy 1.0.3; perf: half of a render). A vector holds at most 4 doubles
@@ -70,7 +71,7 @@ constexpr CompressTable kCompress = [] {
 
 // (Functions, not lambdas: GCC compiles a lambda without the target's attributes, so it cannot inline the
 // SIMD code and passes every vector through memory.)
-HWY_INLINE std::size_t append(D d, M m, const Entry& e, ShadowBatch& out, std::size_t at) {
+HWY_INLINE std::size_t append(D d, M m, const Entry& e, const Vec3V& origin, V tnear, ShadowBatch& out, std::size_t at) {
   static_assert(hn::MaxLanes(D()) <= 4, "kCompress holds 4 lanes");
   std::uint8_t bits[8] = {};
   hn::StoreMaskBits(d, m, bits);
@@ -78,9 +79,10 @@ HWY_INLINE std::size_t append(D d, M m, const Entry& e, ShadowBatch& out, std::s
   const auto put = [&](V v, std::vector<double>& column) HWY_ATTR { hn::StoreU(hn::TableLookupLanes(v, to_front), d, column.data() + at); };
   put(e.o.x, out.ox), put(e.o.y, out.oy), put(e.o.z, out.oz);
   put(e.i.x, out.ix), put(e.i.y, out.iy), put(e.i.z, out.iz), put(e.with_pdf, out.with_pdf);
-  put(e.d.x, out.dx), put(e.d.y, out.dy), put(e.d.z, out.dz), put(e.tfar, out.tfar);
+  put(origin.x, out.rays.ox), put(origin.y, out.rays.oy), put(origin.z, out.rays.oz);
+  put(e.d.x, out.rays.dx), put(e.d.y, out.rays.dy), put(e.d.z, out.rays.dz), put(tnear, out.rays.tnear), put(e.tfar, out.rays.tfar);
   put(e.arriving_r, out.arriving_r), put(e.arriving_g, out.arriving_g), put(e.arriving_b, out.arriving_b);
-  put(e.light_pdf, out.light_pdf), put(e.owner, out.owner);
+  put(e.light_pdf, out.light_pdf), put(e.row, out.row);
   return hn::CountTrue(d, m);
 }
 
@@ -92,8 +94,12 @@ HWY_INLINE V power_heuristic(V a, V b) { return (a * a) / (a * a + b * b); }
 
 }  // namespace
 
-void LightSlots(const HitBatch& hits, bool environment, const std::vector<LaneLight>& lights, ShadowBatch& out, SlotRanges& ranges,
-                SampleBatch& samples) {
+HWY_INLINE Vec3V origin_at(D d, const HitBatch& h, std::size_t k) {
+  return {load(d, h.origin_x, k), load(d, h.origin_y, k), load(d, h.origin_z, k)};
+}
+
+void LightSlots(const HitBatch& hits, bool environment, const std::vector<LaneLight>& lights, double tnear, ShadowBatch& out,
+                SlotRanges& ranges, SampleBatch& samples) {
   const D d;
   const std::size_t n = hits.padded_size(), lanes = hn::Lanes(d);
   const V zero = hn::Zero(d), one = hn::Set(d, 1.0), infinity = hn::Set(d, std::numeric_limits<double>::infinity());
@@ -111,8 +117,8 @@ void LightSlots(const HitBatch& hits, bool environment, const std::vector<LaneLi
       const M lit = hn::And(real(d, k, hits.size()), hn::And(o.z > zero, hn::And(il.z > zero, pdf > zero)));
       size += append(d, lit,
                      {o, il, l, one, infinity, load(d, hits.light_r, k), load(d, hits.light_g, k), load(d, hits.light_b, k), pdf,
-                      load(d, hits.owner, k)},
-                     out, size);
+                      hn::Iota(d, double(k))},
+                     origin_at(d, hits, k), hn::Set(d, tnear), out, size);
     }
   ranges.lights_begin = size;
   ranges.light_begin.clear();
@@ -123,7 +129,7 @@ void LightSlots(const HitBatch& hits, bool environment, const std::vector<LaneLi
     for (std::size_t k = 0; k < n; k += lanes) {
       const FrameV frame = frame_at(d, hits, k);
       const Vec3V o{load(d, hits.ox, k), load(d, hits.oy, k), load(d, hits.oz, k)};
-      Entry e{o, {}, {vx, vy, vz}, zero, infinity, r, g, b, zero, load(d, hits.owner, k)};
+      Entry e{o, {}, {vx, vy, vz}, zero, infinity, r, g, b, zero, hn::Iota(d, double(k))};
       if (!light.directional) {
         // Toward the point from the hit, its irradiance falling as the squared distance, the ray stopping
         // just short of it.
@@ -134,7 +140,8 @@ void LightSlots(const HitBatch& hits, bool environment, const std::vector<LaneLi
         e.tfar = dist * hn::Set(d, 1.0 - 1e-6);
       }
       e.i = frame.to_local(e.d);
-      size += append(d, hn::And(real(d, k, hits.size()), hn::And(e.i.z > zero, o.z > zero)), e, out, size);
+      size += append(d, hn::And(real(d, k, hits.size()), hn::And(e.i.z > zero, o.z > zero)), e, origin_at(d, hits, k), hn::Set(d, tnear), out,
+                     size);
     }
   }
   ranges.brdf_begin = size;
@@ -151,7 +158,7 @@ void LightSlots(const HitBatch& hits, bool environment, const std::vector<LaneLi
   }
 }
 
-void BrdfSlots(const HitBatch& hits, const SampleBatch& samples, const Rgb& radiance, ShadowBatch& out) {
+void BrdfSlots(const HitBatch& hits, const SampleBatch& samples, const Rgb& radiance, double tnear, ShadowBatch& out) {
   const D d;
   const std::size_t n = hits.padded_size(), lanes = hn::Lanes(d);
   const V zero = hn::Zero(d), one = hn::Set(d, 1.0), infinity = hn::Set(d, std::numeric_limits<double>::infinity());
@@ -163,7 +170,8 @@ void BrdfSlots(const HitBatch& hits, const SampleBatch& samples, const Rgb& radi
     const Vec3V o{load(d, samples.ox, k), load(d, samples.oy, k), load(d, samples.oz, k)};
     const Vec3V i{load(d, samples.ix, k), load(d, samples.iy, k), load(d, samples.iz, k)};
     const M found = hn::And(real(d, k, hits.size()), load(d, samples.found, k) != zero);
-    size += append(d, found, {o, i, frame.to_world(i), one, infinity, r, g, b, pdf, load(d, hits.owner, k)}, out, size);
+    size += append(d, found, {o, i, frame.to_world(i), one, infinity, r, g, b, pdf, hn::Iota(d, double(k))}, origin_at(d, hits, k),
+                   hn::Set(d, tnear), out, size);
   }
   out.set_size(size);
 }
@@ -205,19 +213,19 @@ HWY_AFTER_NAMESPACE();
 #if HWY_ONCE
 namespace facetfit {
 
-void light_slots(const HitBatch& hits, bool environment, const std::vector<LaneLight>& lights, ShadowBatch& out, SlotRanges& ranges,
-                 SampleBatch& samples, bool baseline) {
+void light_slots(const HitBatch& hits, bool environment, const std::vector<LaneLight>& lights, double tnear, ShadowBatch& out,
+                 SlotRanges& ranges, SampleBatch& samples, bool baseline) {
 #if HWY_TARGETS & HWY_AVX2
-  if (!baseline && cpu_has_avx2()) return N_AVX2::LightSlots(hits, environment, lights, out, ranges, samples);
+  if (!baseline && cpu_has_avx2()) return N_AVX2::LightSlots(hits, environment, lights, tnear, out, ranges, samples);
 #endif
-  HWY_STATIC_DISPATCH(LightSlots)(hits, environment, lights, out, ranges, samples);
+  HWY_STATIC_DISPATCH(LightSlots)(hits, environment, lights, tnear, out, ranges, samples);
 }
 
-void brdf_slots(const HitBatch& hits, const SampleBatch& samples, const Rgb& radiance, ShadowBatch& out, bool baseline) {
+void brdf_slots(const HitBatch& hits, const SampleBatch& samples, const Rgb& radiance, double tnear, ShadowBatch& out, bool baseline) {
 #if HWY_TARGETS & HWY_AVX2
-  if (!baseline && cpu_has_avx2()) return N_AVX2::BrdfSlots(hits, samples, radiance, out);
+  if (!baseline && cpu_has_avx2()) return N_AVX2::BrdfSlots(hits, samples, radiance, tnear, out);
 #endif
-  HWY_STATIC_DISPATCH(BrdfSlots)(hits, samples, radiance, out);
+  HWY_STATIC_DISPATCH(BrdfSlots)(hits, samples, radiance, tnear, out);
 }
 
 void shadow_values(ShadowBatch& batch, const SlotRanges& ranges, bool baseline) {

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "render/shading_batch.h"
+#include "render/sphere_batch.h"
 
 namespace facetfit {
 
@@ -47,21 +48,23 @@ struct LaneLight {
 };
 
 // The evaluations the slots need (the EvaluationBatch a material's eval() fills) and, per evaluation, its
-// shadow ray and what arrives along it: the world direction, the ray's length, the radiance if nothing
-// blocks it, the environment's density of the direction (0 for a light) and the hit it belongs to.
-// Afterwards value (r, g, b) and whether the slot casts a ray at all.
+// shadow ray (from the hit's shadow-ray origin along the world direction, up to the light), the radiance
+// arriving along it if nothing blocks it, the environment's density of the direction (0 for a light) and
+// the hit it belongs to (its row in the HitBatch). Afterwards value (r, g, b) and whether the slot casts
+// a ray at all.
 struct ShadowBatch : EvaluationBatch {
-  std::vector<double> dx, dy, dz, tfar, arriving_r, arriving_g, arriving_b, light_pdf, owner;
+  RayBatch rays;
+  std::vector<double> arriving_r, arriving_g, arriving_b, light_pdf, row;
   std::vector<double> value_r, value_g, value_b, casts;
   // Room for n entries written in place by the lanes; size() stays.
   void reserve(std::size_t n) {
+    rays.reserve(n);
     ensure(n, [this](std::size_t m) {
       grow(m);
-      resize({&dx, &dy, &dz, &tfar, &arriving_r, &arriving_g, &arriving_b, &light_pdf, &owner, &value_r, &value_g, &value_b, &casts}, m,
-             0.0);
+      resize({&arriving_r, &arriving_g, &arriving_b, &light_pdf, &row, &value_r, &value_g, &value_b, &casts}, m, 0.0);
     });
   }
-  void set_size(std::size_t n) { Columns::set_size(n); }
+  void set_size(std::size_t n) { Columns::set_size(n), rays.set_size(n); }
 };
 
 // The ranges of a ShadowBatch's entries by slot: the environment's light samples [0, lights_begin), the
@@ -75,12 +78,14 @@ struct SlotRanges {
 // Appends to `out` (emptied first) the evaluations of the environment's light samples (`environment`) and of
 // the lights, for the hits' padded_size() entries, and the ranges; then fills `samples` (emptied first) with
 // the BRDF samples to draw (`environment`), one per hit.
-void light_slots(const HitBatch& hits, bool environment, const std::vector<LaneLight>& lights, ShadowBatch& out, SlotRanges& ranges,
-                 SampleBatch& samples, bool baseline = false);
+// The shadow rays start at the hits' origins and ignore what lies nearer than `tnear`.
+void light_slots(const HitBatch& hits, bool environment, const std::vector<LaneLight>& lights, double tnear, ShadowBatch& out,
+                 SlotRanges& ranges, SampleBatch& samples, bool baseline = false);
 
 // Appends the BRDF samples found (`samples`, drawn for `hits`) as evaluations with their world directions,
 // arriving `radiance` at density 1 / 4 pi: a constant environment's (the caller replaces both under a map).
-void brdf_slots(const HitBatch& hits, const SampleBatch& samples, const Rgb& radiance, ShadowBatch& out, bool baseline = false);
+void brdf_slots(const HitBatch& hits, const SampleBatch& samples, const Rgb& radiance, double tnear, ShadowBatch& out,
+                bool baseline = false);
 
 // The value of each entry's shadow ray from its evaluation (ShadowBatch::r, g, b, pdf), as the one-hit
 // path computes it: multiple importance sampling by the power heuristic for the environment's light and
