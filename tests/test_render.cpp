@@ -260,7 +260,8 @@ TEST(Tracer, SpheresAndTrianglesTogether) {
 
 // Everything that makes shadow rays: an environment (light and BRDF samples: the sky's map, or a constant
 // one whose light samples the stream path draws in SIMD lanes), both kinds of light, a plane the spheres
-// shadow, and the proposals of every kind (closed-form GGX, tabulated Beckmann, a measured table, a LUT).
+// shadow, and the proposals of every kind (closed-form GGX, tabulated Beckmann, a measured table, a LUT
+// whose frame follows a tangent).
 class RayStreams : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(RayStreams, AndOneRayAtATimeGiveTheSameImage) {
@@ -275,7 +276,7 @@ TEST_P(RayStreams, AndOneRayAtATimeGiveTheSameImage) {
     "materials": {"g": {"type": "ggx", "alpha": 0.2, "f0": [0.9, 0.6, 0.3]},
                   "b": {"type": "beckmann", "alpha": 0.4},
                   "m": {"type": "measured", "file": "builtin:red-plastic"},
-                  "l": {"type": "lut", "file": ")" + dir.file("gold.exr") + R"("},
+                  "l": {"type": "lut", "file": ")" + dir.file("gold.exr") + R"(", "tangent": [0.3, 1, 0.2]},
                   "floor": {"type": "lambert", "albedo": [0.5, 0.5, 0.5]}},
     "objects": [{"type": "sphere", "center": [-1.2, 0.5, 0], "radius": 0.5, "material": "g"},
                 {"type": "sphere", "center": [0, 0.5, 0], "radius": 0.5, "material": "b"},

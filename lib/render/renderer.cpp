@@ -322,6 +322,8 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
     std::vector<Wave> waves;
     SphereSampleBatch light_samples;
     CameraSampleBatch samples;
+    TileHits tile_hits;
+    std::vector<char> present;  // per material: whether the lanes shade some hit of this sample index
   };
   tbb::enumerable_thread_specific<TileSpace> tile_spaces;
   // Every pixel of the tile at once, one sample index after the other: camera rays, shading, then shadow
@@ -339,6 +341,9 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
     std::vector<char>& blocked = space.blocked;
     Textured& textured = space.textured;
     std::vector<Wave>& waves = space.waves;
+    TileHits& tile_hits = space.tile_hits;
+    std::vector<char>& present = space.present;
+    present.resize(materials.size());
     planned.resize(n), waves.resize(materials.size());
     cameras.reserve(n), cameras.set_size(n);
     const std::size_t padded = cameras.padded_size();
@@ -367,34 +372,54 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
         for (std::size_t k = 0; k < n; ++k) light_samples.push(samples.u[2][k], samples.u[3][k]);
         sample_uniform_sphere_batch(light_samples);
       }
-      for (Wave& w : waves) w.hits.clear();
       rays.clear(), values.clear();
+      // Each pixel's hit: shaded here one at a time where its material has no lanes, otherwise given to
+      // the lanes in the tile's columns.
+      tile_hits.resize_to(n);
+      std::fill(present.begin(), present.end(), char(0));
       for (std::size_t k = 0; k < n; ++k) {
         Planned& pk = planned[k];
-        place(hits[k], samples.d(k), pk);
-        if (!hits[k].found()) continue;
-        const std::size_t material = std::size_t(object_material[std::size_t(hits[k].object)]);
-        if (!in_lanes[material]) {
+        const Hit& hit = hits[k];
+        tile_hits.material[k] = -1.0;
+        const std::size_t material = hit.found() ? std::size_t(object_material[std::size_t(hit.object)]) : 0;
+        if (!hit.found() || !in_lanes[material]) {
+          place(hit, samples.d(k), pk);
           const Vec3 light_d = sphere_lanes ? light_samples.d(k) : Vec3(0.0);
           const double u[5] = {samples.u[2][k], samples.u[3][k], samples.u[4][k], samples.u[5][k], samples.u[6][k]};
-          plan(hits[k], u, sphere_lanes ? &light_d : nullptr, textured, pk, rays, values);
+          plan(hit, u, sphere_lanes ? &light_d : nullptr, textured, pk, rays, values);
           continue;
         }
-        HitBatch& h = waves[material].hits;
-        const std::size_t j = h.push();
-        const Frame& f = pk.frame;
-        h.tx[j] = f.t.x, h.ty[j] = f.t.y, h.tz[j] = f.t.z, h.bx[j] = f.b.x, h.by[j] = f.b.y, h.bz[j] = f.b.z;
-        h.nx[j] = f.n.x, h.ny[j] = f.n.y, h.nz[j] = f.n.z;
-        h.ox[j] = pk.o.x, h.oy[j] = pk.o.y, h.oz[j] = pk.o.z;
-        h.px[j] = pk.p.x, h.py[j] = pk.p.y, h.pz[j] = pk.p.z;
-        h.origin_x[j] = pk.origin.x, h.origin_y[j] = pk.origin.y, h.origin_z[j] = pk.origin.z;
-        if (env) {
-          const Environment::Sample ls = sphere_lanes ? env->lookup(light_samples.d(k)) : env->sample(samples.u[2][k], samples.u[3][k]);
-          h.lx[j] = ls.d.x, h.ly[j] = ls.d.y, h.lz[j] = ls.d.z, h.light_pdf[j] = ls.pdf;
-          h.light_r[j] = ls.radiance.r, h.light_g[j] = ls.radiance.g, h.light_b[j] = ls.radiance.b;
-          h.u1[j] = samples.u[4][k], h.u2[j] = samples.u[5][k], h.u3[j] = samples.u[6][k];
+        pk.radiance = Rgb(0.0), pk.alpha = 1.0, pk.ray_first = pk.ray_last = 0;
+        present[material] = 1;
+        tile_hits.material[k] = double(material), tile_hits.t[k] = hit.t;
+        const ObjectDesc& object = desc.objects[std::size_t(hit.object)];
+        const bool sphere = object.kind == ObjectDesc::Kind::sphere;
+        const Vec3 g = sphere ? object.center : hit.ng;
+        tile_hits.sphere[k] = sphere ? 1.0 : 0.0, tile_hits.gx[k] = g.x, tile_hits.gy[k] = g.y, tile_hits.gz[k] = g.z;
+        if (env && !sphere_lanes) {
+          const Environment::Sample ls = env->sample(samples.u[2][k], samples.u[3][k]);
+          tile_hits.lx[k] = ls.d.x, tile_hits.ly[k] = ls.d.y, tile_hits.lz[k] = ls.d.z, tile_hits.light_pdf[k] = ls.pdf;
+          tile_hits.light_r[k] = ls.radiance.r, tile_hits.light_g[k] = ls.radiance.g, tile_hits.light_b[k] = ls.radiance.b;
         }
-        h.owner[j] = double(k);
+      }
+      std::copy_n(samples.dx.begin(), padded, tile_hits.dx.begin()), std::copy_n(samples.dy.begin(), padded, tile_hits.dy.begin());
+      std::copy_n(samples.dz.begin(), padded, tile_hits.dz.begin());
+      std::copy_n(samples.u[4].begin(), padded, tile_hits.u1.begin()), std::copy_n(samples.u[5].begin(), padded, tile_hits.u2.begin());
+      std::copy_n(samples.u[6].begin(), padded, tile_hits.u3.begin());
+      if (sphere_lanes) {
+        // A constant environment's radiance and density; its directions drawn in lanes above.
+        const Environment::Sample constant = env->lookup(Vec3(0.0, 0.0, 1.0));
+        std::copy_n(light_samples.x.begin(), padded, tile_hits.lx.begin()), std::copy_n(light_samples.y.begin(), padded, tile_hits.ly.begin());
+        std::copy_n(light_samples.z.begin(), padded, tile_hits.lz.begin());
+        std::fill_n(tile_hits.light_pdf.begin(), padded, constant.pdf);
+        std::fill_n(tile_hits.light_r.begin(), padded, constant.radiance.r), std::fill_n(tile_hits.light_g.begin(), padded, constant.radiance.g);
+        std::fill_n(tile_hits.light_b.begin(), padded, constant.radiance.b);
+      }
+      for (std::size_t m = 0; m < materials.size(); ++m) {
+        if (present[m])
+          place_hits(tile_hits, cam.position, eps, double(m), tangents[m] ? &*tangents[m] : nullptr, waves[m].hits);
+        else
+          waves[m].hits.clear();
       }
       for (std::size_t m = 0; m < materials.size(); ++m) {
         Wave& w = waves[m];

@@ -69,20 +69,33 @@ constexpr CompressTable kCompress = [] {
   return t;
 }();
 
-// (Functions, not lambdas: GCC compiles a lambda without the target's attributes, so it cannot inline the
-// SIMD code and passes every vector through memory.)
-HWY_INLINE std::size_t append(D d, M m, const Entry& e, const Vec3V& origin, V tnear, ShadowBatch& out, std::size_t at) {
+// Stores vectors with the lanes of a mask moved to the front, from position `at` of a column: a whole
+// vector is written, the columns have room past their entries. (Functions and structs, not lambdas: GCC
+// compiles a lambda without the target's attributes, so it cannot inline the SIMD code and passes every
+// vector through memory.)
+struct ToFront {
+  decltype(hn::SetTableIndices(D(), static_cast<const std::int64_t*>(nullptr))) index;
+  std::size_t at;
+  HWY_INLINE void operator()(D d, V v, std::vector<double>& column) const {
+    hn::StoreU(hn::TableLookupLanes(v, index), d, column.data() + at);
+  }
+};
+HWY_INLINE ToFront to_front(D d, M m, std::size_t at) {
   static_assert(hn::MaxLanes(D()) <= 4, "kCompress holds 4 lanes");
   std::uint8_t bits[8] = {};
   hn::StoreMaskBits(d, m, bits);
-  const auto to_front = hn::SetTableIndices(d, kCompress.index[bits[0] & 15]);
-  const auto put = [&](V v, std::vector<double>& column) HWY_ATTR { hn::StoreU(hn::TableLookupLanes(v, to_front), d, column.data() + at); };
-  put(e.o.x, out.ox), put(e.o.y, out.oy), put(e.o.z, out.oz);
-  put(e.i.x, out.ix), put(e.i.y, out.iy), put(e.i.z, out.iz), put(e.with_pdf, out.with_pdf);
-  put(origin.x, out.rays.ox), put(origin.y, out.rays.oy), put(origin.z, out.rays.oz);
-  put(e.d.x, out.rays.dx), put(e.d.y, out.rays.dy), put(e.d.z, out.rays.dz), put(tnear, out.rays.tnear), put(e.tfar, out.rays.tfar);
-  put(e.arriving_r, out.arriving_r), put(e.arriving_g, out.arriving_g), put(e.arriving_b, out.arriving_b);
-  put(e.light_pdf, out.light_pdf), put(e.row, out.row);
+  return {hn::SetTableIndices(d, kCompress.index[bits[0] & 15]), at};
+}
+
+HWY_INLINE std::size_t append(D d, M m, const Entry& e, const Vec3V& origin, V tnear, ShadowBatch& out, std::size_t at) {
+  const ToFront put = to_front(d, m, at);
+  put(d, e.o.x, out.ox), put(d, e.o.y, out.oy), put(d, e.o.z, out.oz);
+  put(d, e.i.x, out.ix), put(d, e.i.y, out.iy), put(d, e.i.z, out.iz), put(d, e.with_pdf, out.with_pdf);
+  put(d, origin.x, out.rays.ox), put(d, origin.y, out.rays.oy), put(d, origin.z, out.rays.oz);
+  put(d, e.d.x, out.rays.dx), put(d, e.d.y, out.rays.dy), put(d, e.d.z, out.rays.dz), put(d, tnear, out.rays.tnear);
+  put(d, e.tfar, out.rays.tfar);
+  put(d, e.arriving_r, out.arriving_r), put(d, e.arriving_g, out.arriving_g), put(d, e.arriving_b, out.arriving_b);
+  put(d, e.light_pdf, out.light_pdf), put(d, e.row, out.row);
   return hn::CountTrue(d, m);
 }
 
@@ -93,6 +106,67 @@ HWY_INLINE M real(D d, std::size_t k, std::size_t count) { return hn::Iota(d, do
 HWY_INLINE V power_heuristic(V a, V b) { return (a * a) / (a * a + b * b); }
 
 }  // namespace
+
+HWY_INLINE V dot(const Vec3V& a, const Vec3V& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+
+// glm::normalize: v times the reciprocal of its length.
+HWY_INLINE Vec3V normalize(D d, const Vec3V& v) {
+  const V inv = hn::Set(d, 1.0) / hn::Sqrt(dot(v, v));
+  return {v.x * inv, v.y * inv, v.z * inv};
+}
+
+void PlaceHits(const TileHits& tile, const Vec3& camera, double eps, double material, const Vec3* tangent, HitBatch& out) {
+  const D d;
+  const std::size_t n = tile.padded_size(), lanes = hn::Lanes(d);
+  const V zero = hn::Zero(d), one = hn::Set(d, 1.0), this_material = hn::Set(d, material), epsilon = hn::Set(d, eps);
+  out.clear();
+  out.reserve(tile.size() + lanes);
+  std::size_t size = 0;
+  for (std::size_t k = 0; k < n; k += lanes) {
+    const M mine = hn::And(real(d, k, tile.size()), load(d, tile.material, k) == this_material);
+    if (hn::AllFalse(d, mine)) continue;
+    const V t = load(d, tile.t, k);
+    const Vec3V dir{load(d, tile.dx, k), load(d, tile.dy, k), load(d, tile.dz, k)};
+    const Vec3V p{hn::Set(d, camera.x) + t * dir.x, hn::Set(d, camera.y) + t * dir.y, hn::Set(d, camera.z) + t * dir.z};
+    const Vec3V g{load(d, tile.gx, k), load(d, tile.gy, k), load(d, tile.gz, k)};
+    const M sphere = load(d, tile.sphere, k) != zero;
+    Vec3V nrm = normalize(d, {hn::IfThenElse(sphere, p.x - g.x, g.x), hn::IfThenElse(sphere, p.y - g.y, g.y), hn::IfThenElse(sphere, p.z - g.z, g.z)});
+    // Shade the side the camera sees.
+    const M back = dot(nrm, dir) > zero;
+    nrm = {hn::IfThenElse(back, hn::Neg(nrm.x), nrm.x), hn::IfThenElse(back, hn::Neg(nrm.y), nrm.y), hn::IfThenElse(back, hn::Neg(nrm.z), nrm.z)};
+    // Frame(n) of core/frame.h (Duff et al. 2017).
+    const V sign = hn::CopySign(one, nrm.z), a = hn::Neg(one) / (sign + nrm.z), c = nrm.x * nrm.y * a;
+    FrameV frame{{one + sign * nrm.x * nrm.x * a, sign * c, hn::Neg(sign * nrm.x)}, {c, sign + nrm.y * nrm.y * a, hn::Neg(nrm.y)}, nrm};
+    if (tangent) {
+      // Frame(n, along): the tangent's projection on the surface where it does not vanish.
+      const Vec3V along{hn::Set(d, tangent->x), hn::Set(d, tangent->y), hn::Set(d, tangent->z)};
+      const V along_n = dot(along, nrm);
+      const Vec3V projected{along.x - along_n * nrm.x, along.y - along_n * nrm.y, along.z - along_n * nrm.z};
+      const V len = hn::Sqrt(dot(projected, projected));
+      const M turns = len > hn::Set(d, 1e-9);
+      const V safe = hn::IfThenElse(turns, len, one);
+      const Vec3V t_axis{projected.x / safe, projected.y / safe, projected.z / safe};
+      const Vec3V b_axis{nrm.y * t_axis.z - nrm.z * t_axis.y, nrm.z * t_axis.x - nrm.x * t_axis.z, nrm.x * t_axis.y - nrm.y * t_axis.x};
+      frame.t = {hn::IfThenElse(turns, t_axis.x, frame.t.x), hn::IfThenElse(turns, t_axis.y, frame.t.y), hn::IfThenElse(turns, t_axis.z, frame.t.z)};
+      frame.b = {hn::IfThenElse(turns, b_axis.x, frame.b.x), hn::IfThenElse(turns, b_axis.y, frame.b.y), hn::IfThenElse(turns, b_axis.z, frame.b.z)};
+    }
+    const Vec3V o = frame.to_local({hn::Neg(dir.x), hn::Neg(dir.y), hn::Neg(dir.z)});
+    const ToFront put = to_front(d, mine, size);
+    put(d, frame.t.x, out.tx), put(d, frame.t.y, out.ty), put(d, frame.t.z, out.tz);
+    put(d, frame.b.x, out.bx), put(d, frame.b.y, out.by), put(d, frame.b.z, out.bz);
+    put(d, nrm.x, out.nx), put(d, nrm.y, out.ny), put(d, nrm.z, out.nz);
+    put(d, o.x, out.ox), put(d, o.y, out.oy), put(d, o.z, out.oz);
+    put(d, p.x, out.px), put(d, p.y, out.py), put(d, p.z, out.pz);
+    put(d, p.x + epsilon * nrm.x, out.origin_x), put(d, p.y + epsilon * nrm.y, out.origin_y), put(d, p.z + epsilon * nrm.z, out.origin_z);
+    put(d, load(d, tile.lx, k), out.lx), put(d, load(d, tile.ly, k), out.ly), put(d, load(d, tile.lz, k), out.lz);
+    put(d, load(d, tile.light_pdf, k), out.light_pdf);
+    put(d, load(d, tile.light_r, k), out.light_r), put(d, load(d, tile.light_g, k), out.light_g), put(d, load(d, tile.light_b, k), out.light_b);
+    put(d, load(d, tile.u1, k), out.u1), put(d, load(d, tile.u2, k), out.u2), put(d, load(d, tile.u3, k), out.u3);
+    put(d, hn::Iota(d, double(k)), out.owner);
+    size += hn::CountTrue(d, mine);
+  }
+  out.set_size(size);
+}
 
 HWY_INLINE Vec3V origin_at(D d, const HitBatch& h, std::size_t k) {
   return {load(d, h.origin_x, k), load(d, h.origin_y, k), load(d, h.origin_z, k)};
@@ -212,6 +286,13 @@ HWY_AFTER_NAMESPACE();
 
 #if HWY_ONCE
 namespace facetfit {
+
+void place_hits(const TileHits& tile, const Vec3& camera, double eps, double material, const Vec3* tangent, HitBatch& out, bool baseline) {
+#if HWY_TARGETS & HWY_AVX2
+  if (!baseline && cpu_has_avx2()) return N_AVX2::PlaceHits(tile, camera, eps, material, tangent, out);
+#endif
+  HWY_STATIC_DISPATCH(PlaceHits)(tile, camera, eps, material, tangent, out);
+}
 
 void light_slots(const HitBatch& hits, bool environment, const std::vector<LaneLight>& lights, double tnear, ShadowBatch& out,
                  SlotRanges& ranges, SampleBatch& samples, bool baseline) {

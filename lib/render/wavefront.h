@@ -17,9 +17,28 @@
 
 namespace facetfit {
 
-// A tile's hits on one material for one sample index, in columns: the shading frame, the direction toward
-// the camera in it, the hit and the shadow rays' origin, the environment's light sample (its world
-// direction, density and radiance) and the BRDF sample's numbers.
+// A tile's camera rays for one sample index, per pixel, in columns: the hit (t, infinity for none; the
+// material's index, -1 for none; a sphere's centre or a triangle's normal in g), the ray's direction, the
+// environment's light sample (world direction, density, radiance) and the BRDF sample's numbers.
+struct TileHits : Columns {
+  std::vector<double> t, material, sphere, gx, gy, gz;
+  std::vector<double> dx, dy, dz;
+  std::vector<double> lx, ly, lz, light_pdf, light_r, light_g, light_b;
+  std::vector<double> u1, u2, u3;
+  // n pixels, whose columns the caller writes in place.
+  void resize_to(std::size_t n) {
+    ensure(n, [this](std::size_t m) {
+      resize({&t, &material, &sphere, &gx, &gy, &dx, &dy, &lx, &ly, &light_r, &light_g, &light_b}, m, 0.0);
+      resize({&gz, &dz, &lz, &light_pdf}, m, 1.0);
+      resize({&u1, &u2, &u3}, m, 0.5);
+    });
+    set_size(n);
+  }
+};
+
+// The hits on one material, for one sample index, in columns: the shading frame, the direction toward
+// the camera in it, the hit and the shadow rays' origin, the environment's light sample, the BRDF
+// sample's numbers and the pixel's index in the tile (owner).
 struct HitBatch : Columns {
   std::vector<double> tx, ty, tz, bx, by, bz, nx, ny, nz;
   std::vector<double> ox, oy, oz;
@@ -27,17 +46,26 @@ struct HitBatch : Columns {
   std::vector<double> origin_x, origin_y, origin_z;
   std::vector<double> lx, ly, lz, light_pdf, light_r, light_g, light_b;
   std::vector<double> u1, u2, u3;
-  std::vector<double> owner;  // the hit's index in the tile (exact in a double)
-  std::size_t push() {
-    return next([this](std::size_t n) {
+  std::vector<double> owner;  // exact in a double
+  // Room for n hits written in place by the lanes; size() stays.
+  void reserve(std::size_t n) {
+    ensure(n, [this](std::size_t m) {
       resize({&tx, &ty, &bx, &by, &nx, &ny, &ox, &oy, &px, &py, &pz, &origin_x, &origin_y, &origin_z, &lx, &ly, &light_r, &light_g,
               &light_b, &owner},
-             n, 0.0);
-      resize({&tz, &bz, &nz, &oz, &lz, &light_pdf}, n, 1.0);
-      resize({&u1, &u2, &u3}, n, 0.5);
+             m, 0.0);
+      resize({&tz, &bz, &nz, &oz, &lz, &light_pdf}, m, 1.0);
+      resize({&u1, &u2, &u3}, m, 0.5);
     });
   }
+  void set_size(std::size_t n) { Columns::set_size(n); }
 };
+
+// Fills `out` with the tile's hits on material `material` (emptied first), as the renderer's one-hit path
+// places a hit: p = camera + t d; the normal from the sphere's centre or the triangle's, turned toward the
+// camera; the frame of core/frame.h about it (along `tangent` where given); o the direction toward the
+// camera in it; the shadow rays' origin p + eps n.
+void place_hits(const TileHits& tile, const Vec3& camera, double eps, double material, const Vec3* tangent, HitBatch& out,
+                bool baseline = false);
 
 // A light as the lanes read it: directional (vector toward it) or a point (its position), and what it
 // sends (irradiance, or intensity at unit distance).
