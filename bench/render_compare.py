@@ -258,8 +258,8 @@ def main(facetfit, mitsuba_python, dst, rgl=None):
     if llvm:
         scaling.append(("Mitsuba llvm_ad_rgb", mitsuba_run(mitsuba_python, "llvm_ad_rgb", ggx_mi, 64, env, one_cpu)[0], rows[0][6][0]))
     # Mitsuba's GGX sphere with its kernels compiled for narrower vectors than the host's: how much of its
-    # lead is vector width (facetfit's kernels run four doubles, AVX2).
-    widths = []
+    # lead is vector width; and facetfit's GGX and LUT spheres with its AVX2 code where the host has AVX-512.
+    widths, own_widths = [], []
     flags = open("/proc/cpuinfo").read() if os.path.exists("/proc/cpuinfo") else ""
     if llvm and " avx2" in flags:
         avx2 = "haswell:+avx2,+fma,+f16c,+bmi,+bmi2,+popcnt,+lzcnt,+sse4.2:"
@@ -269,6 +269,10 @@ def main(facetfit, mitsuba_python, dst, rgl=None):
                 widths.append((label, mitsuba_run(mitsuba_python, "llvm_ad_rgb", ggx_mi, 64, dict(env, FACETFIT_LLVM_TARGET=target))[0]))
             except (subprocess.CalledProcessError, ValueError):
                 widths.append((label, None))
+    if " avx512f" in flags:
+        no_avx3 = ["env", "FACETFIT_NO_AVX3=1"]
+        own_widths = [("the host's (AVX-512, 8 doubles)", rows[0][2], rows[1][2]),
+                      ("AVX2, 4 doubles", facetfit_run(facetfit, work, ggx_ff, 64, no_avx3)[0], facetfit_run(facetfit, work, cases[1][1], 64, no_avx3)[0])]
     # The GGX sphere's stages on one CPU: camera rays and hits alone, then each light alone, then both.
     stages = [(what, facetfit_run(facetfit, work, ggx_ff, 64, one_cpu, environment=e, light=l)[0]) for what, e, l in (
         ("camera rays and their hits alone (no light, no environment)", False, False),
@@ -319,14 +323,20 @@ def main(facetfit, mitsuba_python, dst, rgl=None):
             out.write("| %s | %.3f s | %.3f s | %.2f |\n" % (name, one, all_, one / all_))
         if widths:
             out.write("\n## Vector width\n\nMitsuba's llvm_ad_rgb variant compiles its kernels for the host's widest vectors: 16\n"
-                      "single-precision lanes with AVX-512, 8 with AVX2. facetfit's SIMD kernels run 4 double-precision lanes\n"
-                      "(AVX2: render/simd_targets.h) and the rest of its pipeline one sample at a time. The GGX sphere at 64 spp\n"
-                      "with Mitsuba's kernels compiled for narrower vectors (Dr.Jit's `jit_llvm_set_target`), against facetfit's\n"
-                      "render in the table at the top (%.3f s):\n\n| Mitsuba llvm_ad_rgb target | render | facetfit render / Mitsuba's |\n"
+                      "single-precision lanes with AVX-512, 8 with AVX2. facetfit runs double precision, 8 lanes with AVX-512\n"
+                      "and 4 with AVX2 (render/simd_targets.h), in its shading models' kernels and in a tile's hits, light and\n"
+                      "BRDF samples, shadow rays and their values (render/wavefront.h, render/sphere_batch.h). The GGX sphere\n"
+                      "at 64 spp with Mitsuba's kernels compiled for narrower vectors (Dr.Jit's `jit_llvm_set_target`), against\n"
+                      "facetfit's render in the table at the top (%.3f s):\n\n| Mitsuba llvm_ad_rgb target | render | facetfit render / Mitsuba's |\n"
                       "|---|---|---|\n" % rows[0][2])
             for label, seconds in widths:
                 out.write("| %s | %s | %s |\n" % (label, "%.3f s" % seconds if seconds else "n/a",
                                                    "%.2f" % (rows[0][2] / seconds) if seconds else "n/a"))
+        if own_widths:
+            out.write("\nfacetfit's spheres at 64 spp with its AVX2 code on the same host (`FACETFIT_NO_AVX3=1`):\n\n"
+                      "| facetfit target | GGX sphere | tabulated LUT sphere |\n|---|---|---|\n")
+            for label, ggx_seconds, lut_seconds in own_widths:
+                out.write("| %s | %.3f s | %.3f s |\n" % (label, ggx_seconds, lut_seconds))
         out.write("\n## Noise at equal samples\n\nA render's time is half of its cost; the other half is its noise. Two renders of each\n"
                   "renderer at 64 spp with different seeds (Mitsuba: %s), over the pixels the sphere covers wholly\n"
                   "(%d): the variance of one render per pixel and channel, E[(a - b)^2] / 2, and the mean of both. Variance\n"
@@ -352,16 +362,17 @@ def main(facetfit, mitsuba_python, dst, rgl=None):
                   "is its render time plus this.\n" % (RUNS, startup[0], startup[1], startup[2]))
         out.write("\n## Where the time goes\n\n`perf record` of one facetfit render (64 spp, whole process), self time by\n"
                   "library and symbol (the sphere is intersected in closed form, render/tracer.h; Embree traces triangles only).\n"
-                  "A tile's samples are shaded in steps (render/renderer.cpp): their numbers and camera rays in SIMD lanes\n"
-                  "(`N_AVX2::DrawCameraSamples`, render/camera_batch.h), a constant environment's light samples in SIMD lanes\n"
-                  "(`N_AVX2::SampleUniformSphereBatch`, render/environment_batch.h), the hits and each hit's frame (`place`)\n"
-                  "in the tile loop; `plan` (light directions, queues); BRDF sampling and evaluation in one call per\n"
-                  "material, in SIMD lanes for GGX (`N_AVX2::SampleGgxBatch`, `N_AVX2::EvalGgxBatch`, render/ggx_batch.h)\n"
-                  "and for a LUT or a measured table's fitted LUT (`N_AVX2::SampleTabulatedBatch`, `N_AVX2::EvalTabulatedBatch`,\n"
-                  "render/tabulated_batch.h), a MERL-layout table's f too (`N_AVX2::EvalMerlBatch`, render/merl_batch.h);\n"
-                  "then `finish` (shadow rays and their values) in the tile loop. An RGL or UTIA file's own evaluation is\n"
-                  "still one pair at a time. The kernels are compiled for AVX2 and the baseline: an AVX-512 target made the\n"
-                  "GGX sphere slower (render/simd_targets.h).\n")
+                  "A tile's samples are shaded in steps (render/renderer.cpp), each in SIMD lanes over the tile (`N_AVX3::` on\n"
+                  "an AVX-512 host, `N_AVX2::` with AVX2): their numbers and camera rays (`DrawCameraSamples`,\n"
+                  "render/camera_batch.h), the spheres' hits (`NearestSpheres`, render/sphere_batch.h), a constant\n"
+                  "environment's light samples (`SampleUniformSphereBatch`, render/environment_batch.h), the hits placed per\n"
+                  "material (`PlaceHits`, render/wavefront.h), the slots of the environment's light sample and of the lights\n"
+                  "(`LightSlots`), BRDF sampling (`SampleGgxBatch`, `SampleTabulatedBatch`) and its slots (`BrdfSlots`),\n"
+                  "evaluation (`EvalGgxBatch`, render/ggx_batch.h; `EvalTabulatedBatch`, render/tabulated_batch.h; a\n"
+                  "MERL-layout table's f, `EvalMerlBatch`, render/merl_batch.h), the shadow rays' values (`ShadowValues`)\n"
+                  "and blocking (`BlockedBySpheres`); the tile loop (`render::{lambda}`) gathers the hits and adds the\n"
+                  "unblocked values. A hit whose model has no lanes (an RGL or UTIA file's own evaluation, a lobe\n"
+                  "textured per hit) is shaded one pair at a time inside the tile loop.\n")
         out.write("\nBy stage: the GGX sphere at 64 spp on one CPU with parts of the scene left out (one render each, the\n"
                   "median of %d); the camera stage (the numbers and camera rays in SIMD lanes, render/camera_batch.h, the\n"
                   "sphere's hits, each hit's frame, the accumulation) is what every sample pays.\n\n"

@@ -16,6 +16,7 @@
 #include "model/tabulated.h"
 #include "model/parametric.h"
 #include "model/proposal.h"
+#include "core/frame.h"
 #include "render/renderer.h"
 #include "render/camera_batch.h"
 #include "render/environment.h"
@@ -27,6 +28,7 @@
 #include "render/tabulated_batch.h"
 #include "render/texture.h"
 #include "render/tracer.h"
+#include "render/wavefront.h"
 #include "support/tensor_file.h"
 #include "test_util.h"
 
@@ -202,12 +204,12 @@ TEST(Tracer, SpheresInLanesEqualTheClosedForm) {
       scalar.push_back(r);
       rays.push(r.origin, r.dir, r.tnear, r.tfar);
     }
-    for (const bool baseline : {false, true}) {
+    for (const SimdTarget target : kSimdTargets) {
       std::vector<double> t;
       std::vector<int> which;
       std::vector<char> blocked(n, 0);
-      nearest_spheres(spheres, rays, t, which, baseline);
-      blocked_by_spheres(spheres, rays, blocked, baseline);
+      nearest_spheres(spheres, rays, t, which, target);
+      blocked_by_spheres(spheres, rays, blocked, target);
       for (std::size_t k = 0; k < n; ++k) {
         double best = std::numeric_limits<double>::infinity();
         int nearest = -1;
@@ -218,11 +220,11 @@ TEST(Tracer, SpheresInLanesEqualTheClosedForm) {
           if (ts < bounded.tfar) bounded.tfar = best = ts, nearest = int(s);
           any = any || std::isfinite(intersect_sphere(list[s].first, list[s].second, scalar[k]));
         }
-        EXPECT_EQ(which[k], nearest) << n << " " << k << " " << baseline;
+        EXPECT_EQ(which[k], nearest) << n << " " << k << " " << simd_target_name(target);
         if (nearest >= 0) {
-          EXPECT_NEAR(t[k], best, 1e-14 * best) << n << " " << k << " " << baseline;
+          EXPECT_NEAR(t[k], best, 1e-14 * best) << n << " " << k << " " << simd_target_name(target);
         }
-        EXPECT_EQ(bool(blocked[k]), any) << n << " " << k << " " << baseline;
+        EXPECT_EQ(bool(blocked[k]), any) << n << " " << k << " " << simd_target_name(target);
       }
     }
   }
@@ -314,11 +316,105 @@ TEST_P(RayStreams, AndOneRayAtATimeGiveTheSameImage) {
 
 INSTANTIATE_TEST_SUITE_P(Render, RayStreams, ::testing::Values(R"({"builtin": "sky"})", R"({"constant": [0.3, 0.3, 0.3]})"));
 
+// The lanes' hits and slots (render/wavefront.h) on every SIMD target against the one-hit path's
+// arithmetic: each hit placed as Frame (core/frame.h) places it, with and without a tangent, on spheres
+// and triangles; each light's and the environment's slot where it lights the hit and nowhere else, with
+// its direction in the frame, its ray and what arrives along it.
+TEST(Wavefront, HitsAndSlotsEqualTheOneHitPath) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const auto unit = [&] { return glm::normalize(Vec3(u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5) + Vec3(1e-3)); };
+  const Vec3 camera(0.2, 0.5, 4.0), tangent(0.3, 1.0, 0.2);
+  const double eps = 2e-4;
+  const std::vector<LaneLight> lights = {{true, 0.3, 1.0, 0.5, 3, 2, 1}, {false, -2.0, 3.0, 1.0, 5, 4, 3}};
+  for (const std::size_t n : {1, 5, 37}) {
+    TileHits tile;
+    tile.resize_to(n);
+    for (std::size_t k = 0; k < n; ++k) {
+      const Vec3 d = glm::normalize(Vec3(u(rng) - 0.5, u(rng) - 0.5, -4.0));
+      tile.dx[k] = d.x, tile.dy[k] = d.y, tile.dz[k] = d.z;
+      tile.t[k] = 3.0 + u(rng), tile.material[k] = double(k % 3 == 2 ? 1 : 0), tile.sphere[k] = k % 2 ? 1.0 : 0.0;
+      const Vec3 g = k % 2 ? Vec3(u(rng), u(rng), -u(rng)) : unit();  // a centre, or a triangle's normal
+      tile.gx[k] = g.x, tile.gy[k] = g.y, tile.gz[k] = g.z;
+      const Vec3 l = unit();
+      tile.lx[k] = l.x, tile.ly[k] = l.y, tile.lz[k] = l.z, tile.light_pdf[k] = k % 5 ? 0.1 : 0.0;
+      tile.light_r[k] = 0.3, tile.light_g[k] = 0.2, tile.light_b[k] = 0.1;
+      tile.u1[k] = u(rng), tile.u2[k] = u(rng), tile.u3[k] = u(rng);
+    }
+    for (const bool with_tangent : {false, true})
+      for (const SimdTarget target : kSimdTargets) {
+        const std::string where = std::to_string(n) + (with_tangent ? " tangent " : " ") + simd_target_name(target);
+        HitBatch hits;
+        place_hits(tile, camera, eps, 0.0, with_tangent ? &tangent : nullptr, hits, target);
+        ShadowBatch slots;
+        SlotRanges ranges;
+        SampleBatch samples;
+        light_slots(hits, true, lights, eps, slots, ranges, samples, target);
+        const auto close = [](double a, double b) { return std::abs(a - b) <= 1e-12 * std::max(1.0, std::abs(b)); };
+        // The one-hit path, hit by hit of material 0, slot by slot.
+        std::size_t row = 0, env_entries = 0;
+        std::vector<std::size_t> light_entries(lights.size(), 0);
+        for (std::size_t k = 0; k < n; ++k) {
+          if (tile.material[k] != 0.0) continue;
+          ASSERT_LT(row, hits.size()) << where;
+          EXPECT_EQ(hits.owner[row], double(k)) << where;
+          const Vec3 dir(tile.dx[k], tile.dy[k], tile.dz[k]);
+          const Vec3 p = camera + tile.t[k] * dir;
+          Vec3 nrm = tile.sphere[k] != 0.0 ? glm::normalize(p - Vec3(tile.gx[k], tile.gy[k], tile.gz[k])) : glm::normalize(Vec3(tile.gx[k], tile.gy[k], tile.gz[k]));
+          if (glm::dot(nrm, dir) > 0.0) nrm = -nrm;
+          const Frame frame = with_tangent ? Frame(nrm, tangent) : Frame(nrm);
+          const Vec3 o = frame.to_local(-dir), origin = p + eps * nrm;
+          for (const auto& [a, b] : {std::pair{hits.tx[row], frame.t.x}, {hits.ty[row], frame.t.y}, {hits.tz[row], frame.t.z},
+                                     {hits.bx[row], frame.b.x}, {hits.by[row], frame.b.y}, {hits.bz[row], frame.b.z},
+                                     {hits.nx[row], frame.n.x}, {hits.ny[row], frame.n.y}, {hits.nz[row], frame.n.z},
+                                     {hits.ox[row], o.x}, {hits.oy[row], o.y}, {hits.oz[row], o.z},
+                                     {hits.origin_x[row], origin.x}, {hits.origin_y[row], origin.y}, {hits.origin_z[row], origin.z},
+                                     {hits.u1[row], tile.u1[k]}, {hits.light_pdf[row], tile.light_pdf[k]}})
+            ASSERT_TRUE(close(a, b)) << where << " hit " << k << ": " << a << " against " << b;
+          // The environment's slot: where the light sample and the view are above the horizon.
+          const Vec3 l(tile.lx[k], tile.ly[k], tile.lz[k]);
+          const Vec3 il = frame.to_local(l);
+          if (o.z > 0.0 && il.z > 0.0 && tile.light_pdf[k] > 0.0) {
+            const std::size_t e = env_entries++;
+            ASSERT_LT(e, ranges.lights_begin) << where;
+            EXPECT_EQ(slots.row[e], double(row)) << where;
+            EXPECT_TRUE(close(slots.iz[e], il.z) && close(slots.rays.dx[e], l.x) && close(slots.rays.ox[e], origin.x)) << where;
+            EXPECT_EQ(slots.rays.tnear[e], eps) << where;
+            EXPECT_TRUE(std::isinf(slots.rays.tfar[e])) << where;
+          }
+          for (std::size_t j = 0; j < lights.size(); ++j) {
+            const LaneLight& light = lights[j];
+            Vec3 d(light.x, light.y, light.z);
+            double dist = std::numeric_limits<double>::infinity(), falloff = 1.0;
+            if (!light.directional) {
+              const Vec3 to = d - p;
+              dist = glm::length(to), d = to / dist, falloff = 1.0 / (dist * dist), dist *= 1.0 - 1e-6;
+            }
+            const Vec3 i = frame.to_local(d);
+            if (!(i.z > 0.0 && o.z > 0.0)) continue;
+            const std::size_t e = ranges.light_begin[j] + light_entries[j]++;
+            ASSERT_LT(e, j + 1 < lights.size() ? ranges.light_begin[j + 1] : ranges.brdf_begin) << where;
+            EXPECT_EQ(slots.row[e], double(row)) << where;
+            EXPECT_TRUE(close(slots.iz[e], i.z) && close(slots.rays.dy[e], d.y) && close(slots.arriving_r[e], light.r * falloff)) << where;
+            EXPECT_TRUE(light.directional ? std::isinf(slots.rays.tfar[e]) : close(slots.rays.tfar[e], dist)) << where;
+          }
+          ++row;
+        }
+        EXPECT_EQ(row, hits.size()) << where;
+        EXPECT_EQ(env_entries, ranges.lights_begin) << where;
+        for (std::size_t j = 0; j < lights.size(); ++j)
+          EXPECT_EQ(ranges.light_begin[j] + light_entries[j], j + 1 < lights.size() ? ranges.light_begin[j + 1] : ranges.brdf_begin) << where;
+        EXPECT_EQ(slots.size(), ranges.brdf_begin) << where;
+        EXPECT_EQ(samples.size(), hits.size()) << where;
+      }
+  }
+}
+
 TEST(Environment, ConstantLightSamplesInSimdLanesEqualSample) {
   const Environment env = Environment::constant(Rgb(0.3));
   std::mt19937 rng(5);
   std::uniform_real_distribution<double> u(0.0, 1.0);
-  for (const bool baseline : {false, true})
+  for (const SimdTarget target : kSimdTargets)
     for (std::size_t n : {1, 3, 4, 15, 16, 17, 61}) {
       SphereSampleBatch batch;
       std::vector<std::pair<double, double>> numbers;
@@ -328,7 +424,7 @@ TEST(Environment, ConstantLightSamplesInSimdLanesEqualSample) {
         numbers.emplace_back(u1, u2);
         batch.push(u1, u2);
       }
-      sample_uniform_sphere_batch(batch, baseline);
+      sample_uniform_sphere_batch(batch, target);
       for (std::size_t k = 0; k < n; ++k) {
         const Vec3 want = env.sample(numbers[k].first, numbers[k].second).d, got = batch.d(k);
         EXPECT_NEAR(got.x, want.x, 1e-12) << k;
@@ -353,7 +449,7 @@ TEST(Camera, SamplesInSimdLanesEqualOneAtATime) {
   camera.to_sx = 2.0 / 16000.0, camera.to_sy = 2.0 / 9000.0;
   std::mt19937 rng(11);
   std::uniform_int_distribution<int> px(0, 15999), py(0, 8999);
-  for (const bool baseline : {false, true})
+  for (const SimdTarget target : kSimdTargets)
     for (std::size_t n : {1, 3, 4, 15, 16, 17, 61})
       for (const auto& [seed, s] : {std::pair<std::uint64_t, int>{1, 0}, {0xFFFFFFFFFFFFull, 63}, {7, (1 << 24) + 5}}) {
         CameraSampleBatch batch;
@@ -362,7 +458,7 @@ TEST(Camera, SamplesInSimdLanesEqualOneAtATime) {
           pixels.emplace_back(k == 0 ? 0 : px(rng), k == 0 ? 0 : py(rng));
           batch.push(pixels.back().first, pixels.back().second);
         }
-        camera_sample_batch(camera, seed, s, batch, baseline);
+        camera_sample_batch(camera, seed, s, batch, target);
         for (std::size_t k = 0; k < n; ++k) {
           const auto [x, y] = pixels[k];
           const std::uint64_t start = SampleSequence::start(seed, SampleSequence::pixel_key(x, y), s);
@@ -394,7 +490,7 @@ TEST(Shading, GgxInSimdLanesEqualsOnePairAtATime) {
   for (const double alpha : {0.005, 0.3, 1.5})
     for (const Smith smith : {Smith::masking, Smith::correlated, Smith::separable})
       for (int variant = 0; variant < 4; ++variant)
-        for (const bool baseline : {false, true}) {
+        for (const SimdTarget target : kSimdTargets) {
           const bool with_curve = variant & 1, layered = variant & 2;
           const Rgb f0(0.9, 0.6, 0.3), body = layered ? Rgb(0.3, 0.2, 0.1) : Rgb(0.0);
           const Coat coat = layered ? Coat{0.05, 0.04} : Coat{};
@@ -403,7 +499,7 @@ TEST(Shading, GgxInSimdLanesEqualsOnePairAtATime) {
                                        : std::make_shared<ParametricBrdf>(ndf, smith, f0, Rgb(0.8, 0.7, 0.5), body, coat);
           const ShadingModel model(brdf, std::make_shared<GgxProposal>(alpha, f0, body, coat));
           ASSERT_TRUE(model.batch_model());
-          const std::string where = "alpha " + std::to_string(alpha) + " variant " + std::to_string(variant) + (baseline ? " baseline" : "");
+          const std::string where = "alpha " + std::to_string(alpha) + " variant " + std::to_string(variant) + " " + simd_target_name(target);
           EvaluationBatch lanes, reference;
           SampleBatch drawn, one_by_one;
           const std::size_t n = 200 + std::size_t(cases % 17);
@@ -413,8 +509,8 @@ TEST(Shading, GgxInSimdLanesEqualsOnePairAtATime) {
             const double u1 = u(rng), u2 = u(rng), u3 = u(rng);
             drawn.push(o, u1, u2, u3), one_by_one.push(o, u1, u2, u3);
           }
-          eval_ggx_batch(*model.batch_model(), lanes, baseline), model.eval(reference, false);
-          sample_ggx_batch(*model.batch_model(), drawn, baseline), model.sample_directions(one_by_one, false);
+          eval_ggx_batch(*model.batch_model(), lanes, target), model.eval(reference, false);
+          sample_ggx_batch(*model.batch_model(), drawn, target), model.sample_directions(one_by_one, false);
           for (std::size_t k = 0; k < n; ++k) {
             const double values[4][2] = {{lanes.r[k], reference.r[k]}, {lanes.g[k], reference.g[k]}, {lanes.b[k], reference.b[k]},
                                          {lanes.pdf[k], reference.pdf[k]}};
@@ -433,7 +529,7 @@ TEST(Shading, GgxInSimdLanesEqualsOnePairAtATime) {
           }
           ++cases;
         }
-  EXPECT_EQ(cases, 72);
+  EXPECT_EQ(cases, 108);  // every case on each of the three SIMD targets
   // Both outcomes were compared (about half the views are below the horizon).
   EXPECT_GT(found, 5000);
   EXPECT_GT(refused, 1000);
@@ -462,14 +558,14 @@ TEST(Shading, TabulatedInSimdLanesEqualsOnePairAtATime) {
   for (const auto& [type, alpha] : {std::pair{NdfType::ggx, 0.005}, {NdfType::ggx, 0.3}, {NdfType::ggx, 1.5}, {NdfType::beckmann, 0.3}})
     for (const Smith smith : {Smith::masking, Smith::correlated, Smith::separable})
       for (const bool layered : {false, true})
-        for (const bool baseline : {false, true}) {
+        for (const SimdTarget target : kSimdTargets) {
           MicrofacetTables tables{tabulate_ndf(Ndf::isotropic(type, alpha)), smith, curve, layered ? Rgb(0.3, 0.2, 0.1) : Rgb(0.0),
                                   layered ? Coat{0.05, 0.04} : Coat{}};
           const auto lobe = std::make_shared<TabulatedMicrofacet>(tables);
           const ShadingModel model(lobe, lobe);
           ASSERT_TRUE(model.tabulated_batch_model());
           ASSERT_TRUE(model.has_lanes());
-          const std::string where = "alpha " + std::to_string(alpha) + (layered ? " layered" : "") + (baseline ? " baseline" : "");
+          const std::string where = "alpha " + std::to_string(alpha) + (layered ? " layered" : "") + " " + simd_target_name(target);
           EvaluationBatch lanes, reference;
           SampleBatch drawn, one_by_one;
           const std::size_t n = 300 + std::size_t(cases % 17);
@@ -480,8 +576,8 @@ TEST(Shading, TabulatedInSimdLanesEqualsOnePairAtATime) {
             const double u1 = u(rng), u2 = u(rng), u3 = u(rng);
             drawn.push(o, u1, u2, u3), one_by_one.push(o, u1, u2, u3);
           }
-          eval_tabulated_batch(*model.tabulated_batch_model(), lanes, baseline), model.eval(reference, false);
-          sample_tabulated_batch(*model.tabulated_batch_model(), drawn, baseline), model.sample_directions(one_by_one, false);
+          eval_tabulated_batch(*model.tabulated_batch_model(), lanes, target), model.eval(reference, false);
+          sample_tabulated_batch(*model.tabulated_batch_model(), drawn, target), model.sample_directions(one_by_one, false);
           for (std::size_t k = 0; k < n; ++k) {
             ASSERT_EQ(drawn.found[k], one_by_one.found[k]) << where << " sample " << k;
             if (!one_by_one.found[k]) continue;
@@ -510,7 +606,7 @@ TEST(Shading, TabulatedInSimdLanesEqualsOnePairAtATime) {
           ++cases;
         }
   std::printf("[ lanes ] worst relative difference of f and pdf %.2e, of a drawn direction %.2e\n", worst, sample_worst);
-  EXPECT_EQ(cases, 48);
+  EXPECT_EQ(cases, 72);  // every case on each of the three SIMD targets
   EXPECT_GT(compared, 20000);  // about half the pairs are above the horizon, four values each
   EXPECT_GT(found, 5000);
 }
@@ -571,7 +667,7 @@ TEST(Shading, MerlTableInSimdLanesEqualsOnePairAtATime) {
   const auto direction = [&] { return lane_test_direction(rng, 0.05); };
   double worst = 0.0;
   int values = 0, zero = 0;
-  for (const bool baseline : {false, true}) {
+  for (const SimdTarget target : kSimdTargets) {
     EvaluationBatch lanes;
     std::vector<Vec3> os, is;
     for (std::size_t k = 0; k < 4003; ++k) {
@@ -580,14 +676,14 @@ TEST(Shading, MerlTableInSimdLanesEqualsOnePairAtATime) {
       if (k % 4 == 1) o = glm::normalize(Vec3(0.001 * o.x, 0.001 * o.y, 1.0)), i = glm::normalize(Vec3(-o.x, o.y, o.z));  // near the normal
       lanes.push(o, i), os.push_back(o), is.push_back(i);
     }
-    eval_merl_batch(*model, lanes, baseline);
+    eval_merl_batch(*model, lanes, target);
     for (std::size_t k = 0; k < os.size(); ++k) {
       const Rgb expected = table.eval(os[k], is[k]).value_or(Rgb(0.0));
       for (int c = 0; c < 3; ++c) {
         const double a = c == 0 ? lanes.r[k] : (c == 1 ? lanes.g[k] : lanes.b[k]), b = expected[c];
         ASSERT_TRUE(std::isfinite(a)) << k;
         // To rounding, through the arc cosines' and arc tangent's last bits (worst 3.5e-11).
-        ASSERT_LE(std::abs(a - b), 1e-9 * std::max(std::abs(b), 1e-3)) << (baseline ? "baseline " : "") << "pair " << k << " channel " << c
+        ASSERT_LE(std::abs(a - b), 1e-9 * std::max(std::abs(b), 1e-3)) << simd_target_name(target) << " " << "pair " << k << " channel " << c
                                                                         << ": " << a << " against " << b;
         worst = std::max(worst, std::abs(a - b) / std::max(std::abs(b), 1e-3));
         ++values, zero += b == 0.0;

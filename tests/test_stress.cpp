@@ -202,7 +202,7 @@ TEST(GgxLanes, EveryBatchLengthAndDegenerateDirectionStayFiniteAndInBounds) {
                                std::make_shared<GgxProposal>(alpha, Rgb(0.5), body, coat));
       ASSERT_TRUE(model.batch_model());
       for (std::size_t n = 0; n <= 40; ++n)
-        for (const bool baseline : {false, true}) {
+        for (const SimdTarget target : kSimdTargets) {
           EvaluationBatch e;
           SampleBatch s;
           for (std::size_t k = 0; k < n; ++k) {
@@ -210,8 +210,8 @@ TEST(GgxLanes, EveryBatchLengthAndDegenerateDirectionStayFiniteAndInBounds) {
             e.push(o, i);
             s.push(o, double(k % 5) / 5.0, double(k % 7) / 7.0, double(k % 3) / 3.0);
           }
-          eval_ggx_batch(*model.batch_model(), e, baseline);
-          sample_ggx_batch(*model.batch_model(), s, baseline);
+          eval_ggx_batch(*model.batch_model(), e, target);
+          sample_ggx_batch(*model.batch_model(), s, target);
           for (std::size_t k = 0; k < n; ++k) {
             for (const double v : {e.r[k], e.g[k], e.b[k], e.pdf[k]}) ASSERT_TRUE(std::isfinite(v)) << "alpha " << alpha << " pair " << k;
             if (!(e.oz[k] > 0.0 && e.iz[k] > 0.0)) {
@@ -242,10 +242,10 @@ TEST(TabulatedLanes, EveryBatchLengthAndDegenerateDirectionStayFiniteAndInBounds
       const ShadingModel model(lobe, lobe);
       ASSERT_TRUE(model.tabulated_batch_model());
       for (std::size_t n = 0; n <= 40; ++n)
-        for (const bool baseline : {false, true}) {
+        for (const SimdTarget target : kSimdTargets) {
           EvaluationBatch e;
           for (std::size_t k = 0; k < n; ++k) e.push(glm::normalize(degenerate[k % 8]), glm::normalize(degenerate[(k * 3 + 1) % 8]));
-          eval_tabulated_batch(*model.tabulated_batch_model(), e, baseline);
+          eval_tabulated_batch(*model.tabulated_batch_model(), e, target);
           for (std::size_t k = 0; k < n; ++k) {
             for (const double v : {e.r[k], e.g[k], e.b[k], e.pdf[k]}) ASSERT_TRUE(std::isfinite(v)) << "alpha " << alpha << " pair " << k;
             if (!(e.oz[k] > 0.0 && e.iz[k] > 0.0)) {
@@ -266,10 +266,10 @@ TEST(MerlLanes, EveryBatchLengthAndDegenerateDirectionStayFiniteAndInBounds) {
     const auto model = MerlBatchModel::of(table);
     ASSERT_TRUE(model);
     for (std::size_t n = 0; n <= 40; ++n)
-      for (const bool baseline : {false, true}) {
+      for (const SimdTarget target : kSimdTargets) {
         EvaluationBatch e;
         for (std::size_t k = 0; k < n; ++k) e.push(glm::normalize(degenerate[k % 8]), glm::normalize(degenerate[(k * 3 + 1) % 8]));
-        eval_merl_batch(*model, e, baseline);
+        eval_merl_batch(*model, e, target);
         for (std::size_t k = 0; k < n; ++k)
           for (const double v : {e.r[k], e.g[k], e.b[k]}) ASSERT_TRUE(std::isfinite(v)) << "pair " << k;
       }
@@ -281,10 +281,10 @@ TEST(EnvironmentLanes, EveryBatchLengthAndTheEndsOfTheUnitIntervalStayOnTheSpher
   // to 40 under the sanitizers, and numbers at 0 and just below 1 (the poles, phi = 0 and 2 pi).
   const double ends[] = {0.0, std::nextafter(1.0, 0.0), 0.5, 1e-300, 0.25};
   for (std::size_t n = 0; n <= 40; ++n)
-    for (const bool baseline : {false, true}) {
+    for (const SimdTarget target : kSimdTargets) {
       SphereSampleBatch b;
       for (std::size_t k = 0; k < n; ++k) b.push(ends[k % 5], ends[(k * 3 + 1) % 5]);
-      sample_uniform_sphere_batch(b, baseline);
+      sample_uniform_sphere_batch(b, target);
       for (std::size_t k = 0; k < n; ++k) {
         for (const double v : {b.x[k], b.y[k], b.z[k]}) ASSERT_TRUE(std::isfinite(v)) << "sample " << k;
         EXPECT_NEAR(glm::length(b.d(k)), 1.0, 1e-12) << "sample " << k;
@@ -303,10 +303,10 @@ TEST(CameraLanes, EveryBatchLengthAndTheImageCornersGiveUnitDirections) {
     camera.tan_half = std::tan(0.5 * 170.0 * kPi / 180.0), camera.aspect = 1.0;
     camera.to_sx = camera.to_sy = 2.0 / size;
     for (std::size_t n = 0; n <= 40; ++n)
-      for (const bool baseline : {false, true}) {
+      for (const SimdTarget target : kSimdTargets) {
         CameraSampleBatch b;
         for (std::size_t k = 0; k < n; ++k) b.push(k % 2 ? size - 1 : 0, k % 4 < 2 ? 0 : size - 1);
-        camera_sample_batch(camera, ~std::uint64_t(0), 1 << 30, b, baseline);
+        camera_sample_batch(camera, ~std::uint64_t(0), 1 << 30, b, target);
         for (std::size_t k = 0; k < n; ++k) {
           for (const auto& u : b.u) ASSERT_TRUE(u[k] >= 0.0 && u[k] < 1.0) << "sample " << k;
           for (const double v : {b.dx[k], b.dy[k], b.dz[k]}) ASSERT_TRUE(std::isfinite(v)) << "sample " << k;

@@ -73,13 +73,11 @@ void DrawCameraSamples(const PinholeCamera& camera, std::uint64_t seed, int s, C
 HWY_AFTER_NAMESPACE();
 
 #if HWY_ONCE
+#include "render/simd_dispatch.h"
 namespace facetfit {
 
-void camera_sample_batch(const PinholeCamera& camera, std::uint64_t seed, int s, CameraSampleBatch& batch, bool baseline) {
-#if HWY_TARGETS & HWY_AVX2
-  if (!baseline && cpu_has_avx2()) return N_AVX2::DrawCameraSamples(camera, seed, s, batch);
-#endif
-  HWY_STATIC_DISPATCH(DrawCameraSamples)(camera, seed, s, batch);
+void camera_sample_batch(const PinholeCamera& camera, std::uint64_t seed, int s, CameraSampleBatch& batch, SimdTarget target) {
+  FACETFIT_DISPATCH(target, DrawCameraSamples, camera, seed, s, batch);
 }
 
 }  // namespace facetfit

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "render/shading_batch.h"
+#include "render/simd_targets.h"
 
 namespace facetfit {
 
@@ -68,8 +69,8 @@ struct CameraSampleBatch : Columns {
 };
 
 // Fills u and d for the batch's padded_size() entries: SampleSequence::number j of each pixel's sample s,
-// and PinholeCamera::direction with its first two. `baseline`: the code for CPUs without AVX2, which the
-// tests run too.
-void camera_sample_batch(const PinholeCamera& camera, std::uint64_t seed, int s, CameraSampleBatch& batch, bool baseline = false);
+// and PinholeCamera::direction with its first two. `target`: which SIMD code runs (render/simd_targets.h;
+// the tests run each).
+void camera_sample_batch(const PinholeCamera& camera, std::uint64_t seed, int s, CameraSampleBatch& batch, SimdTarget target = SimdTarget::best);
 
 }  // namespace facetfit

@@ -36,13 +36,11 @@ void SampleUniformSphereBatch(SphereSampleBatch& batch) {
 HWY_AFTER_NAMESPACE();
 
 #if HWY_ONCE
+#include "render/simd_dispatch.h"
 namespace facetfit {
 
-void sample_uniform_sphere_batch(SphereSampleBatch& batch, bool baseline) {
-#if HWY_TARGETS & HWY_AVX2
-  if (!baseline && cpu_has_avx2()) return N_AVX2::SampleUniformSphereBatch(batch);
-#endif
-  HWY_STATIC_DISPATCH(SampleUniformSphereBatch)(batch);
+void sample_uniform_sphere_batch(SphereSampleBatch& batch, SimdTarget target) {
+  FACETFIT_DISPATCH(target, SampleUniformSphereBatch, batch);
 }
 
 }  // namespace facetfit

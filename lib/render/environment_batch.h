@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "render/shading_batch.h"
+#include "render/simd_targets.h"
 
 namespace facetfit {
 
@@ -22,8 +23,8 @@ struct SphereSampleBatch : Columns {
 };
 
 // Fills x, y, z for the batch's padded_size() entries as Environment::sample of a constant environment
-// does: z' = 1 - 2 u1, r = sqrt(1 - z'^2), phi = 2 pi u2, d = (r cos phi, z', r sin phi). `baseline`: the
-// code for CPUs without AVX2, which the tests run too.
-void sample_uniform_sphere_batch(SphereSampleBatch& batch, bool baseline = false);
+// does: z' = 1 - 2 u1, r = sqrt(1 - z'^2), phi = 2 pi u2, d = (r cos phi, z', r sin phi). `target`: which
+// SIMD code runs (render/simd_targets.h; the tests run each).
+void sample_uniform_sphere_batch(SphereSampleBatch& batch, SimdTarget target = SimdTarget::best);
 
 }  // namespace facetfit

@@ -87,20 +87,15 @@ void EvalGgxBatch(const GgxBatchModel& model, EvaluationBatch& batch) {
 HWY_AFTER_NAMESPACE();
 
 #if HWY_ONCE
+#include "render/simd_dispatch.h"
 namespace facetfit {
 
-void eval_ggx_batch(const GgxBatchModel& model, EvaluationBatch& batch, bool baseline) {
-#if HWY_TARGETS & HWY_AVX2
-  if (!baseline && cpu_has_avx2()) return N_AVX2::EvalGgxBatch(model, batch);
-#endif
-  HWY_STATIC_DISPATCH(EvalGgxBatch)(model, batch);
+void eval_ggx_batch(const GgxBatchModel& model, EvaluationBatch& batch, SimdTarget target) {
+  FACETFIT_DISPATCH(target, EvalGgxBatch, model, batch);
 }
 
-void sample_ggx_batch(const GgxBatchModel& model, SampleBatch& batch, bool baseline) {
-#if HWY_TARGETS & HWY_AVX2
-  if (!baseline && cpu_has_avx2()) return N_AVX2::SampleGgxBatch(model, batch);
-#endif
-  HWY_STATIC_DISPATCH(SampleGgxBatch)(model, batch);
+void sample_ggx_batch(const GgxBatchModel& model, SampleBatch& batch, SimdTarget target) {
+  FACETFIT_DISPATCH(target, SampleGgxBatch, model, batch);
 }
 
 }  // namespace facetfit

@@ -11,6 +11,7 @@
 #include "model/fresnel.h"
 #include "model/smith.h"
 #include "render/shading_batch.h"
+#include "render/simd_targets.h"
 
 namespace facetfit {
 
@@ -27,9 +28,9 @@ struct GgxBatchModel {
 };
 
 // Fills the batch's r, g, b and pdf for its padded_size() pairs; zero where o or i is below the horizon.
-// `baseline`: the code for CPUs without AVX2, which the tests run too.
-void eval_ggx_batch(const GgxBatchModel& model, EvaluationBatch& batch, bool baseline = false);
+// `target`: which SIMD code runs (render/simd_targets.h; the tests run each).
+void eval_ggx_batch(const GgxBatchModel& model, EvaluationBatch& batch, SimdTarget target = SimdTarget::best);
 // Fills the batch's i and found for its padded_size() entries.
-void sample_ggx_batch(const GgxBatchModel& model, SampleBatch& batch, bool baseline = false);
+void sample_ggx_batch(const GgxBatchModel& model, SampleBatch& batch, SimdTarget target = SimdTarget::best);
 
 }  // namespace facetfit

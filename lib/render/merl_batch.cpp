@@ -112,6 +112,7 @@ void EvalMerlBatch(const MerlBatchModel& model, EvaluationBatch& batch) {
 HWY_AFTER_NAMESPACE();
 
 #if HWY_ONCE
+#include "render/simd_dispatch.h"
 namespace facetfit {
 
 std::optional<MerlBatchModel> MerlBatchModel::of(const MerlTable& table) {
@@ -121,11 +122,8 @@ std::optional<MerlBatchModel> MerlBatchModel::of(const MerlTable& table) {
   return m;
 }
 
-void eval_merl_batch(const MerlBatchModel& model, EvaluationBatch& batch, bool baseline) {
-#if HWY_TARGETS & HWY_AVX2
-  if (!baseline && cpu_has_avx2()) return N_AVX2::EvalMerlBatch(model, batch);
-#endif
-  HWY_STATIC_DISPATCH(EvalMerlBatch)(model, batch);
+void eval_merl_batch(const MerlBatchModel& model, EvaluationBatch& batch, SimdTarget target) {
+  FACETFIT_DISPATCH(target, EvalMerlBatch, model, batch);
 }
 
 }  // namespace facetfit

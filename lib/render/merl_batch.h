@@ -7,6 +7,7 @@
 #include <optional>
 
 #include "render/shading_batch.h"
+#include "render/simd_targets.h"
 
 namespace facetfit {
 
@@ -20,8 +21,8 @@ struct MerlBatchModel {
 };
 
 // Fills the batch's r, g and b for its padded_size() pairs (pdf untouched): zero where o or i is below the
-// horizon or a channel has no measured neighbour (MerlTable::eval's none). `baseline`: the code for CPUs
-// without AVX2, which the tests run too.
-void eval_merl_batch(const MerlBatchModel& model, EvaluationBatch& batch, bool baseline = false);
+// horizon or a channel has no measured neighbour (MerlTable::eval's none). `target`: which SIMD code
+// runs (render/simd_targets.h; the tests run each).
+void eval_merl_batch(const MerlBatchModel& model, EvaluationBatch& batch, SimdTarget target = SimdTarget::best);
 
 }  // namespace facetfit

@@ -65,7 +65,7 @@ ShadingModel::Evaluation ShadingModel::eval(const Vec3& o, const Vec3& i) const 
 void ShadingModel::eval(EvaluationBatch& batch, bool simd) const {
   if (simd && batch_model_) return eval_ggx_batch(*batch_model_, batch);
   if (simd && tabulated_batch_model_) {
-    eval_tabulated_batch(*tabulated_batch_model_, batch, false, tabulated_f_);
+    eval_tabulated_batch(*tabulated_batch_model_, batch, SimdTarget::best, tabulated_f_);
     if (tabulated_f_) return;
     if (merl_batch_model_) return eval_merl_batch(*merl_batch_model_, batch);
     for (std::size_t k = 0; k < batch.size(); ++k) {

@@ -6,7 +6,8 @@
 #include <cpuid.h>
 #endif
 
-static_assert(HWY_DISABLED_TARGETS == (HWY_AVX3_DL | HWY_AVX3 | HWY_SSE4 | HWY_SSSE3), "Highway's target bits moved");
+static_assert(HWY_DISABLED_TARGETS == (HWY_AVX3_DL | HWY_SSE4 | HWY_SSSE3), "Highway's target bits moved");
+#include <cstdlib>
 
 namespace facetfit {
 
@@ -21,6 +22,16 @@ bool cpu_has_avx2() {
            __builtin_cpu_supports("avx2") && __builtin_cpu_supports("bmi") && __builtin_cpu_supports("bmi2") &&
            __builtin_cpu_supports("fma");
   }();
+  return yes;
+#else
+  return false;
+#endif
+}
+
+bool cpu_has_avx3() {
+#if HWY_ARCH_X86 && (HWY_TARGETS & HWY_AVX3)
+  static const bool yes = cpu_has_avx2() && __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
+                          __builtin_cpu_supports("avx512dq") && __builtin_cpu_supports("avx512bw") && !std::getenv("FACETFIT_NO_AVX3");
   return yes;
 #else
   return false;

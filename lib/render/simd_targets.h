@@ -1,13 +1,15 @@
 // The SIMD targets every Highway kernel of the renderer is compiled for, and the choice between them at
 // run time. Included first by each kernel file, before any of Highway's headers.
 //
-// Two targets: AVX2 and the baseline. AVX3_DL, AVX3, SSE4 and SSSE3 are off (their bits in
-// hwy/detect_targets.h; each kernel file checks them against Highway's names). AVX3 (AVX-512, eight doubles a
-// vector) was tried on a CPU that has it: the GGX sphere of docs/render-speed.md rendered slower (64 spp
-// 0.22 -> 0.24 s, 1024 spp 3.44 -> 3.61 s, medians of alternating runs; a one-off probe), so it stays off.
+// Three targets: AVX3 (AVX-512, eight doubles a vector), AVX2 (four) and the baseline; AVX3_DL, SSE4 and SSSE3
+// are off (their bits in hwy/detect_targets.h, checked against Highway's names in simd_targets.cpp). AVX3 was
+// off while a render ran one hit at a time between its kernels (it made the GGX sphere of
+// docs/render-speed.md slower, 0.22 -> 0.24 s); with a tile's shading in lanes (render/wavefront.h) it
+// renders the GGX sphere at 64 spp in 0.345 s of one CPU against AVX2's 0.362, the LUT sphere in 0.29 s
+// against 0.42 on two, the MERL sphere in 0.45 against 0.65 (one-off probes, medians of alternating runs).
 #pragma once
 
-#define HWY_DISABLED_TARGETS ((1LL << 7) | (1LL << 8) | (1LL << 11) | (1LL << 12))
+#define HWY_DISABLED_TARGETS ((1LL << 7) | (1LL << 11) | (1LL << 12))
 
 namespace facetfit {
 
@@ -15,5 +17,14 @@ namespace facetfit {
 // (HWY_DYNAMIC_DISPATCH) lives in libhwy.so, whose static initializer times a clock in every process that
 // loads it: 4 ms more for every command's start-up (perf stat). With two targets the CPU's features pick.
 bool cpu_has_avx2();
+// And every feature of its AVX3 (AVX-512: F, VL, DQ, BW) code, unless the environment variable
+// FACETFIT_NO_AVX3 is set: a benchmark's way to time the AVX2 code on the same CPU (bench/render_compare.py).
+bool cpu_has_avx3();
+
+// Which code a kernel runs: the best the CPU has (the renderer's), or, for the tests, AVX2 (where the CPU has
+// it) or the baseline, for CPUs without AVX2.
+enum class SimdTarget { best, avx2, baseline };
+constexpr SimdTarget kSimdTargets[] = {SimdTarget::best, SimdTarget::avx2, SimdTarget::baseline};
+inline const char* simd_target_name(SimdTarget t) { return t == SimdTarget::best ? "best" : t == SimdTarget::avx2 ? "avx2" : "baseline"; }
 
 }  // namespace facetfit

@@ -107,20 +107,15 @@ void NearestSpheres(const SphereSet& spheres, const RayBatch& rays, std::vector<
 HWY_AFTER_NAMESPACE();
 
 #if HWY_ONCE
+#include "render/simd_dispatch.h"
 namespace facetfit {
 
-void blocked_by_spheres(const SphereSet& spheres, const RayBatch& rays, std::vector<char>& blocked, bool baseline) {
-#if HWY_TARGETS & HWY_AVX2
-  if (!baseline && cpu_has_avx2()) return N_AVX2::BlockedBySpheres(spheres, rays, blocked);
-#endif
-  HWY_STATIC_DISPATCH(BlockedBySpheres)(spheres, rays, blocked);
+void blocked_by_spheres(const SphereSet& spheres, const RayBatch& rays, std::vector<char>& blocked, SimdTarget target) {
+  FACETFIT_DISPATCH(target, BlockedBySpheres, spheres, rays, blocked);
 }
 
-void nearest_spheres(const SphereSet& spheres, const RayBatch& rays, std::vector<double>& t, std::vector<int>& sphere, bool baseline) {
-#if HWY_TARGETS & HWY_AVX2
-  if (!baseline && cpu_has_avx2()) return N_AVX2::NearestSpheres(spheres, rays, t, sphere);
-#endif
-  HWY_STATIC_DISPATCH(NearestSpheres)(spheres, rays, t, sphere);
+void nearest_spheres(const SphereSet& spheres, const RayBatch& rays, std::vector<double>& t, std::vector<int>& sphere, SimdTarget target) {
+  FACETFIT_DISPATCH(target, NearestSpheres, spheres, rays, t, sphere);
 }
 
 }  // namespace facetfit

@@ -10,6 +10,7 @@
 
 #include "core/vec.h"
 #include "render/shading_batch.h"
+#include "render/simd_targets.h"
 
 namespace facetfit {
 
@@ -42,10 +43,10 @@ struct SphereSet {
 
 // Per ray of the batch (its size() rays), whether a sphere meets it in (tnear, tfar): blocked[k] is set to 1
 // where one does and left as it is otherwise.
-void blocked_by_spheres(const SphereSet& spheres, const RayBatch& rays, std::vector<char>& blocked, bool baseline = false);
+void blocked_by_spheres(const SphereSet& spheres, const RayBatch& rays, std::vector<char>& blocked, SimdTarget target = SimdTarget::best);
 
 // Per ray, the nearest sphere in (tnear, tfar): t (infinity where none) and its index in the set (-1).
 void nearest_spheres(const SphereSet& spheres, const RayBatch& rays, std::vector<double>& t, std::vector<int>& sphere,
-                     bool baseline = false);
+                     SimdTarget target = SimdTarget::best);
 
 }  // namespace facetfit

@@ -282,6 +282,7 @@ void EvalTabulatedBatch(const TabulatedBatchModel& model, EvaluationBatch& batch
 HWY_AFTER_NAMESPACE();
 
 #if HWY_ONCE
+#include "render/simd_dispatch.h"
 #include "model/tabulated.h"
 
 namespace facetfit {
@@ -305,18 +306,12 @@ std::optional<TabulatedBatchModel> TabulatedBatchModel::of(const TabulatedMicrof
   return m;
 }
 
-void eval_tabulated_batch(const TabulatedBatchModel& model, EvaluationBatch& batch, bool baseline, bool with_f) {
-#if HWY_TARGETS & HWY_AVX2
-  if (!baseline && cpu_has_avx2()) return N_AVX2::EvalTabulatedBatch(model, batch, with_f);
-#endif
-  HWY_STATIC_DISPATCH(EvalTabulatedBatch)(model, batch, with_f);
+void eval_tabulated_batch(const TabulatedBatchModel& model, EvaluationBatch& batch, SimdTarget target, bool with_f) {
+  FACETFIT_DISPATCH(target, EvalTabulatedBatch, model, batch, with_f);
 }
 
-void sample_tabulated_batch(const TabulatedBatchModel& model, SampleBatch& batch, bool baseline) {
-#if HWY_TARGETS & HWY_AVX2
-  if (!baseline && cpu_has_avx2()) return N_AVX2::SampleTabulatedBatch(model, batch);
-#endif
-  HWY_STATIC_DISPATCH(SampleTabulatedBatch)(model, batch);
+void sample_tabulated_batch(const TabulatedBatchModel& model, SampleBatch& batch, SimdTarget target) {
+  FACETFIT_DISPATCH(target, SampleTabulatedBatch, model, batch);
 }
 
 }  // namespace facetfit

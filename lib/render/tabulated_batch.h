@@ -11,6 +11,7 @@
 #include "model/coat.h"
 #include "model/smith.h"
 #include "render/shading_batch.h"
+#include "render/simd_targets.h"
 
 namespace facetfit {
 
@@ -38,10 +39,10 @@ struct TabulatedBatchModel {
 };
 
 // Fills the batch's r, g, b and pdf for its padded_size() pairs; zero where o or i is below the horizon.
-// `baseline`: the code for CPUs without AVX2, which the tests run too. Without `with_f`, pdf alone: the
+// `target`: which SIMD code runs (render/simd_targets.h; the tests run each). Without `with_f`, pdf alone: the
 // density of a model the lobe only samples (a measured table's fitted LUT).
-void eval_tabulated_batch(const TabulatedBatchModel& model, EvaluationBatch& batch, bool baseline = false, bool with_f = true);
+void eval_tabulated_batch(const TabulatedBatchModel& model, EvaluationBatch& batch, SimdTarget target = SimdTarget::best, bool with_f = true);
 // Fills the batch's i and found for its padded_size() entries (ShadingModel::sample_direction).
-void sample_tabulated_batch(const TabulatedBatchModel& model, SampleBatch& batch, bool baseline = false);
+void sample_tabulated_batch(const TabulatedBatchModel& model, SampleBatch& batch, SimdTarget target = SimdTarget::best);
 
 }  // namespace facetfit

@@ -54,10 +54,10 @@ struct Entry {
   V with_pdf, tfar, arriving_r, arriving_g, arriving_b, light_pdf, row;
 };
 // The lanes of mask bits m moved to the front, in order: Highway's CompressStore copies a 256-byte table
-// onto the stack at every call (hwy 1.0.3; perf: half of a render). A vector holds at most 4 doubles
+// onto the stack at every call (hwy 1.0.3; perf: half of a render). For vectors of at most 4 doubles
 // (AVX2; render/simd_targets.h).
 struct CompressTable {
-  std::int64_t index[16][4];
+  std::int64_t index[16][8];  // 8 wide, so that an AVX-512 vector's load stays inside (it does not use them)
 };
 constexpr CompressTable kCompress = [] {
   CompressTable t{};
@@ -74,17 +74,20 @@ constexpr CompressTable kCompress = [] {
 // compiles a lambda without the target's attributes, so it cannot inline the SIMD code and passes every
 // vector through memory.)
 struct ToFront {
+  M mask;
   decltype(hn::SetTableIndices(D(), static_cast<const std::int64_t*>(nullptr))) index;
   std::size_t at;
   HWY_INLINE void operator()(D d, V v, std::vector<double>& column) const {
-    hn::StoreU(hn::TableLookupLanes(v, index), d, column.data() + at);
+    if constexpr (hn::MaxLanes(D()) > 4)  // AVX-512 compresses itself
+      hn::CompressStore(v, mask, d, column.data() + at);
+    else
+      hn::StoreU(hn::TableLookupLanes(v, index), d, column.data() + at);
   }
 };
 HWY_INLINE ToFront to_front(D d, M m, std::size_t at) {
-  static_assert(hn::MaxLanes(D()) <= 4, "kCompress holds 4 lanes");
   std::uint8_t bits[8] = {};
   hn::StoreMaskBits(d, m, bits);
-  return {hn::SetTableIndices(d, kCompress.index[bits[0] & 15]), at};
+  return {m, hn::SetTableIndices(d, kCompress.index[bits[0] & 15]), at};
 }
 
 HWY_INLINE std::size_t append(D d, M m, const Entry& e, const Vec3V& origin, V tnear, ShadowBatch& out, std::size_t at) {
@@ -285,35 +288,24 @@ void ShadowValues(ShadowBatch& batch, const SlotRanges& ranges) {
 HWY_AFTER_NAMESPACE();
 
 #if HWY_ONCE
+#include "render/simd_dispatch.h"
 namespace facetfit {
 
-void place_hits(const TileHits& tile, const Vec3& camera, double eps, double material, const Vec3* tangent, HitBatch& out, bool baseline) {
-#if HWY_TARGETS & HWY_AVX2
-  if (!baseline && cpu_has_avx2()) return N_AVX2::PlaceHits(tile, camera, eps, material, tangent, out);
-#endif
-  HWY_STATIC_DISPATCH(PlaceHits)(tile, camera, eps, material, tangent, out);
+void place_hits(const TileHits& tile, const Vec3& camera, double eps, double material, const Vec3* tangent, HitBatch& out, SimdTarget target) {
+  FACETFIT_DISPATCH(target, PlaceHits, tile, camera, eps, material, tangent, out);
 }
 
 void light_slots(const HitBatch& hits, bool environment, const std::vector<LaneLight>& lights, double tnear, ShadowBatch& out,
-                 SlotRanges& ranges, SampleBatch& samples, bool baseline) {
-#if HWY_TARGETS & HWY_AVX2
-  if (!baseline && cpu_has_avx2()) return N_AVX2::LightSlots(hits, environment, lights, tnear, out, ranges, samples);
-#endif
-  HWY_STATIC_DISPATCH(LightSlots)(hits, environment, lights, tnear, out, ranges, samples);
+                 SlotRanges& ranges, SampleBatch& samples, SimdTarget target) {
+  FACETFIT_DISPATCH(target, LightSlots, hits, environment, lights, tnear, out, ranges, samples);
 }
 
-void brdf_slots(const HitBatch& hits, const SampleBatch& samples, const Rgb& radiance, double tnear, ShadowBatch& out, bool baseline) {
-#if HWY_TARGETS & HWY_AVX2
-  if (!baseline && cpu_has_avx2()) return N_AVX2::BrdfSlots(hits, samples, radiance, tnear, out);
-#endif
-  HWY_STATIC_DISPATCH(BrdfSlots)(hits, samples, radiance, tnear, out);
+void brdf_slots(const HitBatch& hits, const SampleBatch& samples, const Rgb& radiance, double tnear, ShadowBatch& out, SimdTarget target) {
+  FACETFIT_DISPATCH(target, BrdfSlots, hits, samples, radiance, tnear, out);
 }
 
-void shadow_values(ShadowBatch& batch, const SlotRanges& ranges, bool baseline) {
-#if HWY_TARGETS & HWY_AVX2
-  if (!baseline && cpu_has_avx2()) return N_AVX2::ShadowValues(batch, ranges);
-#endif
-  HWY_STATIC_DISPATCH(ShadowValues)(batch, ranges);
+void shadow_values(ShadowBatch& batch, const SlotRanges& ranges, SimdTarget target) {
+  FACETFIT_DISPATCH(target, ShadowValues, batch, ranges);
 }
 
 }  // namespace facetfit

@@ -14,6 +14,7 @@
 
 #include "render/shading_batch.h"
 #include "render/sphere_batch.h"
+#include "render/simd_targets.h"
 
 namespace facetfit {
 
@@ -65,7 +66,7 @@ struct HitBatch : Columns {
 // camera; the frame of core/frame.h about it (along `tangent` where given); o the direction toward the
 // camera in it; the shadow rays' origin p + eps n.
 void place_hits(const TileHits& tile, const Vec3& camera, double eps, double material, const Vec3* tangent, HitBatch& out,
-                bool baseline = false);
+                SimdTarget target = SimdTarget::best);
 
 // A light as the lanes read it: directional (vector toward it) or a point (its position), and what it
 // sends (irradiance, or intensity at unit distance).
@@ -108,16 +109,16 @@ struct SlotRanges {
 // the BRDF samples to draw (`environment`), one per hit.
 // The shadow rays start at the hits' origins and ignore what lies nearer than `tnear`.
 void light_slots(const HitBatch& hits, bool environment, const std::vector<LaneLight>& lights, double tnear, ShadowBatch& out,
-                 SlotRanges& ranges, SampleBatch& samples, bool baseline = false);
+                 SlotRanges& ranges, SampleBatch& samples, SimdTarget target = SimdTarget::best);
 
 // Appends the BRDF samples found (`samples`, drawn for `hits`) as evaluations with their world directions,
 // arriving `radiance` at density 1 / 4 pi: a constant environment's (the caller replaces both under a map).
 void brdf_slots(const HitBatch& hits, const SampleBatch& samples, const Rgb& radiance, double tnear, ShadowBatch& out,
-                bool baseline = false);
+                SimdTarget target = SimdTarget::best);
 
 // The value of each entry's shadow ray from its evaluation (ShadowBatch::r, g, b, pdf), as the one-hit
 // path computes it: multiple importance sampling by the power heuristic for the environment's light and
 // BRDF samples, a light's value times the cosine; casts 0 for a BRDF sample of zero density.
-void shadow_values(ShadowBatch& batch, const SlotRanges& ranges, bool baseline = false);
+void shadow_values(ShadowBatch& batch, const SlotRanges& ranges, SimdTarget target = SimdTarget::best);
 
 }  // namespace facetfit
