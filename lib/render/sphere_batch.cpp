@@ -6,11 +6,13 @@
 #include <hwy/foreach_target.h>  // before highway.h
 
 #include <hwy/highway.h>
+#include <hwy/contrib/math/math-inl.h>
 
 #include <algorithm>
 #include <cstdint>
 #include <limits>
 
+#include "render/lanes-inl.h"
 #include "render/sphere_batch.h"
 
 HWY_BEFORE_NAMESPACE();
@@ -20,8 +22,8 @@ namespace hn = hwy::HWY_NAMESPACE;
 
 namespace {
 
-using D = hn::ScalableTag<double>;
-using V = hn::Vec<D>;
+using lanes::D;
+using lanes::V;
 
 struct RayV {
   V ox, oy, oz, dx, dy, dz, tnear, tfar;

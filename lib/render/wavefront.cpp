@@ -6,10 +6,12 @@
 #include <hwy/foreach_target.h>  // before highway.h
 
 #include <hwy/highway.h>
+#include <hwy/contrib/math/math-inl.h>
 
 #include <cstdint>
 #include <limits>
 
+#include "render/lanes-inl.h"
 #include "render/wavefront.h"
 
 HWY_BEFORE_NAMESPACE();
@@ -19,8 +21,8 @@ namespace hn = hwy::HWY_NAMESPACE;
 
 namespace {
 
-using D = hn::ScalableTag<double>;
-using V = hn::Vec<D>;
+using lanes::D;
+using lanes::V;
 using M = hn::Mask<D>;
 
 struct Vec3V {
