@@ -377,7 +377,7 @@ TEST(Wavefront, HitsAndSlotsEqualTheOneHitPath) {
           if (o.z > 0.0 && il.z > 0.0 && tile.light_pdf[k] > 0.0) {
             const std::size_t e = env_entries++;
             ASSERT_LT(e, ranges.lights_begin) << where;
-            EXPECT_EQ(slots.row[e], double(row)) << where;
+            EXPECT_EQ(slots.owner[e], double(k)) << where;
             EXPECT_TRUE(close(slots.iz[e], il.z) && close(slots.rays.dx[e], l.x) && close(slots.rays.ox[e], origin.x)) << where;
             EXPECT_EQ(slots.rays.tnear[e], eps) << where;
             EXPECT_TRUE(std::isinf(slots.rays.tfar[e])) << where;
@@ -394,7 +394,7 @@ TEST(Wavefront, HitsAndSlotsEqualTheOneHitPath) {
             if (!(i.z > 0.0 && o.z > 0.0)) continue;
             const std::size_t e = ranges.light_begin[j] + light_entries[j]++;
             ASSERT_LT(e, j + 1 < lights.size() ? ranges.light_begin[j + 1] : ranges.brdf_begin) << where;
-            EXPECT_EQ(slots.row[e], double(row)) << where;
+            EXPECT_EQ(slots.owner[e], double(k)) << where;
             EXPECT_TRUE(close(slots.iz[e], i.z) && close(slots.rays.dy[e], d.y) && close(slots.arriving_r[e], light.r * falloff)) << where;
             EXPECT_TRUE(light.directional ? std::isinf(slots.rays.tfar[e]) : close(slots.rays.tfar[e], dist)) << where;
           }

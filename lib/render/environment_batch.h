@@ -19,6 +19,11 @@ struct SphereSampleBatch : Columns {
     u1[k] = a, u2[k] = b;
     return k;
   }
+  // n entries, whose inputs the caller writes in place.
+  void resize_to(std::size_t n) {
+    ensure(n, [this](std::size_t m) { resize({&u1, &u2, &x, &y, &z}, m, 0.5); });
+    set_size(n);
+  }
   Vec3 d(std::size_t k) const { return {x[k], y[k], z[k]}; }
 };
 

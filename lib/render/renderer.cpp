@@ -368,8 +368,8 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
       std::copy_n(samples.dz.begin(), padded, cameras.dz.begin());
       tracer.intersect(cameras, hits, true);
       if (sphere_lanes) {
-        light_samples.clear();
-        for (std::size_t k = 0; k < n; ++k) light_samples.push(samples.u[2][k], samples.u[3][k]);
+        light_samples.resize_to(n);
+        std::copy_n(samples.u[2].begin(), padded, light_samples.u1.begin()), std::copy_n(samples.u[3].begin(), padded, light_samples.u2.begin());
         sample_uniform_sphere_batch(light_samples);
       }
       rays.clear(), values.clear();
@@ -449,7 +449,7 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
         const auto add = [&](std::size_t begin, std::size_t end) {
           for (std::size_t e = begin; e < end; ++e)
             if (b.casts[e] != 0.0 && !w.blocked[e])
-              planned[std::size_t(w.hits.owner[std::size_t(b.row[e])])].radiance += Rgb(b.value_r[e], b.value_g[e], b.value_b[e]);
+              planned[std::size_t(b.owner[e])].radiance += Rgb(b.value_r[e], b.value_g[e], b.value_b[e]);
         };
         add(0, w.ranges.lights_begin);
         add(w.ranges.brdf_begin, b.size());

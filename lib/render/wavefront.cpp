@@ -50,10 +50,10 @@ FrameV frame_at(D d, const HitBatch& h, std::size_t k) {
 
 // Appends the lanes of `m` as entries of `out` from position `at`: one evaluation (o, i, with_pdf) and
 // its shadow ray (origin, direction, tnear, length), the arriving radiance, the environment density and the
-// hit's row. Returns the count.
+// pixel it lights (the hit's owner). Returns the count.
 struct Entry {
   Vec3V o, i, d;
-  V with_pdf, tfar, arriving_r, arriving_g, arriving_b, light_pdf, row;
+  V with_pdf, tfar, arriving_r, arriving_g, arriving_b, light_pdf, owner;
 };
 // The lanes of mask bits m moved to the front, in order: Highway's CompressStore copies a 256-byte table
 // onto the stack at every call (hwy 1.0.3; perf: half of a render). For vectors of at most 4 doubles
@@ -100,7 +100,7 @@ HWY_INLINE std::size_t append(D d, M m, const Entry& e, const Vec3V& origin, V t
   put(d, e.d.x, out.rays.dx), put(d, e.d.y, out.rays.dy), put(d, e.d.z, out.rays.dz), put(d, tnear, out.rays.tnear);
   put(d, e.tfar, out.rays.tfar);
   put(d, e.arriving_r, out.arriving_r), put(d, e.arriving_g, out.arriving_g), put(d, e.arriving_b, out.arriving_b);
-  put(d, e.light_pdf, out.light_pdf), put(d, e.row, out.row);
+  put(d, e.light_pdf, out.light_pdf), put(d, e.owner, out.owner);
   return hn::CountTrue(d, m);
 }
 
@@ -196,7 +196,7 @@ void LightSlots(const HitBatch& hits, bool environment, const std::vector<LaneLi
       const M lit = hn::And(real(d, k, hits.size()), hn::And(o.z > zero, hn::And(il.z > zero, pdf > zero)));
       size += append(d, lit,
                      {o, il, l, one, infinity, load(d, hits.light_r, k), load(d, hits.light_g, k), load(d, hits.light_b, k), pdf,
-                      hn::Iota(d, double(k))},
+                      load(d, hits.owner, k)},
                      origin_at(d, hits, k), hn::Set(d, tnear), out, size);
     }
   ranges.lights_begin = size;
@@ -208,7 +208,7 @@ void LightSlots(const HitBatch& hits, bool environment, const std::vector<LaneLi
     for (std::size_t k = 0; k < n; k += lanes) {
       const FrameV frame = frame_at(d, hits, k);
       const Vec3V o{load(d, hits.ox, k), load(d, hits.oy, k), load(d, hits.oz, k)};
-      Entry e{o, {}, {vx, vy, vz}, zero, infinity, r, g, b, zero, hn::Iota(d, double(k))};
+      Entry e{o, {}, {vx, vy, vz}, zero, infinity, r, g, b, zero, load(d, hits.owner, k)};
       if (!light.directional) {
         // Toward the point from the hit, its irradiance falling as the squared distance, the ray stopping
         // just short of it.
@@ -249,7 +249,7 @@ void BrdfSlots(const HitBatch& hits, const SampleBatch& samples, const Rgb& radi
     const Vec3V o{load(d, samples.ox, k), load(d, samples.oy, k), load(d, samples.oz, k)};
     const Vec3V i{load(d, samples.ix, k), load(d, samples.iy, k), load(d, samples.iz, k)};
     const M found = hn::And(real(d, k, hits.size()), load(d, samples.found, k) != zero);
-    size += append(d, found, {o, i, frame.to_world(i), one, infinity, r, g, b, pdf, hn::Iota(d, double(k))}, origin_at(d, hits, k),
+    size += append(d, found, {o, i, frame.to_world(i), one, infinity, r, g, b, pdf, load(d, hits.owner, k)}, origin_at(d, hits, k),
                    hn::Set(d, tnear), out, size);
   }
   out.set_size(size);

@@ -79,18 +79,18 @@ struct LaneLight {
 // The evaluations the slots need (the EvaluationBatch a material's eval() fills) and, per evaluation, its
 // shadow ray (from the hit's shadow-ray origin along the world direction, up to the light), the radiance
 // arriving along it if nothing blocks it, the environment's density of the direction (0 for a light) and
-// the hit it belongs to (its row in the HitBatch). Afterwards value (r, g, b) and whether the slot casts
-// a ray at all.
+// the pixel it lights (its hit's owner). Afterwards value (r, g, b) and whether the slot casts a ray at
+// all.
 struct ShadowBatch : EvaluationBatch {
   RayBatch rays;
-  std::vector<double> arriving_r, arriving_g, arriving_b, light_pdf, row;
+  std::vector<double> arriving_r, arriving_g, arriving_b, light_pdf, owner;
   std::vector<double> value_r, value_g, value_b, casts;
   // Room for n entries written in place by the lanes; size() stays.
   void reserve(std::size_t n) {
     rays.reserve(n);
     ensure(n, [this](std::size_t m) {
       grow(m);
-      resize({&arriving_r, &arriving_g, &arriving_b, &light_pdf, &row, &value_r, &value_g, &value_b, &casts}, m, 0.0);
+      resize({&arriving_r, &arriving_g, &arriving_b, &light_pdf, &owner, &value_r, &value_g, &value_b, &casts}, m, 0.0);
     });
   }
   void set_size(std::size_t n) { Columns::set_size(n), rays.set_size(n); }
