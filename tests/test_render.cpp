@@ -535,6 +535,53 @@ TEST(Shading, GgxInSimdLanesEqualsOnePairAtATime) {
   EXPECT_GT(refused, 1000);
 }
 
+// A Lambertian surface in lanes (render/lambert_batch.h) on every SIMD target, against ShadingModel's
+// one pair at a time: f, density and cosine sampling, views and lights on both sides of the horizon.
+TEST(Shading, LambertInSimdLanesEqualsOnePairAtATime) {
+  const Rgb albedo(0.5, 0.3, 0.1);
+  const ShadingModel model(std::make_shared<LambertBrdf>(albedo), nullptr);
+  ASSERT_TRUE(model.has_lanes());
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const auto direction = [&] {
+    const double z = 2.0 * u(rng) - 1.0, phi = 2.0 * kPi * u(rng), r = std::sqrt(std::max(0.0, 1.0 - z * z));
+    return Vec3(r * std::cos(phi), r * std::sin(phi), z);
+  };
+  EvaluationBatch pairs;
+  SampleBatch draws;
+  for (int k = 0; k < 203; ++k) {
+    const Vec3 o = direction();
+    pairs.push(o, direction());
+    draws.push(o, u(rng), u(rng), u(rng));
+  }
+  EvaluationBatch reference = pairs;
+  model.eval(reference, false);
+  SampleBatch one_by_one = draws;
+  model.sample_directions(one_by_one, false);
+  int found = 0, lit = 0;
+  for (const SimdTarget target : kSimdTargets) {
+    EvaluationBatch lanes = pairs;
+    eval_lambert_batch(albedo, lanes, target);
+    SampleBatch drawn = draws;
+    sample_lambert_batch(drawn, target);
+    for (std::size_t k = 0; k < pairs.size(); ++k) {
+      EXPECT_EQ(lanes.r[k], reference.r[k]) << simd_target_name(target) << " pair " << k;
+      EXPECT_EQ(lanes.b[k], reference.b[k]) << simd_target_name(target) << " pair " << k;
+      EXPECT_EQ(lanes.pdf[k], reference.pdf[k]) << simd_target_name(target) << " pair " << k;
+      lit += reference.r[k] > 0.0;
+      ASSERT_EQ(drawn.found[k], one_by_one.found[k]) << simd_target_name(target) << " sample " << k;
+      if (!one_by_one.found[k]) continue;
+      ++found;
+      for (const auto& [a, b] : {std::pair{drawn.ix[k], one_by_one.ix[k]}, {drawn.iy[k], one_by_one.iy[k]}, {drawn.iz[k], one_by_one.iz[k]}})
+        EXPECT_NEAR(a, b, 1e-12) << simd_target_name(target) << " sample " << k;
+    }
+  }
+  // Both sides of the horizon were compared.
+  EXPECT_GT(found, 3 * 60);
+  EXPECT_LT(found, 3 * 150);
+  EXPECT_GT(lit, 3 * 25);
+}
+
 TEST(Shading, TabulatedInSimdLanesEqualsOnePairAtATime) {
   // Every term the tabulated kernel holds (render/tabulated_batch.h): D's spline from a peak a node wide to
   // a flat lobe (GGX 0.005 to 1.5 and Beckmann tabulated), G1's table under the three Smith forms, the

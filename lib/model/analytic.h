@@ -31,6 +31,7 @@ class LambertBrdf final : public Brdf {
  public:
   explicit LambertBrdf(const Rgb& albedo) : albedo_(albedo) {}
   std::optional<Rgb> eval(const Vec3& o, const Vec3& i) const override;
+  const Rgb& albedo() const { return albedo_; }
 
  private:
   Rgb albedo_;

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "io/merl.h"
+#include "model/analytic.h"
 #include "model/ndf.h"
 #include "model/parametric.h"
 #include "model/tabulated.h"
@@ -36,6 +37,7 @@ ShadingModel::ShadingModel(std::shared_ptr<const Brdf> brdf, std::shared_ptr<con
     tabulated_f_ = brdf_.get() == static_cast<const Brdf*>(tabulated);
     if (const auto* table = dynamic_cast<const MerlTable*>(brdf_.get())) merl_batch_model_ = MerlBatchModel::of(*table);
   }
+  if (const auto* lambert = dynamic_cast<const LambertBrdf*>(brdf_.get()); lambert && lobe_weight_ == 0.0) lambert_albedo_ = lambert->albedo();
 }
 
 Rgb ShadingModel::f(const Vec3& o, const Vec3& i) const {
@@ -64,6 +66,7 @@ ShadingModel::Evaluation ShadingModel::eval(const Vec3& o, const Vec3& i) const 
 
 void ShadingModel::eval(EvaluationBatch& batch, bool simd) const {
   if (simd && batch_model_) return eval_ggx_batch(*batch_model_, batch);
+  if (simd && lambert_albedo_) return eval_lambert_batch(*lambert_albedo_, batch);
   if (simd && tabulated_batch_model_) {
     eval_tabulated_batch(*tabulated_batch_model_, batch, SimdTarget::best, tabulated_f_);
     if (tabulated_f_) return;
@@ -82,6 +85,7 @@ void ShadingModel::eval(EvaluationBatch& batch, bool simd) const {
 
 void ShadingModel::sample_directions(SampleBatch& batch, bool simd) const {
   if (simd && batch_model_) return sample_ggx_batch(*batch_model_, batch);
+  if (simd && lambert_albedo_) return sample_lambert_batch(batch);
   if (simd && tabulated_batch_model_) return sample_tabulated_batch(*tabulated_batch_model_, batch);
   for (std::size_t k = 0; k < batch.size(); ++k) {
     const auto i = sample_direction(batch.o(k), batch.u1[k], batch.u2[k], batch.u3[k]);

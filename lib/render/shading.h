@@ -13,6 +13,7 @@
 #include "model/ndf.h"
 #include "model/proposal.h"
 #include "render/ggx_batch.h"
+#include "render/lambert_batch.h"
 #include "render/merl_batch.h"
 #include "render/shading_batch.h"
 #include "render/tabulated_batch.h"
@@ -49,7 +50,7 @@ class ShadingModel {
   const std::optional<TabulatedBatchModel>& tabulated_batch_model() const { return tabulated_batch_model_; }
   // Whether eval(EvaluationBatch&) and sample_directions() run in lanes (wholly or in part): a batch then
   // costs less than the pairs one by one.
-  bool has_lanes() const { return batch_model_ || tabulated_batch_model_; }
+  bool has_lanes() const { return batch_model_ || tabulated_batch_model_ || lambert_albedo_; }
 
   using Sample = BrdfSample;
   std::optional<Sample> sample(const Vec3& o, double u1, double u2, double u3) const;
@@ -76,6 +77,7 @@ class ShadingModel {
   std::optional<TabulatedBatchModel> tabulated_batch_model_;
   bool tabulated_f_ = false;
   std::optional<MerlBatchModel> merl_batch_model_;  // f of a MERL-layout table under a tabulated proposal
+  std::optional<Rgb> lambert_albedo_;  // a Lambertian surface sampled by the cosine alone (render/lambert_batch.h)
 };
 
 }  // namespace facetfit
