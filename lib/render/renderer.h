@@ -17,8 +17,9 @@ struct RenderSettings {
   int spp = 0;                // 0: the scene's
   std::uint64_t seed = 0;     // 0: the scene's
   int passes = 4;             // samples are added in passes (progressive), each over the whole image
-  // Rays traced as streams, a tile at a time (render/tracer.h); false: one ray at a time (the same image,
-  // the reference the stream path is tested against).
+  // A tile at a time: rays as streams (render/tracer.h, render/sphere_batch.h) and shading in SIMD lanes
+  // (render/wavefront.h); false: one ray and one evaluation at a time (the same image, the reference the
+  // stream path is tested against).
   bool ray_streams = true;
   // Bytes the image buffers and the environment map may take together (core/memory_budget.h); 0: half of
   // the machine's memory. A scene over it is refused before anything is allocated.
