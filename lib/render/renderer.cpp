@@ -326,6 +326,9 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
     std::vector<char> present;  // per material: whether the lanes shade some hit of this sample index
   };
   tbb::enumerable_thread_specific<TileSpace> tile_spaces;
+  // A constant environment's radiance and density in every direction (the lanes' environment light and
+  // BRDF samples take them); zero otherwise, where the lanes' BRDF samples look the map up.
+  const Environment::Sample constant_light = env && env->is_constant() ? env->lookup(Vec3(0.0, 0.0, 1.0)) : Environment::Sample{Vec3(0.0), Rgb(0.0), 0.0};
   // Every pixel of the tile at once, one sample index after the other: camera rays, shading, then shadow
   // rays, as streams (Embree's for triangles; coherent camera rays travel together) and evaluations in
   // batches.
@@ -362,6 +365,14 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
     CameraSampleBatch& samples = space.samples;
     samples.clear();
     for (int k = 0; k < count; ++k) samples.push(tile.cols().begin() + k % tw, tile.rows().begin() + k / tw);
+    tile_hits.resize_to(n);
+    if (sphere_lanes) {
+      // A constant environment's radiance and density, the same for every light sample of the tile.
+      std::fill_n(tile_hits.light_pdf.begin(), padded, constant_light.pdf);
+      std::fill_n(tile_hits.light_r.begin(), padded, constant_light.radiance.r);
+      std::fill_n(tile_hits.light_g.begin(), padded, constant_light.radiance.g);
+      std::fill_n(tile_hits.light_b.begin(), padded, constant_light.radiance.b);
+    }
     for (int s = first; s < last; ++s) {
       camera_sample_batch(camera, seed, s, samples);
       std::copy_n(samples.dx.begin(), padded, cameras.dx.begin()), std::copy_n(samples.dy.begin(), padded, cameras.dy.begin());
@@ -375,7 +386,6 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
       rays.clear(), values.clear();
       // Each pixel's hit: shaded here one at a time where its material has no lanes, otherwise given to
       // the lanes in the tile's columns.
-      tile_hits.resize_to(n);
       std::fill(present.begin(), present.end(), char(0));
       for (std::size_t k = 0; k < n; ++k) {
         Planned& pk = planned[k];
@@ -406,14 +416,9 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
       std::copy_n(samples.dz.begin(), padded, tile_hits.dz.begin());
       std::copy_n(samples.u[4].begin(), padded, tile_hits.u1.begin()), std::copy_n(samples.u[5].begin(), padded, tile_hits.u2.begin());
       std::copy_n(samples.u[6].begin(), padded, tile_hits.u3.begin());
-      if (sphere_lanes) {
-        // A constant environment's radiance and density; its directions drawn in lanes above.
-        const Environment::Sample constant = env->lookup(Vec3(0.0, 0.0, 1.0));
+      if (sphere_lanes) {  // its directions, drawn in lanes above
         std::copy_n(light_samples.x.begin(), padded, tile_hits.lx.begin()), std::copy_n(light_samples.y.begin(), padded, tile_hits.ly.begin());
         std::copy_n(light_samples.z.begin(), padded, tile_hits.lz.begin());
-        std::fill_n(tile_hits.light_pdf.begin(), padded, constant.pdf);
-        std::fill_n(tile_hits.light_r.begin(), padded, constant.radiance.r), std::fill_n(tile_hits.light_g.begin(), padded, constant.radiance.g);
-        std::fill_n(tile_hits.light_b.begin(), padded, constant.radiance.b);
       }
       for (std::size_t m = 0; m < materials.size(); ++m) {
         if (present[m])
@@ -428,7 +433,7 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
         if (env) {
           materials[m]->sample_directions(w.samples, true);
           const std::size_t brdf_begin = w.shadows.size();
-          brdf_slots(w.hits, w.samples, sphere_lanes ? env->lookup(Vec3(0.0, 0.0, 1.0)).radiance : Rgb(0.0), eps, w.shadows);
+          brdf_slots(w.hits, w.samples, constant_light.radiance, eps, w.shadows);
           if (!sphere_lanes)
             for (std::size_t e = brdf_begin; e < w.shadows.size(); ++e) {
               const Environment::Sample ls = env->lookup({w.shadows.rays.dx[e], w.shadows.rays.dy[e], w.shadows.rays.dz[e]});

@@ -2,12 +2,13 @@
 
 #include <hwy/highway.h>
 
+#include <cstdlib>
+
 #if HWY_ARCH_X86
 #include <cpuid.h>
 #endif
 
 static_assert(HWY_DISABLED_TARGETS == (HWY_AVX3_DL | HWY_SSE4 | HWY_SSSE3), "Highway's target bits moved");
-#include <cstdlib>
 
 namespace facetfit {
 

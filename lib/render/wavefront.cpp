@@ -48,9 +48,7 @@ FrameV frame_at(D d, const HitBatch& h, std::size_t k) {
           {load(d, h.nx, k), load(d, h.ny, k), load(d, h.nz, k)}};
 }
 
-// Appends the lanes of `m` as entries of `out` from position `at`: one evaluation (o, i, with_pdf) and
-// its shadow ray (origin, direction, tnear, length), the arriving radiance, the environment density and the
-// pixel it lights (the hit's owner). Returns the count.
+// One slot per lane, before compaction.
 struct Entry {
   Vec3V o, i, d;
   V with_pdf, tfar, arriving_r, arriving_g, arriving_b, light_pdf, owner;
@@ -72,9 +70,7 @@ constexpr CompressTable kCompress = [] {
 }();
 
 // Stores vectors with the lanes of a mask moved to the front, from position `at` of a column: a whole
-// vector is written, the columns have room past their entries. (Functions and structs, not lambdas: GCC
-// compiles a lambda without the target's attributes, so it cannot inline the SIMD code and passes every
-// vector through memory.)
+// vector is written, the columns have room past their entries.
 struct ToFront {
   M mask;
   decltype(hn::SetTableIndices(D(), static_cast<const std::int64_t*>(nullptr))) index;
@@ -92,6 +88,9 @@ HWY_INLINE ToFront to_front(D d, M m, std::size_t at) {
   return {m, hn::SetTableIndices(d, kCompress.index[bits[0] & 15]), at};
 }
 
+// Appends the lanes of `m` as entries of `out` from position `at`: one evaluation (o, i, with_pdf) and
+// its shadow ray (origin, direction, tnear, length), the arriving radiance, the environment density and the
+// pixel it lights (the hit's owner). Returns the count.
 HWY_INLINE std::size_t append(D d, M m, const Entry& e, const Vec3V& origin, V tnear, ShadowBatch& out, std::size_t at) {
   const ToFront put = to_front(d, m, at);
   put(d, e.o.x, out.ox), put(d, e.o.y, out.oy), put(d, e.o.z, out.oz);
@@ -110,8 +109,6 @@ HWY_INLINE M real(D d, std::size_t k, std::size_t count) { return hn::Iota(d, do
 
 HWY_INLINE V power_heuristic(V a, V b) { return (a * a) / (a * a + b * b); }
 
-}  // namespace
-
 HWY_INLINE V dot(const Vec3V& a, const Vec3V& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
 
 // glm::normalize: v times the reciprocal of its length.
@@ -119,6 +116,8 @@ HWY_INLINE Vec3V normalize(D d, const Vec3V& v) {
   const V inv = hn::Set(d, 1.0) / hn::Sqrt(dot(v, v));
   return {v.x * inv, v.y * inv, v.z * inv};
 }
+
+}  // namespace
 
 void PlaceHits(const TileHits& tile, const Vec3& camera, double eps, double material, const Vec3* tangent, HitBatch& out) {
   const D d;
