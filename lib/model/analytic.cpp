@@ -3,7 +3,7 @@
 namespace facetfit {
 
 std::optional<Rgb> MicrofacetBrdf::eval(const Vec3& o, const Vec3& i) const {
-  if (i.z <= 0.0 || o.z <= 0.0) return Rgb(0.0);
+  if (!above_horizon(o, i)) return Rgb(0.0);
   const Vec3 h = glm::normalize(i + o);
   const double g2 = smith_g2(smith_, ndf_.lambda(o), ndf_.lambda(i));
   const double scalar = ndf_.D(h) * g2 / (4.0 * i.z * o.z);

@@ -23,7 +23,7 @@ struct Coat {
   bool present() const { return alpha > 0.0 && f0 > 0.0; }
   // f(o, i) of the coat alone, the same in R, G and B.
   double eval(const Vec3& o, const Vec3& i) const {
-    if (!present() || i.z <= 0.0 || o.z <= 0.0) return 0.0;
+    if (!present() || !above_horizon(o, i)) return 0.0;
     const Vec3 h = glm::normalize(i + o);
     const Ndf ndf = Ndf::isotropic(NdfType::ggx, alpha);
     const double f = fresnel_schlick(Rgb(f0), clamp(glm::dot(i, h), 0.0, 1.0)).r;

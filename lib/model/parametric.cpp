@@ -7,7 +7,7 @@
 namespace facetfit {
 
 std::optional<Rgb> ParametricBrdf::eval(const Vec3& o, const Vec3& i) const {
-  if (i.z <= 0.0 || o.z <= 0.0) return Rgb(0.0);
+  if (!above_horizon(o, i)) return Rgb(0.0);
   const Vec3 h = glm::normalize(i + o);
   return eval_with(o, i, h, ndf_.D(h), ndf_.lambda(o));
 }

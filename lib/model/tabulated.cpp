@@ -89,7 +89,7 @@ double TabulatedMicrofacet::g1(const Vec3& w) const {
 Rgb TabulatedMicrofacet::fresnel(double cos_d) const { return shared_->tables.fresnel.eval(std::acos(clamp(cos_d, 0.0, 1.0))); }
 
 std::optional<Rgb> TabulatedMicrofacet::eval(const Vec3& o, const Vec3& i) const {
-  if (i.z <= 0.0 || o.z <= 0.0) return Rgb(0.0);
+  if (!above_horizon(o, i)) return Rgb(0.0);
   const Vec3 h = glm::normalize(i + o);
   const double g2 = smith_g2_from_g1(shared_->tables.smith, g1(o), g1(i));
   return shared_->tables.body * kInvPi + fresnel(glm::dot(i, h)) * (D(h) * g2 / (4.0 * i.z * o.z)) + Rgb(shared_->tables.coat.eval(o, i));

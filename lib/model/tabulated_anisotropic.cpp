@@ -106,7 +106,7 @@ double TabulatedAnisotropic::lambda(const Vec3& w) const {
 }
 
 std::optional<Rgb> TabulatedAnisotropic::eval(const Vec3& o, const Vec3& i) const {
-  if (o.z <= 0.0 || i.z <= 0.0) return Rgb(0.0);
+  if (!above_horizon(o, i)) return Rgb(0.0);
   const Vec3 h = glm::normalize(o + i);
   const double g2 = smith_g2(shared_->tables.smith, lambda(o), lambda(i));
   return shared_->tables.fresnel.eval(std::acos(clamp(glm::dot(o, h), 0.0, 1.0))) * (D(h) * g2 / (4.0 * o.z * i.z));

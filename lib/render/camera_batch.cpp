@@ -6,8 +6,10 @@
 #include <hwy/foreach_target.h>  // before highway.h
 
 #include <hwy/highway.h>
+#include <hwy/contrib/math/math-inl.h>
 
 #include "render/camera_batch.h"
+#include "render/lanes-inl.h"
 
 HWY_BEFORE_NAMESPACE();
 namespace facetfit {
@@ -60,7 +62,7 @@ void DrawCameraSamples(const PinholeCamera& camera, std::uint64_t seed, int s, C
     const auto x = hn::Set(d, camera.forward.x) + sx * hn::Set(d, camera.right.x) + sy * hn::Set(d, camera.up.x);
     const auto y = hn::Set(d, camera.forward.y) + sx * hn::Set(d, camera.right.y) + sy * hn::Set(d, camera.up.y);
     const auto z = hn::Set(d, camera.forward.z) + sx * hn::Set(d, camera.right.z) + sy * hn::Set(d, camera.up.z);
-    const auto inv_len = one / hn::Sqrt(x * x + y * y + z * z);
+    const auto inv_len = lanes::inverse_sqrt(d, x * x + y * y + z * z);
     hn::StoreU(x * inv_len, d, batch.dx.data() + k);
     hn::StoreU(y * inv_len, d, batch.dy.data() + k);
     hn::StoreU(z * inv_len, d, batch.dz.data() + k);

@@ -47,19 +47,19 @@ void EvalGgxBatch(const GgxBatchModel& model, EvaluationBatch& batch) {
     const auto above = hn::And(iz > zero, oz > zero);
     // h = normalize(i + o)
     V hx = ix + ox, hy = iy + oy, hz = iz + oz;
-    const V inv_len = one / hn::Sqrt(hx * hx + hy * hy + hz * hz);
+    const V inv_len = lanes::inverse_sqrt(d, hx * hx + hy * hy + hz * hz);
     hx = hx * inv_len, hy = hy * inv_len, hz = hz * inv_len;
-    const V dh = lanes::ggx_ndf(hx, hy, hz, a2, a2, d_numerator);
+    const V dh = lanes::ggx_ndf(d, hx, hy, hz, a2, a2, d_numerator);
     const V lambda_o = lanes::ggx_lambda(d, ox, oy, oz, a2, a2), lambda_i = lanes::ggx_lambda(d, ix, iy, iz, a2, a2);
     V g2;
     switch (model.smith) {
-      case Smith::masking: g2 = one / (one + hn::Max(lambda_i, lambda_o)); break;
-      case Smith::correlated: g2 = one / (one + lambda_i + lambda_o); break;
-      case Smith::separable: g2 = one / ((one + lambda_i) * (one + lambda_o)); break;
+      case Smith::masking: g2 = lanes::reciprocal(d, one + hn::Max(lambda_i, lambda_o)); break;
+      case Smith::correlated: g2 = lanes::reciprocal(d, one + lambda_i + lambda_o); break;
+      case Smith::separable: g2 = lanes::reciprocal(d, (one + lambda_i) * (one + lambda_o)); break;
     }
     const V four_cos = hn::Set(d, 4.0) * iz * oz;
     const V cos_d = hn::Min(hn::Max(ix * hx + iy * hy + iz * hz, zero), one);
-    const V specular = dh * g2 / four_cos;
+    const V specular = lanes::divide(d, dh * g2, four_cos);
     V fresnel[3];
     if (model.curve) {
       lanes::fresnel_curve(d, model.curve, cos_d, fresnel);
@@ -75,8 +75,10 @@ void EvalGgxBatch(const GgxBatchModel& model, EvaluationBatch& batch) {
       const lanes::CoatTerms terms = lanes::coat_terms(d, model.coat, ox, oy, oz, ix, iy, iz, hx, hy, hz, cos_d, four_cos, o_faces_h);
       coat_f = terms.f, coat_pdf = terms.pdf;
     }
-    for (int c = 0; c < 3; ++c) hn::StoreU(hn::IfThenElseZero(above, body[c] + fresnel[c] * specular + coat_f), d, out[c] + k);
-    const V lobe_pdf = hn::IfThenElseZero(o_faces_h, (one / (one + lambda_o)) * dh / (hn::Set(d, 4.0) * oz));
+    // f where cos(theta_i) cos(theta_o) does not underflow (above_horizon, core/vec.h)
+    const auto formed = hn::And(above, iz * oz > zero);
+    for (int c = 0; c < 3; ++c) hn::StoreU(hn::IfThenElseZero(formed, body[c] + fresnel[c] * specular + coat_f), d, out[c] + k);
+    const V lobe_pdf = hn::IfThenElseZero(o_faces_h, lanes::divide(d, dh, (one + lambda_o) * hn::Set(d, 4.0) * oz));
     hn::StoreU(hn::IfThenElseZero(above, lanes::mixture_density(d, model.weights, coat, lobe_pdf, coat_pdf, iz)), d, batch.pdf.data() + k);
   }
 }

@@ -27,7 +27,7 @@ V atan2(D d, V y, V x) {
   const V ax = hn::Abs(x), ay = hn::Abs(y);
   const auto steep = ay > ax;
   const V num = hn::IfThenElse(steep, ax, ay), den = hn::IfThenElse(steep, ay, ax);
-  V a = hn::IfThenElseZero(den > hn::Zero(d), hn::Atan(d, num / hn::IfThenElse(den > hn::Zero(d), den, hn::Set(d, 1.0))));
+  V a = hn::IfThenElseZero(den > hn::Zero(d), hn::Atan(d, lanes::divide(d, num, hn::IfThenElse(den > hn::Zero(d), den, hn::Set(d, 1.0)))));
   a = hn::IfThenElse(steep, hn::Set(d, 0.5 * kPi) - a, a);
   a = hn::IfThenElse(x < hn::Zero(d), hn::Set(d, kPi) - a, a);
   return hn::CopySign(a, y);
@@ -62,6 +62,7 @@ void EvalMerlBatch(const MerlBatchModel& model, EvaluationBatch& batch) {
     V hx = ix + ox, hy = iy + oy, hz = iz + oz;
     const V len = hn::Sqrt(hx * hx + hy * hy + hz * hz);
     const auto long_enough = len > hn::Set(d, 1e-12);
+    // Divided, as halfdiff does: sqrt(theta_h) indexes the table, and near the pole the last bit of h moves it.
     const V safe_len = hn::IfThenElse(long_enough, len, one);
     hx = hn::IfThenElseZero(long_enough, hx / safe_len), hy = hn::IfThenElseZero(long_enough, hy / safe_len);
     hz = hn::IfThenElse(long_enough, hz / safe_len, one);
@@ -69,8 +70,8 @@ void EvalMerlBatch(const MerlBatchModel& model, EvaluationBatch& batch) {
     const V theta_h = hn::Acos(d, ct);
     const V r = hn::Sqrt(hx * hx + hy * hy);
     const auto turned = r > zero;
-    const V safe_r = hn::IfThenElse(turned, r, one);
-    const V c = hn::IfThenElse(turned, hx / safe_r, one), s = hn::IfThenElseZero(turned, hy / safe_r);
+    const V inv_r = lanes::reciprocal(d, hn::IfThenElse(turned, r, one));
+    const V c = hn::IfThenElse(turned, hx * inv_r, one), s = hn::IfThenElseZero(turned, hy * inv_r);
     const V tx = c * ix + s * iy, ty = hn::Neg(s) * ix + c * iy, tz = iz;
     const V dx = ct * tx - r * tz, dy = ty, dz = r * tx + ct * tz;
     const V theta_d = hn::Acos(d, hn::Min(hn::Max(dz, hn::Set(d, -1.0)), one));
@@ -100,8 +101,7 @@ void EvalMerlBatch(const MerlBatchModel& model, EvaluationBatch& batch) {
     }
     const auto measured = hn::And(above, hn::And(hn::And(weight[0] > zero, weight[1] > zero), weight[2] > zero));
     for (int ch = 0; ch < 3; ++ch) {
-      const V safe = hn::IfThenElse(measured, weight[ch], one);
-      hn::StoreU(hn::IfThenElseZero(measured, sum[ch] / safe), d, out[ch] + k);
+      hn::StoreU(hn::IfThenElseZero(measured, lanes::divide(d, sum[ch], hn::IfThenElse(measured, weight[ch], one))), d, out[ch] + k);
     }
   }
 }

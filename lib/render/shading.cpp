@@ -57,7 +57,7 @@ double ShadingModel::pdf(const Vec3& o, const Vec3& i) const {
 }
 
 ShadingModel::Evaluation ShadingModel::eval(const Vec3& o, const Vec3& i) const {
-  if (!ggx_brdf_ || i.z <= 0.0 || o.z <= 0.0) return {f(o, i), pdf(o, i)};
+  if (!ggx_brdf_ || !above_horizon(o, i)) return {f(o, i), pdf(o, i)};
   const Vec3 h = glm::normalize(i + o);
   const Ndf& ndf = ggx_brdf_->ndf();
   const double d = ndf.D(h), lambda_o = ndf.lambda(o);

@@ -47,12 +47,12 @@ HWY_INLINE V intersect(D d, V cx, V cy, V cz, V radius, const RayV& r, V tfar) {
   const auto away = hn::And(c > zero, hn::And(b <= zero, r.tnear >= zero));
   // Every shadow ray leaving a sphere's lit side ends here, without the divisions and the square root.
   if (hn::AllTrue(d, away)) return inf;
-  const V s = b / a;
+  const V inv_a = lanes::reciprocal(d, a), s = b * inv_a;
   const V nx = fx + s * r.dx, ny = fy + s * r.dy, nz = fz + s * r.dz;
   const V chord2 = r2 - (nx * nx + ny * ny + nz * nz);
   const auto meets = hn::AndNot(away, chord2 >= zero);
   const V q = b + hn::CopySign(hn::Sqrt(hn::IfThenElseZero(meets, a * chord2)), b);
-  const V t0 = q / a, t1 = hn::IfThenElse(q != zero, c / hn::IfThenElse(q != zero, q, hn::Set(d, 1.0)), t0);
+  const V t0 = q * inv_a, t1 = hn::IfThenElse(q != zero, lanes::divide(d, c, hn::IfThenElse(q != zero, q, hn::Set(d, 1.0))), t0);
   const auto swap = t0 > t1;
   const V lo = hn::IfThenElse(swap, t1, t0), hi = hn::IfThenElse(swap, t0, t1);
   const V t = hn::IfThenElse(hn::And(lo > r.tnear, lo < tfar), lo, hn::IfThenElse(hn::And(hi > r.tnear, hi < tfar), hi, inf));

@@ -77,7 +77,7 @@ V g1(D d, const TabulatedBatchModel& model, V c) {
 V positive_phi_integral(D d, V a, V b) {
   const auto whole = a <= b;
   const V safe_a = hn::IfThenElse(whole, hn::Set(d, 1.0), a);
-  const V ratio = hn::Max(hn::Neg(b) / safe_a, hn::Set(d, -1.0));
+  const V ratio = hn::Max(lanes::divide(d, hn::Neg(b), safe_a), hn::Set(d, -1.0));
   const V part = hn::Set(d, 2.0) * (hn::Sqrt(hn::Max(hn::Zero(d), a * a - b * b)) + b * hn::Acos(d, ratio));
   return hn::IfThenElse(whole, hn::Set(d, 2.0 * kPi) * b, part);
 }
@@ -116,7 +116,7 @@ CosSin cos_sin_upper(D d, V phi) {
 CosSin sample_phi(D d, V a, V b, V u) {
   const V zero = hn::Zero(d), one = hn::Set(d, 1.0), two = hn::Set(d, 2.0), half = hn::Set(d, 0.5), pi = hn::Set(d, kPi);
   const auto whole = a <= b;
-  const V ratio = hn::Min(hn::Max(hn::Neg(b) / hn::IfThenElse(whole, one, a), hn::Set(d, -1.0)), one);
+  const V ratio = hn::Min(hn::Max(lanes::divide(d, hn::Neg(b), hn::IfThenElse(whole, one, a)), hn::Set(d, -1.0)), one);
   const V phi_max = hn::IfThenElse(whole, pi, hn::Acos(d, ratio));
   const auto lower = u < half;
   const V sign = hn::IfThenElse(lower, hn::Set(d, -1.0), one);
@@ -133,7 +133,7 @@ CosSin sample_phi(D d, V a, V b, V u) {
     const auto beyond = f > zero;
     hi = hn::IfThenElse(beyond, phi, hi), lo = hn::IfThenElse(beyond, lo, phi);
     const V df = a * cos_phi + b, mid = half * (lo + hi);
-    V next = hn::IfThenElse(df > zero, phi - f / hn::IfThenElse(df > zero, df, one), mid);
+    V next = hn::IfThenElse(df > zero, phi - lanes::divide(d, f, hn::IfThenElse(df > zero, df, one)), mid);
     next = hn::IfThenElse(hn::And(next > lo, next < hi), next, mid);
     const V step = next - phi;
     // Stopped: the rotation by the last step to first order.
@@ -163,7 +163,7 @@ lanes::Direction lobe_direction(D d, const TabulatedBatchModel& model, int top_s
   const GridPosition view = locate(d, oz, r);
   const V keep = one - view.t;
   const auto first = u1 < keep;
-  V u = hn::IfThenElse(first, u1 / keep, (u1 - keep) / hn::IfThenElse(view.t > zero, view.t, one));
+  V u = lanes::divide(d, hn::IfThenElse(first, u1, u1 - keep), hn::IfThenElse(first, keep, hn::IfThenElse(view.t > zero, view.t, one)));
   u = hn::Min(hn::Max(u, zero), hn::Set(d, 1.0 - 1e-16));
   const I slice = hn::IfThenElse(hn::RebindMask(di, first), view.j, view.j + hn::Set(di, 1));
   // The interval of theta_h: the last node of the slice's running sums <= u (sample_cdf: zero-mass
@@ -180,7 +180,7 @@ lanes::Direction lobe_direction(D d, const TabulatedBatchModel& model, int top_s
   const V c0 = hn::GatherIndex(d, model.cdf, row + k), c1 = hn::GatherIndex(d, model.cdf, row + k + hn::Set(di, 1));
   const V mass = c1 - c0;
   const auto some = mass > zero;
-  const V frac = hn::IfThenElse(some, hn::Min(hn::Max((u - c0) / hn::IfThenElse(some, mass, one), zero), one), hn::Set(d, 0.5));
+  const V frac = hn::IfThenElse(some, hn::Min(hn::Max(lanes::divide(d, u - c0, hn::IfThenElse(some, mass, one)), zero), one), hn::Set(d, 0.5));
   // Uniform in cos(theta_h) within the interval.
   const V n0 = hn::GatherIndex(d, model.cos_nodes, k), n1 = hn::GatherIndex(d, model.cos_nodes, k + hn::Set(di, 1));
   const V cos_h = n0 - frac * (n0 - n1);
@@ -190,7 +190,7 @@ lanes::Direction lobe_direction(D d, const TabulatedBatchModel& model, int top_s
   V hx = sin_h * phi.c, hy = sin_h * phi.s;
   const V o_xy = hn::Sqrt(ox * ox + oy * oy);
   const auto turned = hn::And(sin_o > zero, o_xy > zero);
-  const V safe = hn::IfThenElse(turned, o_xy, one), turn_c = ox / safe, turn_s = oy / safe;
+  const V per_xy = lanes::reciprocal(d, hn::IfThenElse(turned, o_xy, one)), turn_c = ox * per_xy, turn_s = oy * per_xy;
   const V tx = turn_c * hx - turn_s * hy, ty = turn_s * hx + turn_c * hy;
   hx = hn::IfThenElse(turned, tx, hx), hy = hn::IfThenElse(turned, ty, hy);
   const V two_o_h = hn::Set(d, 2.0) * (ox * hx + oy * hy + oz * cos_h);
@@ -224,7 +224,7 @@ void EvalTabulatedBatch(const TabulatedBatchModel& model, EvaluationBatch& batch
     const auto above = hn::And(iz > zero, oz > zero);
     // h = normalize(i + o)
     V hx = ix + ox, hy = iy + oy, hz = iz + oz;
-    const V inv_len = one / hn::Sqrt(hx * hx + hy * hy + hz * hz);
+    const V inv_len = lanes::inverse_sqrt(d, hx * hx + hy * hy + hz * hz);
     hx = hx * inv_len, hy = hy * inv_len, hz = hz * inv_len;
     const auto h_up = hz > zero;
     // theta_h once, for D and for the normal's place on the grid.
@@ -246,15 +246,17 @@ void EvalTabulatedBatch(const TabulatedBatchModel& model, EvaluationBatch& batch
         case Smith::masking: g2 = hn::Min(g1_i, g1_o); break;
         case Smith::correlated: {
           const V den = g1_i + g1_o - g1_i * g1_o;
-          g2 = hn::IfThenElseZero(den > zero, g1_i * g1_o / hn::IfThenElse(den > zero, den, one));
+          g2 = hn::IfThenElseZero(den > zero, lanes::divide(d, g1_i * g1_o, hn::IfThenElse(den > zero, den, one)));
           break;
         }
         case Smith::separable: g2 = g1_i * g1_o; break;
       }
       V fresnel[3];
       lanes::fresnel_curve(d, model.curve, cos_d, fresnel);
-      const V specular = dh * g2 / four_cos;
-      for (int c = 0; c < 3; ++c) hn::StoreU(hn::IfThenElseZero(above, body[c] + fresnel[c] * specular + coat_f), d, out[c] + k);
+      const V specular = lanes::divide(d, dh * g2, four_cos);
+      // f where cos(theta_i) cos(theta_o) does not underflow (above_horizon, core/vec.h)
+      const auto formed = hn::And(above, iz * oz > zero);
+      for (int c = 0; c < 3; ++c) hn::StoreU(hn::IfThenElseZero(formed, body[c] + fresnel[c] * specular + coat_f), d, out[c] + k);
     }
 
     // The lobe's visible normals (TabulatedMicrofacet::measured_visible_normal_pdf): the mass of the
@@ -270,8 +272,8 @@ void EvalTabulatedBatch(const TabulatedBatchModel& model, EvaluationBatch& batch
     const V phi_total = positive_phi_integral(d, sin_o * sin_h, oz * hz);
     const auto visible = hn::And(hn::And(o_faces_h, h_up), hn::And(band > zero, phi_total > zero));
     const V safe_band = hn::IfThenElse(visible, band, one), safe_total = hn::IfThenElse(visible, phi_total, one);
-    const V safe_oh = hn::IfThenElse(visible, o_dot_h, one);
-    const V lobe_pdf = hn::IfThenElseZero(visible, mass / safe_band * o_dot_h / safe_total / (four * safe_oh));
+    // mass / band (o.h) / total / (4 o.h): o.h cancels.
+    const V lobe_pdf = hn::IfThenElseZero(visible, lanes::divide(d, mass, four * safe_band * safe_total));
     hn::StoreU(hn::IfThenElseZero(above, lanes::mixture_density(d, model.weights, coat, lobe_pdf, coat_pdf, iz)), d, batch.pdf.data() + k);
   }
 }

@@ -107,13 +107,11 @@ HWY_INLINE std::size_t append(D d, M m, const Entry& e, const Vec3V& origin, V t
 // earlier tile's).
 HWY_INLINE M real(D d, std::size_t k, std::size_t count) { return hn::Iota(d, double(k)) < hn::Set(d, double(count)); }
 
-HWY_INLINE V power_heuristic(V a, V b) { return (a * a) / (a * a + b * b); }
-
 HWY_INLINE V dot(const Vec3V& a, const Vec3V& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
 
 // glm::normalize: v times the reciprocal of its length.
 HWY_INLINE Vec3V normalize(D d, const Vec3V& v) {
-  const V inv = hn::Set(d, 1.0) / hn::Sqrt(dot(v, v));
+  const V inv = lanes::inverse_sqrt(d, dot(v, v));
   return {v.x * inv, v.y * inv, v.z * inv};
 }
 
@@ -139,7 +137,7 @@ void PlaceHits(const TileHits& tile, const Vec3& camera, double eps, double mate
     const M back = dot(nrm, dir) > zero;
     nrm = {hn::IfThenElse(back, hn::Neg(nrm.x), nrm.x), hn::IfThenElse(back, hn::Neg(nrm.y), nrm.y), hn::IfThenElse(back, hn::Neg(nrm.z), nrm.z)};
     // Frame(n) of core/frame.h (Duff et al. 2017).
-    const V sign = hn::CopySign(one, nrm.z), a = hn::Neg(one) / (sign + nrm.z), c = nrm.x * nrm.y * a;
+    const V sign = hn::CopySign(one, nrm.z), a = hn::Neg(lanes::reciprocal(d, sign + nrm.z)), c = nrm.x * nrm.y * a;
     FrameV frame{{one + sign * nrm.x * nrm.x * a, sign * c, hn::Neg(sign * nrm.x)}, {c, sign + nrm.y * nrm.y * a, hn::Neg(nrm.y)}, nrm};
     if (tangent) {
       // Frame(n, along): the tangent's projection on the surface where it does not vanish.
@@ -149,7 +147,8 @@ void PlaceHits(const TileHits& tile, const Vec3& camera, double eps, double mate
       const V len = hn::Sqrt(dot(projected, projected));
       const M turns = len > hn::Set(d, 1e-9);
       const V safe = hn::IfThenElse(turns, len, one);
-      const Vec3V t_axis{projected.x / safe, projected.y / safe, projected.z / safe};
+      const V inv_len = lanes::reciprocal(d, safe);
+      const Vec3V t_axis{projected.x * inv_len, projected.y * inv_len, projected.z * inv_len};
       const Vec3V b_axis{nrm.y * t_axis.z - nrm.z * t_axis.y, nrm.z * t_axis.x - nrm.x * t_axis.z, nrm.x * t_axis.y - nrm.y * t_axis.x};
       frame.t = {hn::IfThenElse(turns, t_axis.x, frame.t.x), hn::IfThenElse(turns, t_axis.y, frame.t.y), hn::IfThenElse(turns, t_axis.z, frame.t.z)};
       frame.b = {hn::IfThenElse(turns, b_axis.x, frame.b.x), hn::IfThenElse(turns, b_axis.y, frame.b.y), hn::IfThenElse(turns, b_axis.z, frame.b.z)};
@@ -212,8 +211,9 @@ void LightSlots(const HitBatch& hits, bool environment, const std::vector<LaneLi
         // Toward the point from the hit, its irradiance falling as the squared distance, the ray stopping
         // just short of it.
         const V to_x = vx - load(d, hits.px, k), to_y = vy - load(d, hits.py, k), to_z = vz - load(d, hits.pz, k);
-        const V dist = hn::Sqrt(to_x * to_x + to_y * to_y + to_z * to_z), inv2 = one / (dist * dist);
-        e.d = {to_x / dist, to_y / dist, to_z / dist};
+        const V dist2 = to_x * to_x + to_y * to_y + to_z * to_z, inv_dist = lanes::inverse_sqrt(d, dist2), inv2 = inv_dist * inv_dist;
+        const V dist = dist2 * inv_dist;
+        e.d = {to_x * inv_dist, to_y * inv_dist, to_z * inv_dist};
         e.arriving_r = r * inv2, e.arriving_g = g * inv2, e.arriving_b = b * inv2;
         e.tfar = dist * hn::Set(d, 1.0 - 1e-6);
       }
@@ -266,10 +266,12 @@ void ShadowValues(ShadowBatch& batch, const SlotRanges& ranges) {
     const V pdf = load(d, batch.pdf, k), light_pdf = load(d, batch.light_pdf, k), cos_i = load(d, batch.iz, k);
     // environment light: f L cos w(light, brdf) / p_light; BRDF sample: f cos / p_brdf L w(brdf, light);
     // light: f E cos
-    const V env_factor = cos_i * power_heuristic(light_pdf, pdf) / hn::IfThenElse(env_light, light_pdf, one);
+    // The power heuristic's two weights share one reciprocal: w(a, b) = a^2 / (a^2 + b^2).
+    const V light_pdf2 = light_pdf * light_pdf, pdf2 = pdf * pdf, inv_sum = lanes::reciprocal(d, light_pdf2 + pdf2);
+    const V env_factor = cos_i * (light_pdf2 * inv_sum) * lanes::reciprocal(d, hn::IfThenElse(env_light, light_pdf, one));
     const M has_density = pdf > zero;
-    const V brdf_factor = cos_i / hn::IfThenElse(has_density, pdf, one);
-    const V brdf_weight = power_heuristic(pdf, light_pdf);
+    const V brdf_factor = cos_i * lanes::reciprocal(d, hn::IfThenElse(has_density, pdf, one));
+    const V brdf_weight = pdf2 * inv_sum;
     const V f[3] = {load(d, batch.r, k), load(d, batch.g, k), load(d, batch.b, k)};
     const V arriving[3] = {load(d, batch.arriving_r, k), load(d, batch.arriving_g, k), load(d, batch.arriving_b, k)};
     double* value[3] = {batch.value_r.data(), batch.value_g.data(), batch.value_b.data()};
