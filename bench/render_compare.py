@@ -375,7 +375,7 @@ def main(facetfit, mitsuba_python, dst, rgl=None):
                   "textured per hit) is shaded one pair at a time inside the tile loop. On AVX-512 the kernels divide by\n"
                   "AVX-512's 14-bit reciprocal estimate refined by two Newton steps (render/lanes-inl.h: `reciprocal`,\n"
                   "`divide`, `inverse_sqrt`; vdivpd on eight doubles issues once per 16 cycles): 12% of the GGX sphere's\n"
-                  "render (perf stat, one CPU, 350 -> 305 ms); square roots as x times the refined inverse square root were\n"
+                  "render (perf stat, one CPU, 346 -> 311 ms); square roots as x times the refined inverse square root were\n"
                   "slower than vsqrtpd (325 ms) and stay hardware.\n")
         out.write("\nBy stage: the GGX sphere at 64 spp on one CPU with parts of the scene left out (one render each, the\n"
                   "median of %d); the camera stage (the numbers and camera rays in SIMD lanes, render/camera_batch.h, the\n"
