@@ -76,10 +76,16 @@ struct ToFront {
   decltype(hn::SetTableIndices(D(), static_cast<const std::int64_t*>(nullptr))) index;
   std::size_t at;
   HWY_INLINE void operator()(D d, V v, std::vector<double>& column) const {
-    if constexpr (hn::MaxLanes(D()) > 4)  // AVX-512 compresses itself
+#if HWY_TARGET == HWY_AVX3
+    // AVX-512 compresses in a register, then stores the whole vector.
+    (void)d;
+    _mm512_storeu_pd(column.data() + at, _mm512_maskz_compress_pd(mask.raw, v.raw));
+#else
+    if constexpr (hn::MaxLanes(D()) > 4)
       hn::CompressStore(v, mask, d, column.data() + at);
     else
       hn::StoreU(hn::TableLookupLanes(v, index), d, column.data() + at);
+#endif
   }
 };
 HWY_INLINE ToFront to_front(D d, M m, std::size_t at) {
