@@ -142,7 +142,7 @@ void run_render(const RenderArgs& args, Context& ctx) {
               {{"scene", args.scene.empty() ? "default" : args.scene}, {"spp", std::to_string(image.spp)},
                {"seconds", std::to_string(image.seconds)}});
     if (!args.png.empty()) write_display_png(args.png, image.rgba.data(), image.width, image.height, 4, DisplayTransform());
-    if (!ctx.quiet()) std::printf("%s (%dx%d, %d spp, %.2f s)\n", args.output.c_str(), image.width, image.height, image.spp, image.seconds);
+    if (!ctx.quiet()) std::printf("%s (%dx%d, %d spp, %.3f s)\n", args.output.c_str(), image.width, image.height, image.spp, image.seconds);
   } catch (const Error& e) {
     report_error(e.what());
     status = 1;

@@ -353,8 +353,7 @@ TEST(Wavefront, HitsAndSlotsEqualTheOneHitPath) {
         place_hits(tile, camera, eps, 0.0, with_tangent ? &tangent : nullptr, hits, target);
         ShadowBatch slots;
         SlotRanges ranges;
-        SampleBatch samples;
-        light_slots(hits, true, lights, eps, slots, ranges, samples, target);
+        light_slots(hits, true, lights, eps, slots, ranges, target);
         const auto close = [](double a, double b) { return std::abs(a - b) <= 1e-12 * std::max(1.0, std::abs(b)); };
         // The one-hit path, hit by hit of material 0, slot by slot.
         std::size_t row = 0, env_entries = 0;
@@ -372,9 +371,9 @@ TEST(Wavefront, HitsAndSlotsEqualTheOneHitPath) {
           for (const auto& [a, b] : {std::pair{hits.tx[row], frame.t.x}, {hits.ty[row], frame.t.y}, {hits.tz[row], frame.t.z},
                                      {hits.bx[row], frame.b.x}, {hits.by[row], frame.b.y}, {hits.bz[row], frame.b.z},
                                      {hits.nx[row], frame.n.x}, {hits.ny[row], frame.n.y}, {hits.nz[row], frame.n.z},
-                                     {hits.ox[row], o.x}, {hits.oy[row], o.y}, {hits.oz[row], o.z},
+                                     {hits.draws.ox[row], o.x}, {hits.draws.oy[row], o.y}, {hits.draws.oz[row], o.z},
                                      {hits.origin_x[row], origin.x}, {hits.origin_y[row], origin.y}, {hits.origin_z[row], origin.z},
-                                     {hits.u1[row], tile.u1[k]}, {hits.light_pdf[row], tile.light_pdf[k]}})
+                                     {hits.draws.u1[row], tile.u1[k]}, {hits.draws.u3[row], tile.u3[k]}, {hits.light_pdf[row], tile.light_pdf[k]}})
             ASSERT_TRUE(close(a, b)) << where << " hit " << k << ": " << a << " against " << b;
           // The environment's slot: where the light sample and the view are above the horizon.
           const Vec3 l(tile.lx[k], tile.ly[k], tile.lz[k]);
@@ -410,7 +409,7 @@ TEST(Wavefront, HitsAndSlotsEqualTheOneHitPath) {
         for (std::size_t j = 0; j < lights.size(); ++j)
           EXPECT_EQ(ranges.light_begin[j] + light_entries[j], j + 1 < lights.size() ? ranges.light_begin[j + 1] : ranges.brdf_begin) << where;
         EXPECT_EQ(slots.size(), ranges.brdf_begin) << where;
-        EXPECT_EQ(samples.size(), hits.size()) << where;
+        EXPECT_EQ(hits.draws.size(), hits.size()) << where;
       }
   }
 }

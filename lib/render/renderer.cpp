@@ -303,7 +303,6 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
   // Per material shaded in lanes, a tile's hits for one sample index and their slots.
   struct Wave {
     HitBatch hits;
-    SampleBatch samples;
     ShadowBatch shadows;
     SlotRanges ranges;
     std::vector<char> blocked;  // per entry of shadows
@@ -429,11 +428,11 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
       for (std::size_t m = 0; m < materials.size(); ++m) {
         Wave& w = waves[m];
         if (w.hits.size() == 0) continue;
-        light_slots(w.hits, bool(env), lane_lights, eps, w.shadows, w.ranges, w.samples);
+        light_slots(w.hits, bool(env), lane_lights, eps, w.shadows, w.ranges);
         if (env) {
-          materials[m]->sample_directions(w.samples, true);
+          materials[m]->sample_directions(w.hits.draws, true);
           const std::size_t brdf_begin = w.shadows.size();
-          brdf_slots(w.hits, w.samples, constant_light.radiance, eps, w.shadows);
+          brdf_slots(w.hits, constant_light.radiance, eps, w.shadows);
           if (!sphere_lanes)
             for (std::size_t e = brdf_begin; e < w.shadows.size(); ++e) {
               const Environment::Sample ls = env->lookup({w.shadows.rays.dx[e], w.shadows.rays.dy[e], w.shadows.rays.dz[e]});

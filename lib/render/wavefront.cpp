@@ -164,17 +164,21 @@ void PlaceHits(const TileHits& tile, const Vec3& camera, double eps, double mate
     put(d, frame.t.x, out.tx), put(d, frame.t.y, out.ty), put(d, frame.t.z, out.tz);
     put(d, frame.b.x, out.bx), put(d, frame.b.y, out.by), put(d, frame.b.z, out.bz);
     put(d, nrm.x, out.nx), put(d, nrm.y, out.ny), put(d, nrm.z, out.nz);
-    put(d, o.x, out.ox), put(d, o.y, out.oy), put(d, o.z, out.oz);
+    put(d, o.x, out.draws.ox), put(d, o.y, out.draws.oy), put(d, o.z, out.draws.oz);
     put(d, p.x, out.px), put(d, p.y, out.py), put(d, p.z, out.pz);
     put(d, p.x + epsilon * nrm.x, out.origin_x), put(d, p.y + epsilon * nrm.y, out.origin_y), put(d, p.z + epsilon * nrm.z, out.origin_z);
     put(d, load(d, tile.lx, k), out.lx), put(d, load(d, tile.ly, k), out.ly), put(d, load(d, tile.lz, k), out.lz);
     put(d, load(d, tile.light_pdf, k), out.light_pdf);
     put(d, load(d, tile.light_r, k), out.light_r), put(d, load(d, tile.light_g, k), out.light_g), put(d, load(d, tile.light_b, k), out.light_b);
-    put(d, load(d, tile.u1, k), out.u1), put(d, load(d, tile.u2, k), out.u2), put(d, load(d, tile.u3, k), out.u3);
+    put(d, load(d, tile.u1, k), out.draws.u1), put(d, load(d, tile.u2, k), out.draws.u2), put(d, load(d, tile.u3, k), out.draws.u3);
     put(d, hn::Iota(d, double(k)), out.owner);
     size += hn::CountTrue(d, mine);
   }
   out.set_size(size);
+}
+
+HWY_INLINE Vec3V view_at(D d, const HitBatch& h, std::size_t k) {
+  return {load(d, h.draws.ox, k), load(d, h.draws.oy, k), load(d, h.draws.oz, k)};
 }
 
 HWY_INLINE Vec3V origin_at(D d, const HitBatch& h, std::size_t k) {
@@ -182,7 +186,7 @@ HWY_INLINE Vec3V origin_at(D d, const HitBatch& h, std::size_t k) {
 }
 
 void LightSlots(const HitBatch& hits, bool environment, const std::vector<LaneLight>& lights, double tnear, ShadowBatch& out,
-                SlotRanges& ranges, SampleBatch& samples) {
+                SlotRanges& ranges) {
   const D d;
   const std::size_t n = hits.padded_size(), lanes = hn::Lanes(d);
   const V zero = hn::Zero(d), one = hn::Set(d, 1.0), infinity = hn::Set(d, std::numeric_limits<double>::infinity());
@@ -193,7 +197,7 @@ void LightSlots(const HitBatch& hits, bool environment, const std::vector<LaneLi
   if (environment)
     for (std::size_t k = 0; k < n; k += lanes) {
       const FrameV frame = frame_at(d, hits, k);
-      const Vec3V o{load(d, hits.ox, k), load(d, hits.oy, k), load(d, hits.oz, k)};
+      const Vec3V o = view_at(d, hits, k);
       const Vec3V l{load(d, hits.lx, k), load(d, hits.ly, k), load(d, hits.lz, k)};
       const V pdf = load(d, hits.light_pdf, k);
       const Vec3V il = frame.to_local(l);
@@ -211,7 +215,7 @@ void LightSlots(const HitBatch& hits, bool environment, const std::vector<LaneLi
     const V r = hn::Set(d, light.r), g = hn::Set(d, light.g), b = hn::Set(d, light.b);
     for (std::size_t k = 0; k < n; k += lanes) {
       const FrameV frame = frame_at(d, hits, k);
-      const Vec3V o{load(d, hits.ox, k), load(d, hits.oy, k), load(d, hits.oz, k)};
+      const Vec3V o = view_at(d, hits, k);
       Entry e{o, {}, {vx, vy, vz}, zero, infinity, r, g, b, zero, load(d, hits.owner, k)};
       if (!light.directional) {
         // Toward the point from the hit, its irradiance falling as the squared distance, the ray stopping
@@ -230,19 +234,10 @@ void LightSlots(const HitBatch& hits, bool environment, const std::vector<LaneLi
   }
   ranges.brdf_begin = size;
   out.set_size(size);
-  samples.clear();
-  if (!environment) return;
-  // The BRDF samples' inputs are the hits' own columns.
-  samples.resize_to(hits.size());
-  for (std::size_t k = 0; k < n; k += lanes) {
-    hn::StoreU(load(d, hits.ox, k), d, samples.ox.data() + k), hn::StoreU(load(d, hits.oy, k), d, samples.oy.data() + k);
-    hn::StoreU(load(d, hits.oz, k), d, samples.oz.data() + k);
-    hn::StoreU(load(d, hits.u1, k), d, samples.u1.data() + k), hn::StoreU(load(d, hits.u2, k), d, samples.u2.data() + k);
-    hn::StoreU(load(d, hits.u3, k), d, samples.u3.data() + k);
-  }
 }
 
-void BrdfSlots(const HitBatch& hits, const SampleBatch& samples, const Rgb& radiance, double tnear, ShadowBatch& out) {
+void BrdfSlots(const HitBatch& hits, const Rgb& radiance, double tnear, ShadowBatch& out) {
+  const SampleBatch& samples = hits.draws;
   const D d;
   const std::size_t n = hits.padded_size(), lanes = hn::Lanes(d);
   const V zero = hn::Zero(d), one = hn::Set(d, 1.0), infinity = hn::Set(d, std::numeric_limits<double>::infinity());
@@ -305,12 +300,12 @@ void place_hits(const TileHits& tile, const Vec3& camera, double eps, double mat
 }
 
 void light_slots(const HitBatch& hits, bool environment, const std::vector<LaneLight>& lights, double tnear, ShadowBatch& out,
-                 SlotRanges& ranges, SampleBatch& samples, SimdTarget target) {
-  FACETFIT_DISPATCH(target, LightSlots, hits, environment, lights, tnear, out, ranges, samples);
+                 SlotRanges& ranges, SimdTarget target) {
+  FACETFIT_DISPATCH(target, LightSlots, hits, environment, lights, tnear, out, ranges);
 }
 
-void brdf_slots(const HitBatch& hits, const SampleBatch& samples, const Rgb& radiance, double tnear, ShadowBatch& out, SimdTarget target) {
-  FACETFIT_DISPATCH(target, BrdfSlots, hits, samples, radiance, tnear, out);
+void brdf_slots(const HitBatch& hits, const Rgb& radiance, double tnear, ShadowBatch& out, SimdTarget target) {
+  FACETFIT_DISPATCH(target, BrdfSlots, hits, radiance, tnear, out);
 }
 
 void shadow_values(ShadowBatch& batch, const SlotRanges& ranges, SimdTarget target) {

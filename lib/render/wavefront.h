@@ -37,28 +37,27 @@ struct TileHits : Columns {
   }
 };
 
-// The hits on one material, for one sample index, in columns: the shading frame, the direction toward
-// the camera in it, the hit and the shadow rays' origin, the environment's light sample, the BRDF
-// sample's numbers and the pixel's index in the tile (owner).
+// The hits on one material, for one sample index, in columns: the shading frame, the hit and the shadow
+// rays' origin, the environment's light sample, the pixel's index in the tile (owner), and the BRDF
+// sampler's batch (`draws`): its inputs are the direction toward the camera in the frame and the BRDF
+// sample's numbers, its outputs are drawn in place.
 struct HitBatch : Columns {
   std::vector<double> tx, ty, tz, bx, by, bz, nx, ny, nz;
-  std::vector<double> ox, oy, oz;
   std::vector<double> px, py, pz;
   std::vector<double> origin_x, origin_y, origin_z;
   std::vector<double> lx, ly, lz, light_pdf, light_r, light_g, light_b;
-  std::vector<double> u1, u2, u3;
   std::vector<double> owner;  // exact in a double
+  SampleBatch draws;          // as many entries as hits
   // Room for n hits written in place by the lanes; size() stays.
   void reserve(std::size_t n) {
     ensure(n, [this](std::size_t m) {
-      resize({&tx, &ty, &bx, &by, &nx, &ny, &ox, &oy, &px, &py, &pz, &origin_x, &origin_y, &origin_z, &lx, &ly, &light_r, &light_g,
-              &light_b, &owner},
+      resize({&tx, &ty, &bx, &by, &nx, &ny, &px, &py, &pz, &origin_x, &origin_y, &origin_z, &lx, &ly, &light_r, &light_g, &light_b, &owner},
              m, 0.0);
-      resize({&tz, &bz, &nz, &oz, &lz, &light_pdf}, m, 1.0);
-      resize({&u1, &u2, &u3}, m, 0.5);
+      resize({&tz, &bz, &nz, &lz, &light_pdf}, m, 1.0);
     });
+    draws.resize_to(n);  // room; set_size sets its size
   }
-  void set_size(std::size_t n) { Columns::set_size(n); }
+  void set_size(std::size_t n) { Columns::set_size(n), draws.resize_to(n); }
 };
 
 // Fills `out` with the tile's hits on material `material` (emptied first), as the renderer's one-hit path
@@ -105,16 +104,14 @@ struct SlotRanges {
 };
 
 // Appends to `out` (emptied first) the evaluations of the environment's light samples (`environment`) and of
-// the lights, for the hits' padded_size() entries, and the ranges; then fills `samples` (emptied first) with
-// the BRDF samples to draw (`environment`), one per hit.
+// the lights, for the hits' padded_size() entries, and the ranges.
 // The shadow rays start at the hits' origins and ignore what lies nearer than `tnear`.
 void light_slots(const HitBatch& hits, bool environment, const std::vector<LaneLight>& lights, double tnear, ShadowBatch& out,
-                 SlotRanges& ranges, SampleBatch& samples, SimdTarget target = SimdTarget::best);
+                 SlotRanges& ranges, SimdTarget target = SimdTarget::best);
 
-// Appends the BRDF samples found (`samples`, drawn for `hits`) as evaluations with their world directions,
-// arriving `radiance` at density 1 / 4 pi: a constant environment's (the caller replaces both under a map).
-void brdf_slots(const HitBatch& hits, const SampleBatch& samples, const Rgb& radiance, double tnear, ShadowBatch& out,
-                SimdTarget target = SimdTarget::best);
+// Appends the BRDF samples found (hits.draws, drawn) as evaluations with their world directions, arriving
+// `radiance` at density 1 / 4 pi: a constant environment's (the caller replaces both under a map).
+void brdf_slots(const HitBatch& hits, const Rgb& radiance, double tnear, ShadowBatch& out, SimdTarget target = SimdTarget::best);
 
 // The value of each entry's shadow ray from its evaluation (ShadowBatch::r, g, b, pdf), as the one-hit
 // path computes it: multiple importance sampling by the power heuristic for the environment's light and
