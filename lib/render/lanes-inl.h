@@ -28,23 +28,26 @@ using DI = hn::RebindToSigned<D>;
 
 // 1 / x, as the division gives it to a few ulp. AVX-512 has a 14-bit estimate that two Newton steps,
 // y += y (1 - x y), make 56 bits in about half the division's time (vdivpd on 8 doubles issues once per
-// 16 cycles, and a GGX sample divides about twenty times). Where x is 0, infinite or so small that 1/x overflows,
-// the estimate is already the answer (infinity or 0) and the steps would turn it into NaN. Elsewhere the
-// division: AVX2 has no estimate for doubles.
+// 16 cycles, and a GGX sample divides about twenty times). Where x is 0, infinite, NaN or so small that
+// 1/x overflows, the first step's error is not finite: those lanes divide. Elsewhere the division: AVX2
+// has no estimate for doubles.
 inline V reciprocal(D d, V x) {
 #if HWY_TARGET == HWY_AVX3
   const V one = hn::Set(d, 1.0);
   const V y0{_mm512_rcp14_pd(x.raw)};
   const V e0 = hn::NegMulAdd(x, y0, one), y1 = hn::MulAdd(y0, e0, y0);
-  return hn::IfThenElse(hn::IsFinite(e0), hn::MulAdd(y1, hn::NegMulAdd(x, y1, one), y1), y0);
+  const V y2 = hn::MulAdd(y1, hn::NegMulAdd(x, y1, one), y1);
+  const auto special = hn::Not(hn::IsFinite(e0));
+  if (HWY_UNLIKELY(!hn::AllFalse(d, special))) return hn::IfThenElse(special, one / x, y2);
+  return y2;
 #else
   return hn::Set(d, 1.0) / x;
 #endif
 }
 
-// a / b, as the division gives it to a few ulp: a times b's reciprocal, except in the lanes where b is zero
-// or so small that 1/b overflows, which divide (0 / b is 0 and a denormal over a denormal is finite; a
-// times infinity is not).
+// a / b, as the division gives it to a few ulp: a times b's reciprocal, except in the lanes where that is
+// infinite (b zero or so small that 1/b overflows), which divide: 0 / b is 0 and a denormal over a
+// denormal is finite, a times infinity is not.
 inline V divide(D d, V a, V b) {
 #if HWY_TARGET == HWY_AVX3
   const V r = reciprocal(d, b);
@@ -57,14 +60,17 @@ inline V divide(D d, V a, V b) {
 #endif
 }
 
-// 1 / sqrt(x) for x >= 0, as reciprocal: two Newton steps y *= 3/2 - x/2 y^2 on AVX-512's 14-bit estimate,
-// which stands where x is 0 or infinite.
+// 1 / sqrt(x), as reciprocal: two Newton steps y *= 3/2 - x/2 y^2 on AVX-512's 14-bit estimate; the lanes
+// where x is 0, infinite, NaN, negative or so small that the estimate's square overflows take 1 / sqrt(x).
 inline V inverse_sqrt(D d, V x) {
 #if HWY_TARGET == HWY_AVX3
   const V half_x = hn::Set(d, 0.5) * x, three_halves = hn::Set(d, 1.5);
   const V y0{_mm512_rsqrt14_pd(x.raw)};
   const V e0 = half_x * (y0 * y0), y1 = y0 * (three_halves - e0);
-  return hn::IfThenElse(hn::IsFinite(e0), y1 * hn::NegMulAdd(half_x, y1 * y1, three_halves), y0);
+  const V y2 = y1 * hn::NegMulAdd(half_x, y1 * y1, three_halves);
+  const auto special = hn::Not(hn::IsFinite(e0));
+  if (HWY_UNLIKELY(!hn::AllFalse(d, special))) return hn::IfThenElse(special, hn::Set(d, 1.0) / hn::Sqrt(x), y2);
+  return y2;
 #else
   return hn::Set(d, 1.0) / hn::Sqrt(x);
 #endif

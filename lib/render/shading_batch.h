@@ -86,8 +86,12 @@ struct SampleBatch : Columns {
   }
   // n entries, whose inputs the caller writes in place.
   void resize_to(std::size_t n) {
-    ensure(n, [this](std::size_t m) { grow(m); });
+    reserve(n);
     set_size(n);
+  }
+  // Room for n entries written in place; size() stays.
+  void reserve(std::size_t n) {
+    ensure(n, [this](std::size_t m) { grow(m); });
   }
   Vec3 o(std::size_t k) const { return {ox[k], oy[k], oz[k]}; }
   Vec3 i(std::size_t k) const { return {ix[k], iy[k], iz[k]}; }

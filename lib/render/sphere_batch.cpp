@@ -36,7 +36,8 @@ HWY_INLINE RayV ray_at(D d, const RayBatch& rays, std::size_t k) {
 }
 
 // intersect_sphere (render/tracer.cpp) in lanes: the nearest root in (tnear, tfar) or infinity. Every
-// operation as the scalar code orders it (glm's dot sums x, y, then z).
+// operation as the scalar code orders it (glm's dot sums x, y, then z), the divisions by AVX-512's refined
+// reciprocal (render/lanes-inl.h) on that target.
 HWY_INLINE V intersect(D d, V cx, V cy, V cz, V radius, const RayV& r, V tfar) {
   const V zero = hn::Zero(d), inf = hn::Set(d, std::numeric_limits<double>::infinity());
   const V fx = r.ox - cx, fy = r.oy - cy, fz = r.oz - cz;

@@ -267,12 +267,12 @@ void ShadowValues(ShadowBatch& batch, const SlotRanges& ranges) {
     const V pdf = load(d, batch.pdf, k), light_pdf = load(d, batch.light_pdf, k), cos_i = load(d, batch.iz, k);
     // environment light: f L cos w(light, brdf) / p_light; BRDF sample: f cos / p_brdf L w(brdf, light);
     // light: f E cos
-    // The power heuristic's two weights share one reciprocal: w(a, b) = a^2 / (a^2 + b^2).
-    const V light_pdf2 = light_pdf * light_pdf, pdf2 = pdf * pdf, inv_sum = lanes::reciprocal(d, light_pdf2 + pdf2);
-    const V env_factor = cos_i * (light_pdf2 * inv_sum) * lanes::reciprocal(d, hn::IfThenElse(env_light, light_pdf, one));
+    // The power heuristic w(a, b) = a^2 / (a^2 + b^2) both ways (the two divisions share b's reciprocal).
+    const V light_pdf2 = light_pdf * light_pdf, pdf2 = pdf * pdf, sum = light_pdf2 + pdf2;
+    const V env_factor = lanes::divide(d, cos_i * lanes::divide(d, light_pdf2, sum), hn::IfThenElse(env_light, light_pdf, one));
     const M has_density = pdf > zero;
-    const V brdf_factor = cos_i * lanes::reciprocal(d, hn::IfThenElse(has_density, pdf, one));
-    const V brdf_weight = pdf2 * inv_sum;
+    const V brdf_factor = lanes::divide(d, cos_i, hn::IfThenElse(has_density, pdf, one));
+    const V brdf_weight = lanes::divide(d, pdf2, sum);
     const V f[3] = {load(d, batch.r, k), load(d, batch.g, k), load(d, batch.b, k)};
     const V arriving[3] = {load(d, batch.arriving_r, k), load(d, batch.arriving_g, k), load(d, batch.arriving_b, k)};
     double* value[3] = {batch.value_r.data(), batch.value_g.data(), batch.value_b.data()};

@@ -55,9 +55,10 @@ struct HitBatch : Columns {
              m, 0.0);
       resize({&tz, &bz, &nz, &lz, &light_pdf}, m, 1.0);
     });
-    draws.resize_to(n);  // room; set_size sets its size
+    draws.reserve(n);
   }
   void set_size(std::size_t n) { Columns::set_size(n), draws.resize_to(n); }
+  void clear() { Columns::clear(), draws.clear(); }
 };
 
 // Fills `out` with the tile's hits on material `material` (emptied first), as the renderer's one-hit path
