@@ -53,11 +53,25 @@ struct Entry {
   Vec3V o, i, d;
   V with_pdf, tfar, arriving_r, arriving_g, arriving_b, light_pdf, owner;
 };
-// The lanes of mask bits m moved to the front, in order: Highway's CompressStore copies a 256-byte table
-// onto the stack at every call (hwy 1.0.3; perf: half of a render). For vectors of at most 4 doubles
-// (AVX2; render/simd_targets.h).
+// Stores vectors with the lanes of a mask moved to the front, from position `at` of a column: a whole
+// vector is written, the columns have room past their entries.
+#if HWY_TARGET == HWY_AVX3
+// AVX-512 compresses in a register (vcompresspd to memory was slower), then stores the whole vector.
+struct ToFront {
+  M mask;
+  std::size_t at;
+  HWY_INLINE void operator()(D, V v, std::vector<double>& column) const {
+    _mm512_storeu_pd(column.data() + at, _mm512_maskz_compress_pd(mask.raw, v.raw));
+  }
+};
+HWY_INLINE ToFront to_front(D, M m, std::size_t at) { return {m, at}; }
+#else
+// Elsewhere vectors hold at most 4 doubles (render/simd_targets.h): the lanes of mask bits m in order,
+// from a table of our own (Highway's CompressStore copies a 256-byte table onto the stack at every call,
+// hwy 1.0.3; perf: half of a render).
+static_assert(hn::MaxLanes(D()) <= 4, "the compression table holds 4 lanes");
 struct CompressTable {
-  std::int64_t index[16][8];  // 8 wide, so that an AVX-512 vector's load stays inside (it does not use them)
+  std::int64_t index[16][4];
 };
 constexpr CompressTable kCompress = [] {
   CompressTable t{};
@@ -68,31 +82,19 @@ constexpr CompressTable kCompress = [] {
   }
   return t;
 }();
-
-// Stores vectors with the lanes of a mask moved to the front, from position `at` of a column: a whole
-// vector is written, the columns have room past their entries.
 struct ToFront {
-  M mask;
   decltype(hn::SetTableIndices(D(), static_cast<const std::int64_t*>(nullptr))) index;
   std::size_t at;
   HWY_INLINE void operator()(D d, V v, std::vector<double>& column) const {
-#if HWY_TARGET == HWY_AVX3
-    // AVX-512 compresses in a register, then stores the whole vector.
-    (void)d;
-    _mm512_storeu_pd(column.data() + at, _mm512_maskz_compress_pd(mask.raw, v.raw));
-#else
-    if constexpr (hn::MaxLanes(D()) > 4)
-      hn::CompressStore(v, mask, d, column.data() + at);
-    else
-      hn::StoreU(hn::TableLookupLanes(v, index), d, column.data() + at);
-#endif
+    hn::StoreU(hn::TableLookupLanes(v, index), d, column.data() + at);
   }
 };
 HWY_INLINE ToFront to_front(D d, M m, std::size_t at) {
   std::uint8_t bits[8] = {};
   hn::StoreMaskBits(d, m, bits);
-  return {m, hn::SetTableIndices(d, kCompress.index[bits[0] & 15]), at};
+  return {hn::SetTableIndices(d, kCompress.index[bits[0] & 15]), at};
 }
+#endif
 
 // Appends the lanes of `m` as entries of `out` from position `at`: one evaluation (o, i, with_pdf) and
 // its shadow ray (origin, direction, tnear, length), the arriving radiance, the environment density and the
@@ -267,7 +269,7 @@ void ShadowValues(ShadowBatch& batch, const SlotRanges& ranges) {
     const V pdf = load(d, batch.pdf, k), light_pdf = load(d, batch.light_pdf, k), cos_i = load(d, batch.iz, k);
     // environment light: f L cos w(light, brdf) / p_light; BRDF sample: f cos / p_brdf L w(brdf, light);
     // light: f E cos
-    // The power heuristic w(a, b) = a^2 / (a^2 + b^2) both ways (the two divisions share b's reciprocal).
+    // The power heuristic w(a, b) = a^2 / (a^2 + b^2), both ways.
     const V light_pdf2 = light_pdf * light_pdf, pdf2 = pdf * pdf, sum = light_pdf2 + pdf2;
     const V env_factor = lanes::divide(d, cos_i * lanes::divide(d, light_pdf2, sum), hn::IfThenElse(env_light, light_pdf, one));
     const M has_density = pdf > zero;
