@@ -8,6 +8,7 @@
 #include "core/frame.h"
 #include "core/piecewise_constant.h"
 #include "core/quadrature_rules.h"
+#include "model/visible_azimuth.h"
 
 namespace facetfit {
 
@@ -110,35 +111,6 @@ GridPosition locate(const ThetaGrid& grid, double cos_theta) {
   return {j, t};
 }
 
-// phi in (-pi, pi] with density proportional to max(0, a cos(phi) + b), a, b >= 0, from u in [0, 1);
-// returned as (cos phi, sin phi), which Newton's last step has already computed.
-std::pair<double, double> sample_phi(double a, double b, double u) {
-  const double phi_max = a <= b ? kPi : std::acos(-b / a);
-  const double sign = u < 0.5 ? -1.0 : 1.0;
-  u = u < 0.5 ? 2.0 * u : 2.0 * u - 1.0;
-  const double total = a * std::sin(phi_max) + b * phi_max;  // CDF a sin(phi) + b phi on [0, phi_max]
-  if (!(total > 0.0)) return {std::cos(u * kPi), sign * std::sin(u * kPi)};
-  const double target = u * total;
-  // Newton on the monotone CDF, kept inside the bracket. Near phi_max the density vanishes and the last
-  // digits of f are rounding noise: a tighter stop there costs ~7 more iterations (11 instead of 4).
-  double lo = 0.0, hi = phi_max, phi = u * phi_max, s = 0.0, c = 1.0;
-  for (int it = 0; it < 40; ++it) {
-    s = std::sin(phi), c = std::cos(phi);  // one sincos
-    const double f = a * s + b * phi - target;
-    if (f > 0.0) hi = phi; else lo = phi;
-    const double df = a * c + b;
-    double next = df > 0.0 ? phi - f / df : 0.5 * (lo + hi);
-    if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
-    const double step = next - phi;
-    if (std::abs(step) < 1e-7) {  // radians: below what a float ray direction resolves
-      // The rotation by the last step to first order (its square, < 1e-14, is below double rounding).
-      return {c - s * step, sign * (s + c * step)};
-    }
-    phi = next;
-  }
-  return {std::cos(phi), sign * std::sin(phi)};
-}
-
 }  // namespace
 
 double TabulatedMicrofacet::visible_normal_pdf(const Vec3& o, const Vec3& h) const {
@@ -227,7 +199,7 @@ Vec3 TabulatedMicrofacet::measured_visible_normal(const Vec3& o, double u1, doub
   const double sin_h = std::sqrt(std::max(0.0, 1.0 - cos_h * cos_h));
   const double sin_o = std::sqrt(std::max(0.0, 1.0 - o.z * o.z));
   // phi relative to o's azimuth, then turned to it (no arc tangent: its cosine and sine are o.xy / |o.xy|).
-  const auto [cos_phi, sin_phi] = sample_phi(sin_o * sin_h, o.z * cos_h, u2);
+  const auto [cos_phi, sin_phi] = sample_visible_azimuth(sin_o * sin_h, o.z * cos_h, u2);
   const Vec3 h(sin_h * cos_phi, sin_h * sin_phi, cos_h);
   const double o_xy = std::sqrt(o.x * o.x + o.y * o.y);
   if (!(sin_o > 0.0 && o_xy > 0.0)) return h;

@@ -10,6 +10,7 @@
 
 #include <array>
 
+#include "model/visible_azimuth.h"
 #include "render/lanes-inl.h"
 #include "render/tabulated_batch.h"
 
@@ -33,7 +34,7 @@ struct GridPosition {
 GridPosition locate(D d, V c, int resolution) {
   const DI di;
   const V theta = hn::Acos(d, hn::Min(hn::Max(c, hn::Set(d, -1.0)), hn::Set(d, 1.0)));
-  const V x = hn::Min(hn::Sqrt(hn::Max(hn::Zero(d), theta) / hn::Set(d, 0.5 * kPi)), hn::Set(d, 1.0)) * hn::Set(d, double(resolution));
+  const V x = hn::Min(hn::Sqrt(hn::Max(hn::Zero(d), theta) * hn::Set(d, 2.0 / kPi)), hn::Set(d, 1.0)) * hn::Set(d, double(resolution));
   const I j = hn::Min(hn::ConvertTo(di, x), hn::Set(di, resolution - 1));
   return {j, x - hn::ConvertTo(d, j)};
 }
@@ -102,18 +103,34 @@ constexpr std::array<double, 22> kSeries = [] {
 // (1e-18, 2e-17) are below double rounding. Highway's Sin and Cos reduce any argument, each on its own.
 CosSin cos_sin_upper(D d, V phi) {
   const V x = phi - hn::Set(d, 0.5 * kPi), x2 = x * x;
-  V cos_x = hn::Set(d, kSeries[20]), sin_x = hn::Set(d, kSeries[21]);
-  for (int k = 9; k >= 0; --k) {
-    cos_x = hn::MulAdd(cos_x, x2, hn::Set(d, kSeries[std::size_t(2 * k)]));
-    sin_x = hn::MulAdd(sin_x, x2, hn::Set(d, kSeries[std::size_t(2 * k + 1)]));
-  }
+  const auto c = [&](std::size_t n) { return hn::Set(d, kSeries[n]); };
+  const V cos_x = hn::impl::Estrin(x2, c(0), c(2), c(4), c(6), c(8), c(10), c(12), c(14), c(16), c(18), c(20));
+  const V sin_x = hn::impl::Estrin(x2, c(1), c(3), c(5), c(7), c(9), c(11), c(13), c(15), c(17), c(19), c(21));
   return {hn::Neg(sin_x * x), cos_x};
 }
 
+// AzimuthGuess::operator() (model/visible_azimuth.h) on `values`, its table; lanes where a + b = 0 read
+// any node.
+V azimuth_guess(D d, const double* values, V a, V b, V u, V phi_max) {
+  const DI di;
+  constexpr int n = AzimuthGuess::kSize;
+  const V sum = a + b;
+  const V x = lanes::divide(d, a, hn::IfThenElse(sum > hn::Zero(d), sum, hn::Set(d, 1.0))) * hn::Set(d, double(n));
+  const V y = u * hn::Set(d, double(n));
+  const I i = hn::Min(hn::ConvertTo(di, x), hn::Set(di, n - 1)), j = hn::Min(hn::ConvertTo(di, y), hn::Set(di, n - 1));
+  const V t = x - hn::ConvertTo(d, i), w = y - hn::ConvertTo(d, j);
+  const I at = i * hn::Set(di, AzimuthGuess::kStride) + j, one = hn::Set(di, 1), next_row = hn::Set(di, AzimuthGuess::kStride);
+  const V v00 = hn::GatherIndex(d, values, at), v01 = hn::GatherIndex(d, values, at + one);
+  const V v10 = hn::GatherIndex(d, values, at + next_row), v11 = hn::GatherIndex(d, values, at + next_row + one);
+  const V near = v00 + w * (v01 - v00), far = v10 + w * (v11 - v10);
+  return (near + t * (far - near)) * phi_max;
+}
+
 // phi in (-pi, pi] with density proportional to max(0, a cos(phi) + b), a, b >= 0, from u in [0, 1), as
-// (cos phi, sin phi): sample_phi of model/tabulated.cpp, its Newton steps on the CDF a sin(phi) + b phi in
-// every lane until each has stopped (4 steps for most, at most 40).
-CosSin sample_phi(D d, V a, V b, V u) {
+// (cos phi, sin phi): sample_visible_azimuth of model/visible_azimuth.h, its Newton steps on the CDF
+// a sin(phi) + b phi from the table's guess in every lane until each has stopped (2 steps for most, at
+// most 40).
+CosSin sample_phi(D d, const double* guess, V a, V b, V u) {
   const V zero = hn::Zero(d), one = hn::Set(d, 1.0), two = hn::Set(d, 2.0), half = hn::Set(d, 0.5), pi = hn::Set(d, kPi);
   const auto whole = a <= b;
   const V ratio = hn::Min(hn::Max(lanes::divide(d, hn::Neg(b), hn::IfThenElse(whole, one, a)), hn::Set(d, -1.0)), one);
@@ -121,10 +138,11 @@ CosSin sample_phi(D d, V a, V b, V u) {
   const auto lower = u < half;
   const V sign = hn::IfThenElse(lower, hn::Set(d, -1.0), one);
   u = hn::IfThenElse(lower, two * u, two * u - one);
-  const V total = a * hn::Sin(d, phi_max) + b * phi_max;
+  // sin(phi_max) = sqrt(1 - ratio^2) where a > b, 0 where a <= b.
+  const V total = hn::IfThenElseZero(hn::Not(whole), a * hn::Sqrt(hn::Max(zero, one - ratio * ratio))) + b * phi_max;
   const auto flat = hn::Not(total > zero);
   const V target = u * total;
-  V lo = zero, hi = phi_max, phi = u * phi_max, c = one, s = zero;
+  V lo = zero, hi = phi_max, phi = azimuth_guess(d, guess, a, b, u, phi_max), c = one, s = zero;
   auto active = hn::Not(flat);
   for (int it = 0; it < 40 && !hn::AllFalse(d, active); ++it) {
     const CosSin at = cos_sin_upper(d, phi);
@@ -134,7 +152,7 @@ CosSin sample_phi(D d, V a, V b, V u) {
     hi = hn::IfThenElse(beyond, phi, hi), lo = hn::IfThenElse(beyond, lo, phi);
     const V df = a * cos_phi + b, mid = half * (lo + hi);
     V next = hn::IfThenElse(df > zero, phi - lanes::divide(d, f, hn::IfThenElse(df > zero, df, one)), mid);
-    next = hn::IfThenElse(hn::And(next > lo, next < hi), next, mid);
+    next = hn::IfThenElse(hn::And(next >= lo, next <= hi), next, mid);
     const V step = next - phi;
     // Stopped: the rotation by the last step to first order.
     const auto stops = hn::And(active, hn::Abs(step) < hn::Set(d, 1e-7));
@@ -186,7 +204,7 @@ lanes::Direction lobe_direction(D d, const TabulatedBatchModel& model, int top_s
   const V cos_h = n0 - frac * (n0 - n1);
   const V sin_h = hn::Sqrt(hn::Max(zero, one - cos_h * cos_h)), sin_o = hn::Sqrt(hn::Max(zero, one - oz * oz));
   // phi relative to o's azimuth, then turned to it by o.xy / |o.xy|.
-  const CosSin phi = sample_phi(d, sin_o * sin_h, oz * cos_h, u2);
+  const CosSin phi = sample_phi(d, model.azimuth_guess, sin_o * sin_h, oz * cos_h, u2);
   V hx = sin_h * phi.c, hy = sin_h * phi.s;
   const V o_xy = hn::Sqrt(ox * ox + oy * oy);
   const auto turned = hn::And(sin_o > zero, o_xy > zero);
@@ -303,6 +321,7 @@ std::optional<TabulatedBatchModel> TabulatedBatchModel::of(const TabulatedMicrof
   m.smith = tables.smith;
   m.curve = tables.fresnel.value.data();
   m.body = tables.body;
+  m.azimuth_guess = AzimuthGuess::table().values();
   m.coat = tables.coat;
   m.weights = {lobe_weight, lobe.lobe_weight(), lobe.body_weight(), tables.coat.present() ? lobe.coat_weight() : 0.0};
   return m;

@@ -2,7 +2,7 @@
 // render/ggx_batch.h does for GGX: ShadingModel's sample_direction and eval (f(o, i) and the sampling
 // density) with the model as BRDF and proposal, or as the proposal alone (its density), every term theirs
 // in the same order, so the two agree to rounding (tests/test_render.cpp). The arc cosines of the grid
-// lookups and the sines and cosines of the azimuth's Newton steps are Highway's.
+// lookups are Highway's; the azimuth's Newton steps take sines and cosines from a series of their own.
 #pragma once
 
 #include <optional>
@@ -29,6 +29,7 @@ struct TabulatedBatchModel {
   int g1_size = 0;
   Smith smith = Smith::correlated;
   const Rgb* curve = nullptr;  // the Fresnel curve's 90 entries
+  const double* azimuth_guess = nullptr;  // AzimuthGuess::values() (model/visible_azimuth.h)
   Rgb body{0.0};
   Coat coat;
   ProposalWeights weights;
