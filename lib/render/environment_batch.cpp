@@ -9,6 +9,7 @@
 #include <hwy/contrib/math/math-inl.h>
 
 #include "render/environment_batch.h"
+#include "render/lanes-inl.h"
 
 HWY_BEFORE_NAMESPACE();
 namespace facetfit {
@@ -19,14 +20,14 @@ void SampleUniformSphereBatch(SphereSampleBatch& batch) {
   using D = hn::ScalableTag<double>;
   using V = hn::Vec<D>;
   const D d;
-  const V one = hn::Set(d, 1.0), two = hn::Set(d, 2.0), two_pi = hn::Set(d, 2.0 * kPi);
+  const V one = hn::Set(d, 1.0), two = hn::Set(d, 2.0);
   for (std::size_t k = 0; k < batch.padded_size(); k += hn::Lanes(d)) {
     const V z = one - two * hn::LoadU(d, batch.u1.data() + k);
     const V r = hn::Sqrt(hn::Max(hn::Zero(d), one - z * z));
-    const V phi = two_pi * hn::LoadU(d, batch.u2.data() + k);
-    hn::StoreU(r * hn::Cos(d, phi), d, batch.x.data() + k);
+    const lanes::CosSin phi = lanes::cos_sin_turn(d, hn::LoadU(d, batch.u2.data() + k));
+    hn::StoreU(r * phi.c, d, batch.x.data() + k);
     hn::StoreU(z, d, batch.y.data() + k);
-    hn::StoreU(r * hn::Sin(d, phi), d, batch.z.data() + k);
+    hn::StoreU(r * phi.s, d, batch.z.data() + k);
   }
 }
 

@@ -8,6 +8,7 @@
 #define FACETFIT_RENDER_LANES_INL_H_
 #endif
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 
@@ -74,6 +75,40 @@ inline V inverse_sqrt(D d, V x) {
 #else
   return hn::Set(d, 1.0) / hn::Sqrt(x);
 #endif
+}
+
+struct CosSin {
+  V c, s;
+};
+
+// (-1)^k / n! for n = 2k and 2k + 1, k = 0..10: the coefficients of cos_sin's series.
+constexpr std::array<double, 22> kCosSinSeries = [] {
+  std::array<double, 22> c{};
+  double inverse_factorial = 1.0;
+  for (int n = 0; n < 22; ++n) {
+    if (n > 0) inverse_factorial /= n;
+    c[std::size_t(n)] = (n / 2) % 2 == 0 ? inverse_factorial : -inverse_factorial;
+  }
+  return c;
+}();
+
+// cos and sin of phi in [-pi, pi] in one: cos is even, sin odd, and on [0, pi], with x = |phi| - pi/2 in
+// [-pi/2, pi/2], cos = -sin(x) and sin = cos(x), their Taylor series to x^21 and x^20, whose remainders at
+// pi/2 (1e-18, 2e-17) are below double rounding; Estrin's scheme, half Horner's dependent chain. Accurate
+// to double rounding of 1 (absolute, as a direction's components need; sin(0) is 6e-17). Highway's Sin and
+// Cos reduce any argument, each on its own.
+inline CosSin cos_sin(D d, V phi) {
+  const V x = hn::Abs(phi) - hn::Set(d, 0.5 * kPi), x2 = x * x;
+  const auto c = [&](std::size_t n) { return hn::Set(d, kCosSinSeries[n]); };
+  const V cos_x = hn::impl::Estrin(x2, c(0), c(2), c(4), c(6), c(8), c(10), c(12), c(14), c(16), c(18), c(20));
+  const V sin_x = hn::impl::Estrin(x2, c(1), c(3), c(5), c(7), c(9), c(11), c(13), c(15), c(17), c(19), c(21));
+  return {hn::Neg(sin_x * x), hn::CopySign(cos_x, phi)};
+}
+
+// cos and sin of 2 pi u, u in [0, 1): the angle taken in [-pi, pi) (u - 1 is exact for u >= 1/2).
+inline CosSin cos_sin_turn(D d, V u) {
+  const V one = hn::Set(d, 1.0);
+  return cos_sin(d, hn::Set(d, 2.0 * kPi) * hn::IfThenElse(u >= hn::Set(d, 0.5), u - one, u));
 }
 
 // Smith's Lambda of GGX for w above the horizon: (sqrt(1 + alpha^2 tan^2) - 1) / 2, with
@@ -176,7 +211,7 @@ inline V mixture_density(D d, const ProposalWeights& weights, bool coat, V lobe_
 template <class Lobe>
 void sample_proposal(D d, const ProposalWeights& weights, const Coat& coat, SampleBatch& batch, const Lobe& lobe) {
   const std::size_t n = batch.padded_size();
-  const V zero = hn::Zero(d), one = hn::Set(d, 1.0), two = hn::Set(d, 2.0), two_pi = hn::Set(d, 2.0 * kPi);
+  const V zero = hn::Zero(d), one = hn::Set(d, 1.0), two = hn::Set(d, 2.0);
   const V quarter_pi = hn::Set(d, 0.25 * kPi), half_pi = hn::Set(d, 0.5 * kPi);
   const V coat_alpha = hn::Set(d, coat.alpha), lobe_weight = hn::Set(d, weights.lobe_weight);
   const V part_lobe = hn::Set(d, weights.part_lobe), part_body = hn::Set(d, weights.part_body);
@@ -187,7 +222,8 @@ void sample_proposal(D d, const ProposalWeights& weights, const Coat& coat, Samp
   for (std::size_t k = 0; k < n; k += hn::Lanes(d)) {
     const V ox = hn::LoadU(d, batch.ox.data() + k), oy = hn::LoadU(d, batch.oy.data() + k), oz = hn::LoadU(d, batch.oz.data() + k);
     const V u1 = hn::LoadU(d, batch.u1.data() + k), u2 = hn::LoadU(d, batch.u2.data() + k), u3 = hn::LoadU(d, batch.u3.data() + k);
-    const V phi = two_pi * u2, cos_phi = hn::Cos(d, phi), sin_phi = hn::Sin(d, phi);
+    const CosSin turn = cos_sin_turn(d, u2);
+    const V cos_phi = turn.c, sin_phi = turn.s;
     // The proposal (u3 < lobe_weight): u1 picks its part and is rescaled within it (ProposalParts::sample).
     const auto in_lobe = u1 < part_lobe;
     Direction i = lobe(ox, oy, oz, u1 * per_lobe, u2, cos_phi, sin_phi);
@@ -218,7 +254,8 @@ void sample_proposal(D d, const ProposalWeights& weights, const Coat& coat, Samp
       const V num = hn::IfThenElse(a_wins, b, a), den = hn::IfThenElse(a_wins, a, b);
       const V ratio = divide(d, num, hn::IfThenElse(den == zero, one, den));
       const V disc_phi = hn::IfThenElseZero(hn::Not(centre), hn::IfThenElse(a_wins, quarter_pi * ratio, half_pi - quarter_pi * ratio));
-      const V x = r * hn::Cos(d, disc_phi), y = r * hn::Sin(d, disc_phi);
+      const CosSin disc = cos_sin(d, disc_phi);
+      const V x = r * disc.c, y = r * disc.s;
       i.x = hn::IfThenElse(cosine, x, i.x), i.y = hn::IfThenElse(cosine, y, i.y);
       i.z = hn::IfThenElse(cosine, hn::Sqrt(hn::Max(zero, one - x * x - y * y)), i.z);
       refused = hn::AndNot(cosine, refused);

@@ -8,8 +8,6 @@
 #include <hwy/highway.h>
 #include <hwy/contrib/math/math-inl.h>
 
-#include <array>
-
 #include "model/visible_azimuth.h"
 #include "render/lanes-inl.h"
 #include "render/tabulated_batch.h"
@@ -83,32 +81,6 @@ V positive_phi_integral(D d, V a, V b) {
   return hn::IfThenElse(whole, hn::Set(d, 2.0 * kPi) * b, part);
 }
 
-struct CosSin {
-  V c, s;
-};
-
-// (-1)^k / n! for n = 2k and 2k + 1, k = 0..10: the coefficients of the series below.
-constexpr std::array<double, 22> kSeries = [] {
-  std::array<double, 22> c{};
-  double inverse_factorial = 1.0;
-  for (int n = 0; n < 22; ++n) {
-    if (n > 0) inverse_factorial /= n;
-    c[std::size_t(n)] = (n / 2) % 2 == 0 ? inverse_factorial : -inverse_factorial;
-  }
-  return c;
-}();
-
-// cos and sin of phi in [0, pi], every angle sample_phi visits, in one: with x = phi - pi/2 in [-pi/2, pi/2],
-// cos(phi) = -sin(x) and sin(phi) = cos(x), their Taylor series to x^21 and x^20, whose remainders at pi/2
-// (1e-18, 2e-17) are below double rounding. Highway's Sin and Cos reduce any argument, each on its own.
-CosSin cos_sin_upper(D d, V phi) {
-  const V x = phi - hn::Set(d, 0.5 * kPi), x2 = x * x;
-  const auto c = [&](std::size_t n) { return hn::Set(d, kSeries[n]); };
-  const V cos_x = hn::impl::Estrin(x2, c(0), c(2), c(4), c(6), c(8), c(10), c(12), c(14), c(16), c(18), c(20));
-  const V sin_x = hn::impl::Estrin(x2, c(1), c(3), c(5), c(7), c(9), c(11), c(13), c(15), c(17), c(19), c(21));
-  return {hn::Neg(sin_x * x), cos_x};
-}
-
 // AzimuthGuess::operator() (model/visible_azimuth.h) on `values`, its table; lanes where a + b = 0 read
 // any node.
 V azimuth_guess(D d, const double* values, V a, V b, V u, V phi_max) {
@@ -130,7 +102,7 @@ V azimuth_guess(D d, const double* values, V a, V b, V u, V phi_max) {
 // (cos phi, sin phi): sample_visible_azimuth of model/visible_azimuth.h, its Newton steps on the CDF
 // a sin(phi) + b phi from the table's guess in every lane until each has stopped (2 steps for most, at
 // most 40).
-CosSin sample_phi(D d, const double* guess, V a, V b, V u) {
+lanes::CosSin sample_phi(D d, const double* guess, V a, V b, V u) {
   const V zero = hn::Zero(d), one = hn::Set(d, 1.0), two = hn::Set(d, 2.0), half = hn::Set(d, 0.5), pi = hn::Set(d, kPi);
   const auto whole = a <= b;
   const V ratio = hn::Min(hn::Max(lanes::divide(d, hn::Neg(b), hn::IfThenElse(whole, one, a)), hn::Set(d, -1.0)), one);
@@ -145,7 +117,7 @@ CosSin sample_phi(D d, const double* guess, V a, V b, V u) {
   V lo = zero, hi = phi_max, phi = azimuth_guess(d, guess, a, b, u, phi_max), c = one, s = zero;
   auto active = hn::Not(flat);
   for (int it = 0; it < 40 && !hn::AllFalse(d, active); ++it) {
-    const CosSin at = cos_sin_upper(d, phi);
+    const lanes::CosSin at = lanes::cos_sin(d, phi);
     const V sin_phi = at.s, cos_phi = at.c;
     const V f = a * sin_phi + b * phi - target;
     const auto beyond = f > zero;
@@ -161,12 +133,13 @@ CosSin sample_phi(D d, const double* guess, V a, V b, V u) {
     phi = hn::IfThenElse(active, next, phi);
   }
   if (!hn::AllFalse(d, active)) {
-    const CosSin at = cos_sin_upper(d, phi);
+    const lanes::CosSin at = lanes::cos_sin(d, phi);
     c = hn::IfThenElse(active, at.c, c), s = hn::IfThenElse(active, at.s, s);
   }
   if (!hn::AllFalse(d, flat)) {  // no density: uniform
     const V uniform = u * pi;
-    c = hn::IfThenElse(flat, hn::Cos(d, uniform), c), s = hn::IfThenElse(flat, hn::Sin(d, uniform), s);
+    const lanes::CosSin at = lanes::cos_sin(d, uniform);
+    c = hn::IfThenElse(flat, at.c, c), s = hn::IfThenElse(flat, at.s, s);
   }
   return {c, sign * s};
 }
@@ -204,7 +177,7 @@ lanes::Direction lobe_direction(D d, const TabulatedBatchModel& model, int top_s
   const V cos_h = n0 - frac * (n0 - n1);
   const V sin_h = hn::Sqrt(hn::Max(zero, one - cos_h * cos_h)), sin_o = hn::Sqrt(hn::Max(zero, one - oz * oz));
   // phi relative to o's azimuth, then turned to it by o.xy / |o.xy|.
-  const CosSin phi = sample_phi(d, model.azimuth_guess, sin_o * sin_h, oz * cos_h, u2);
+  const lanes::CosSin phi = sample_phi(d, model.azimuth_guess, sin_o * sin_h, oz * cos_h, u2);
   V hx = sin_h * phi.c, hy = sin_h * phi.s;
   const V o_xy = hn::Sqrt(ox * ox + oy * oy);
   const auto turned = hn::And(sin_o > zero, o_xy > zero);
