@@ -447,18 +447,21 @@ TEST(Environment, ConstantLightSamplesInSimdLanesEqualSample) {
     for (std::size_t n : {1, 3, 4, 15, 16, 17, 61}) {
       SphereSampleBatch batch;
       std::vector<std::pair<double, double>> numbers;
+      // The ends of [0, 1) too (the poles, phi = 0 and just short of 2 pi), and the azimuths where the
+      // lanes' cos_sin_turn folds its angle or its series is at its ends (phi = pi/2, pi, 3 pi/2).
+      const double u2_at[] = {0.0, 0.25, std::nextafter(0.5, 0.0), 0.5, 0.75, std::nextafter(1.0, 0.0), 1e-300};
       for (std::size_t k = 0; k < n; ++k) {
-        // The ends of [0, 1) too: the poles and phi = 0.
-        const double u1 = k == 0 ? 0.0 : k == 1 ? std::nextafter(1.0, 0.0) : u(rng), u2 = k == 2 ? 0.0 : u(rng);
+        const double u1 = k == 0 ? 0.0 : k == 1 ? std::nextafter(1.0, 0.0) : u(rng), u2 = k < 7 ? u2_at[k] : u(rng);
         numbers.emplace_back(u1, u2);
         batch.push(u1, u2);
       }
       sample_uniform_sphere_batch(batch, target);
       for (std::size_t k = 0; k < n; ++k) {
+        // To a few ulp of 1: the lanes' cos_sin_turn (render/lanes-inl.h) against the C library's.
         const Vec3 want = env.sample(numbers[k].first, numbers[k].second).d, got = batch.d(k);
-        EXPECT_NEAR(got.x, want.x, 1e-12) << k;
+        EXPECT_NEAR(got.x, want.x, 1e-15) << k << " u2 " << numbers[k].second;
         EXPECT_NEAR(got.y, want.y, 1e-15) << k;
-        EXPECT_NEAR(got.z, want.z, 1e-12) << k;
+        EXPECT_NEAR(got.z, want.z, 1e-15) << k << " u2 " << numbers[k].second;
         EXPECT_NEAR(glm::length(got), 1.0, 1e-12) << k;
       }
     }
@@ -515,7 +518,7 @@ TEST(Shading, GgxInSimdLanesEqualsOnePairAtATime) {
   std::uniform_real_distribution<double> u(0.0, 1.0);
   const auto direction = [&] { return lane_test_direction(rng, 0.05, true); };
   // A drawn direction within 1e-9: the visible normals' sqrt(1 - p1^2) (model/ggx_visible.h) turns the
-  // last bit of p1 or p1^2 (the lanes fuse multiply-adds, take Highway's cosine and, on AVX-512, u1 times
+  // last bit of p1 or p1^2 (the lanes fuse multiply-adds, take their own series' cosine and, on AVX-512, u1 times
   // the part's reciprocal) into 1e-16 / sqrt(1 - p1^2) of i, and p1 comes within 1e-9 of 1 (u1 rescaled
   // near the end of the lobe's part). With the lanes' divisions as they were, one sample of this test's
   // numbers was 1.1e-12 off too.
@@ -632,7 +635,7 @@ TEST(Shading, TabulatedInSimdLanesEqualsOnePairAtATime) {
   // into 1e-16 / theta_h of theta_h, which a peak a node wide (alpha 0.005: d ln D / d theta_h up to ~400)
   // turns into up to 3e-11 of D.
   // A drawn direction within 1e-7, what a float ray direction resolves: the azimuth's Newton steps stop
-  // there (model/tabulated.cpp), and near the end of its range, where the density vanishes, the CDF's
+  // there (model/visible_azimuth.cpp), and near the end of its range, where the density vanishes, the CDF's
   // rounding alone moves the root by ~1e-9.
   int cases = 0, compared = 0, found = 0;
   double worst = 0.0, sample_worst = 0.0;

@@ -26,7 +26,8 @@ AzimuthGuess::AzimuthGuess() {
   for (int i = 0; i <= kSize; ++i) {
     const double a = double(i) / kSize, b = 1.0 - a;
     const AzimuthRange range = azimuth_range(a, b);
-    values_[std::size_t(i * kStride + kSize)] = 1.0;  // where the CDF is flat (a > b), bisection stops short
+    // The ends exactly: at u = 1 with a > b the CDF is flat to rounding over ~1e-8 radians below phi_max.
+    values_[std::size_t(i * kStride + kSize)] = 1.0;
     for (int j = 1; j < kSize; ++j) {
       // Bisection to the last bit: slow and sure, once.
       const double target = double(j) / kSize * range.total;
@@ -46,7 +47,7 @@ const AzimuthGuess& AzimuthGuess::table() {
 }
 
 double AzimuthGuess::operator()(double a, double b, double u, double phi_max) const {
-  const double x = a / (a + b) * kSize, y = u * kSize;
+  const double x = clamp(a / (a + b), 0.0, 1.0) * kSize, y = clamp(u, 0.0, 1.0) * kSize;
   const int i = std::min(int(x), kSize - 1), j = std::min(int(y), kSize - 1);
   const double t = x - i, w = y - j;
   const double* row = values_.data() + std::size_t(i * kStride + j);

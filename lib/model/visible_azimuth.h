@@ -14,7 +14,8 @@ namespace facetfit {
 // i, j = 0..kSize; bilinear between nodes. Its guess is within 1e-4 radians for half of the draws and
 // within 0.05 for 99% (random views and normals): Newton then stops after two steps for most draws where
 // the start u phi_max took four (the LUT sphere's sampler, slowest of 8 lanes: 5.4 -> 2.3 steps). It
-// only sets where Newton starts, never the result. Immutable, built on first use (0.1 ms).
+// only sets where Newton starts: the result moves within the steps' stop (1e-7 radians). Immutable, built
+// on first use (0.1 ms).
 class AzimuthGuess {
  public:
   static constexpr int kSize = 32;
@@ -22,7 +23,8 @@ class AzimuthGuess {
 
   static const AzimuthGuess& table();
   const double* values() const { return values_.data(); }
-  // The guess of phi for (a, b) at u in [0, 1], phi_max given.
+  // The guess of phi for (a, b) at u in [0, 1], phi_max given; a, b >= 0, a + b > 0 (s and u are clamped to
+  // [0, 1], so a guess stays within [0, phi_max]).
   double operator()(double a, double b, double u, double phi_max) const;
 
  private:

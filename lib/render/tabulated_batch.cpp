@@ -32,7 +32,7 @@ struct GridPosition {
 GridPosition locate(D d, V c, int resolution) {
   const DI di;
   const V theta = hn::Acos(d, hn::Min(hn::Max(c, hn::Set(d, -1.0)), hn::Set(d, 1.0)));
-  const V x = hn::Min(hn::Sqrt(hn::Max(hn::Zero(d), theta) * hn::Set(d, 2.0 / kPi)), hn::Set(d, 1.0)) * hn::Set(d, double(resolution));
+  const V x = hn::Min(hn::Sqrt(hn::Max(hn::Zero(d), theta) / hn::Set(d, 0.5 * kPi)), hn::Set(d, 1.0)) * hn::Set(d, double(resolution));
   const I j = hn::Min(hn::ConvertTo(di, x), hn::Set(di, resolution - 1));
   return {j, x - hn::ConvertTo(d, j)};
 }
@@ -82,18 +82,23 @@ V positive_phi_integral(D d, V a, V b) {
 }
 
 // AzimuthGuess::operator() (model/visible_azimuth.h) on `values`, its table; lanes where a + b = 0 read
-// any node.
+// any node. s = a / (a + b) by the lanes' division (a few ulp from the one-pair path's): only the start
+// of Newton's steps, not their root.
 V azimuth_guess(D d, const double* values, V a, V b, V u, V phi_max) {
   const DI di;
   constexpr int n = AzimuthGuess::kSize;
   const V sum = a + b;
-  const V x = lanes::divide(d, a, hn::IfThenElse(sum > hn::Zero(d), sum, hn::Set(d, 1.0))) * hn::Set(d, double(n));
-  const V y = u * hn::Set(d, double(n));
+  // s clamped as AzimuthGuess does: lanes the caller discards (a view below the horizon: b < 0) would
+  // otherwise extrapolate far outside [0, phi_max] and hold the vector's Newton loop for ~25 bisections.
+  const V zero = hn::Zero(d), one = hn::Set(d, 1.0);
+  const V s = lanes::divide(d, a, hn::IfThenElse(sum > zero, sum, one));
+  const V x = hn::Min(hn::Max(s, zero), one) * hn::Set(d, double(n));
+  const V y = hn::Min(hn::Max(u, zero), one) * hn::Set(d, double(n));
   const I i = hn::Min(hn::ConvertTo(di, x), hn::Set(di, n - 1)), j = hn::Min(hn::ConvertTo(di, y), hn::Set(di, n - 1));
   const V t = x - hn::ConvertTo(d, i), w = y - hn::ConvertTo(d, j);
-  const I at = i * hn::Set(di, AzimuthGuess::kStride) + j, one = hn::Set(di, 1), next_row = hn::Set(di, AzimuthGuess::kStride);
-  const V v00 = hn::GatherIndex(d, values, at), v01 = hn::GatherIndex(d, values, at + one);
-  const V v10 = hn::GatherIndex(d, values, at + next_row), v11 = hn::GatherIndex(d, values, at + next_row + one);
+  const I next_row = hn::Set(di, AzimuthGuess::kStride), at = i * next_row + j, next = hn::Set(di, 1);
+  const V v00 = hn::GatherIndex(d, values, at), v01 = hn::GatherIndex(d, values, at + next);
+  const V v10 = hn::GatherIndex(d, values, at + next_row), v11 = hn::GatherIndex(d, values, at + next_row + next);
   const V near = v00 + w * (v01 - v00), far = v10 + w * (v11 - v10);
   return (near + t * (far - near)) * phi_max;
 }
