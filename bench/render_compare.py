@@ -383,7 +383,7 @@ def main(facetfit, mitsuba_python, dst, rgl=None):
                   "slower than vsqrtpd (325 ms) and stay hardware. Sines and cosines are a series of their own\n"
                   "(`cos_sin`, no argument reduction: 311 -> 299 ms), and the tabulated lobe's sampler inverts its\n"
                   "azimuth's CDF by Newton steps from a table's guess (model/visible_azimuth.h: 2.3 steps for the\n"
-                  "slowest of 8 lanes where the start u phi_max took 5.4; the LUT sphere 575 -> 517 ms).\n")
+                  "slowest of 8 lanes where the start u phi_max took 5.4; the LUT sphere 560 -> 528 ms).\n")
         out.write("\nBy stage: the GGX sphere at 64 spp on one CPU with parts of the scene left out (one render each, the\n"
                   "median of %d); the camera stage (the numbers and camera rays in SIMD lanes, render/camera_batch.h, the\n"
                   "sphere's hits, each hit's frame, the accumulation) is what every sample pays.\n\n"
