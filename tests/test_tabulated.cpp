@@ -283,6 +283,22 @@ TEST(Tabulated, ExtremesStayFinite) {
   }
 }
 
+// The azimuth's CDF a sin(phi) + b phi on [0, phi_max], written out here independently of
+// model/visible_azimuth.cpp, and its root for a target by bisection to the last bit.
+struct AzimuthCdf {
+  double a, b, phi_max, total;
+  AzimuthCdf(double a_, double b_) : a(a_), b(b_), phi_max(a_ <= b_ ? kPi : std::acos(-b_ / a_)), total(at(phi_max)) {}
+  double at(double phi) const { return a * std::sin(phi) + b * phi; }
+  double root(double target) const {
+    double lo = 0.0, hi = phi_max;
+    for (int it = 0; it < 64; ++it) {
+      const double mid = 0.5 * (lo + hi);
+      (at(mid) > target ? hi : lo) = mid;
+    }
+    return 0.5 * (lo + hi);
+  }
+};
+
 TEST(VisibleAzimuth, InvertsItsCdf) {
   // The drawn phi is within 1e-7 radians (the sampler's stop, below what a float ray direction resolves)
   // of the root of a sin(phi) + b phi = u' total (u' = u folded onto one side, the root found by
@@ -297,21 +313,15 @@ TEST(VisibleAzimuth, InvertsItsCdf) {
   for (int k = 0; k < 20; ++k) us.push_back(uniform(rng));
   double worst = 0.0;
   for (const auto& [a, b] : cases) {
-    const double phi_max = a <= b ? kPi : std::acos(-b / a);
-    const double total = a * std::sin(phi_max) + b * phi_max;
+    const AzimuthCdf cdf(a, b);
     for (double u : us) {
       const auto [c, s] = sample_visible_azimuth(a, b, u);
       ASSERT_TRUE(std::isfinite(c) && std::isfinite(s)) << a << " " << b << " " << u;
       ASSERT_NEAR(c * c + s * s, 1.0, 1e-12);
-      const double phi = std::atan2(std::abs(s), c), target = (u < 0.5 ? 2.0 * u : 2.0 * u - 1.0) * total;
-      double lo = 0.0, hi = phi_max;
-      for (int it = 0; it < 64; ++it) {
-        const double mid = 0.5 * (lo + hi);
-        (a * std::sin(mid) + b * mid > target ? hi : lo) = mid;
-      }
+      const double phi = std::atan2(std::abs(s), c), target = (u < 0.5 ? 2.0 * u : 2.0 * u - 1.0) * cdf.total;
       // Where the density vanishes (phi_max, a > b or a = b) the root itself is set only to the CDF's
       // rounding: there the CDF's value is the measure.
-      const double phi_error = std::abs(phi - 0.5 * (lo + hi)), cdf_error = std::abs(a * std::sin(phi) + b * phi - target) / total;
+      const double phi_error = std::abs(phi - cdf.root(target)), cdf_error = std::abs(cdf.at(phi) - target) / cdf.total;
       EXPECT_TRUE(phi_error < 1e-7 || cdf_error < 1e-14) << a << " " << b << " " << u << ": " << phi_error << " " << cdf_error;
       worst = std::max(worst, std::min(phi_error, cdf_error));
       if (phi > 1e-7) {
@@ -332,15 +342,10 @@ TEST(VisibleAzimuth, GuessIsNearTheRoot) {
   std::vector<double> errors;
   for (int k = 0; k < 20000; ++k) {
     const double a = uniform(rng), b = uniform(rng), u = uniform(rng);
-    const double phi_max = a <= b ? kPi : std::acos(-b / a), total = a * std::sin(phi_max) + b * phi_max;
-    double lo = 0.0, hi = phi_max;
-    for (int it = 0; it < 64; ++it) {
-      const double mid = 0.5 * (lo + hi);
-      (a * std::sin(mid) + b * mid > u * total ? hi : lo) = mid;
-    }
-    const double g = guess(a, b, u, phi_max);
-    ASSERT_TRUE(g >= 0.0 && g <= phi_max) << a << " " << b << " " << u;
-    errors.push_back(std::abs(g - 0.5 * (lo + hi)));
+    const AzimuthCdf cdf(a, b);
+    const double g = guess(a, b, u, cdf.phi_max);
+    ASSERT_TRUE(g >= 0.0 && g <= cdf.phi_max) << a << " " << b << " " << u;
+    errors.push_back(std::abs(g - cdf.root(u * cdf.total)));
   }
   std::sort(errors.begin(), errors.end());
   const double median = errors[errors.size() / 2], p99 = errors[errors.size() * 99 / 100];
@@ -353,8 +358,7 @@ TEST(VisibleAzimuth, GuessTableIsAnInverseCdf) {
   // Each row of s runs from 0 to 1, increasing, and solves its CDF at its nodes to double rounding.
   const AzimuthGuess& guess = AzimuthGuess::table();
   for (int i = 0; i <= AzimuthGuess::kSize; ++i) {
-    const double a = double(i) / AzimuthGuess::kSize, b = 1.0 - a;
-    const double phi_max = a <= b ? kPi : std::acos(-b / a), total = a * std::sin(phi_max) + b * phi_max;
+    const AzimuthCdf cdf(double(i) / AzimuthGuess::kSize, 1.0 - double(i) / AzimuthGuess::kSize);
     const double* row = guess.values() + i * AzimuthGuess::kStride;
     EXPECT_NEAR(row[0], 0.0, 1e-15);
     EXPECT_NEAR(row[AzimuthGuess::kSize], 1.0, 1e-15);
@@ -362,8 +366,7 @@ TEST(VisibleAzimuth, GuessTableIsAnInverseCdf) {
       if (j > 0) {
         EXPECT_GT(row[j], row[j - 1]) << i << " " << j;
       }
-      const double phi = row[j] * phi_max;
-      EXPECT_NEAR(a * std::sin(phi) + b * phi, double(j) / AzimuthGuess::kSize * total, 1e-14) << i << " " << j;
+      EXPECT_NEAR(cdf.at(row[j] * cdf.phi_max), double(j) / AzimuthGuess::kSize * cdf.total, 1e-14) << i << " " << j;
     }
   }
 }

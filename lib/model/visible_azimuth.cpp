@@ -13,7 +13,9 @@ struct AzimuthRange {
   double phi_max, total;  // the CDF's end and its value there
 };
 
-// sin(phi_max) = sqrt(1 - (b / a)^2) where a > b: no sine of the arc cosine.
+// total is half of positive_phi_integral(a, b) (core/quadrature_rules.h), written here to share phi_max's
+// arc cosine, with sin(phi_max) = sqrt(1 - (b / a)^2) where a > b (no sine of the arc cosine), as the
+// lanes compute it (render/tabulated_batch.cpp, sample_phi).
 AzimuthRange azimuth_range(double a, double b) {
   if (a <= b) return {kPi, b * kPi};
   const double ratio = -b / a, phi_max = std::acos(ratio);
