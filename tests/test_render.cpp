@@ -470,8 +470,8 @@ TEST(Environment, ConstantLightSamplesInSimdLanesEqualSample) {
 TEST(Camera, SamplesInSimdLanesEqualOneAtATime) {
   // The numbers exactly (integer arithmetic, and 53 bits to a double), the directions to rounding; pixels
   // of a wide image (large keys), seeds that set the high bits, sample indices past 2^24 (shifted by 40),
-  // batches of every length modulo the lane count; both the AVX2 code (where the CPU has it) and the
-  // baseline.
+  // batches of every length modulo the lane count; every target (the best one: AVX-512's whole 64-bit
+  // multiplications where the CPU has it; AVX2's from 32-bit halves; the baseline).
   PinholeCamera camera;
   camera.position = Vec3(0.0, 0.6, 4.0);
   camera.forward = glm::normalize(-camera.position);

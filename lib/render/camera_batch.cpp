@@ -24,11 +24,14 @@ using DI = hn::RebindToSigned<D>;
 using VU = hn::Vec<DU>;
 
 // The low 64 bits of a x c: AVX2 multiplies 32 x 32 bits, so from the halves (the high halves' product
-// lies above bit 63). One lane (the baseline) multiplies them whole.
+// lies above bit 63). One lane (the baseline) multiplies them whole, and so does AVX-512 (vpmullq: 3 uops
+// against the halves' 8; perf: the camera samples 9 -> 7% of a Lambertian sphere's render).
 VU mul(VU a, std::uint64_t c) {
   const DU du;
 #if HWY_TARGET == HWY_SCALAR
   return a * hn::Set(du, c);
+#elif HWY_TARGET == HWY_AVX3
+  return VU{_mm512_mullo_epi64(a.raw, hn::Set(du, c).raw)};
 #else
   const hn::Repartition<std::uint32_t, DU> d32;
   const auto c_lo = hn::BitCast(d32, hn::Set(du, c & 0xFFFFFFFFull)), c_hi = hn::BitCast(d32, hn::Set(du, c >> 32));
