@@ -326,17 +326,22 @@ INSTANTIATE_TEST_SUITE_P(Render, RayStreams, ::testing::Values(R"({"builtin": "s
 // The lanes' hits and slots (render/wavefront.h) on every SIMD target against the one-hit path's
 // arithmetic: each hit placed as Frame (core/frame.h) places it, with and without a tangent, on spheres
 // and triangles; each light's and the environment's slot where it lights the hit and nowhere else, with
-// its direction in the frame, its ray and what arrives along it.
+// its direction in the frame, its ray and what arrives along it. Both with a light sample's radiance and
+// density per hit (a map's) and a point light (which reads the hits' positions), and with the same
+// radiance and density for every hit (a constant environment's) and a directional light alone (no
+// positions).
 TEST(Wavefront, HitsAndSlotsEqualTheOneHitPath) {
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> u(0.0, 1.0);
   const auto unit = [&] { return glm::normalize(Vec3(u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5) + Vec3(1e-3)); };
   const Vec3 camera(0.2, 0.5, 4.0), tangent(0.3, 1.0, 0.2);
   const double eps = 2e-4;
-  const std::vector<LaneLight> lights = {{true, 0.3, 1.0, 0.5, 3, 2, 1}, {false, -2.0, 3.0, 1.0, 5, 4, 3}};
-  for (const std::size_t n : {1, 5, 37}) {
+  for (const auto& [uniform, n] : {std::pair<bool, std::size_t>{false, 1}, {false, 5}, {false, 37}, {true, 1}, {true, 5}, {true, 37}}) {
+    std::vector<LaneLight> lights = {{true, 0.3, 1.0, 0.5, 3, 2, 1}};
+    if (!uniform) lights.push_back({false, -2.0, 3.0, 1.0, 5, 4, 3});
     TileHits tile;
     tile.resize_to(n);
+    tile.uniform_light = uniform;
     for (std::size_t k = 0; k < n; ++k) {
       const Vec3 d = glm::normalize(Vec3(u(rng) - 0.5, u(rng) - 0.5, -4.0));
       tile.dx[k] = d.x, tile.dy[k] = d.y, tile.dz[k] = d.z;
@@ -344,17 +349,20 @@ TEST(Wavefront, HitsAndSlotsEqualTheOneHitPath) {
       const Vec3 g = k % 2 ? Vec3(u(rng), u(rng), -u(rng)) : unit();  // a centre, or a triangle's normal
       tile.gx[k] = g.x, tile.gy[k] = g.y, tile.gz[k] = g.z;
       const Vec3 l = unit();
-      tile.lx[k] = l.x, tile.ly[k] = l.y, tile.lz[k] = l.z, tile.light_pdf[k] = k % 5 ? 0.1 : 0.0;
-      tile.light_r[k] = 0.3, tile.light_g[k] = 0.2, tile.light_b[k] = 0.1;
+      tile.lx[k] = l.x, tile.ly[k] = l.y, tile.lz[k] = l.z, tile.light_pdf[k] = k % 5 || uniform ? 0.1 : 0.0;
+      tile.light_r[k] = uniform ? 0.3 : 0.1 * double(k % 4), tile.light_g[k] = 0.2, tile.light_b[k] = 0.1;
       tile.u1[k] = u(rng), tile.u2[k] = u(rng), tile.u3[k] = u(rng);
     }
     for (const bool with_tangent : {false, true})
       for (const SimdTarget target : kSimdTargets) {
-        const std::string where = std::to_string(n) + (with_tangent ? " tangent " : " ") + simd_target_name(target);
+        const std::string where = std::to_string(n) + (with_tangent ? " tangent " : " ") + (uniform ? "uniform " : "") + simd_target_name(target);
         HitBatch hits;
-        place_hits(tile, camera, eps, 0.0, with_tangent ? &tangent : nullptr, hits, target);
+        place_hits(tile, camera, eps, 0.0, with_tangent ? &tangent : nullptr, !uniform, hits, target);
         ShadowBatch slots;
         SlotRanges ranges;
+        if (uniform) {
+          EXPECT_THROW(light_slots(hits, true, {{false, -2.0, 3.0, 1.0, 5, 4, 3}}, eps, slots, ranges, target), std::invalid_argument);
+        }
         light_slots(hits, true, lights, eps, slots, ranges, target);
         const auto close = [](double a, double b) { return std::abs(a - b) <= 1e-12 * std::max(1.0, std::abs(b)); };
         // The one-hit path, hit by hit of material 0, slot by slot.
@@ -375,8 +383,13 @@ TEST(Wavefront, HitsAndSlotsEqualTheOneHitPath) {
                                      {hits.nx[row], frame.n.x}, {hits.ny[row], frame.n.y}, {hits.nz[row], frame.n.z},
                                      {hits.draws.ox[row], o.x}, {hits.draws.oy[row], o.y}, {hits.draws.oz[row], o.z},
                                      {hits.origin_x[row], origin.x}, {hits.origin_y[row], origin.y}, {hits.origin_z[row], origin.z},
-                                     {hits.draws.u1[row], tile.u1[k]}, {hits.draws.u3[row], tile.u3[k]}, {hits.light_pdf[row], tile.light_pdf[k]}})
+                                     {hits.draws.u1[row], tile.u1[k]}, {hits.draws.u3[row], tile.u3[k]}})
             ASSERT_TRUE(close(a, b)) << where << " hit " << k << ": " << a << " against " << b;
+          if (!uniform) {
+            EXPECT_EQ(hits.light_pdf[row], tile.light_pdf[k]) << where;
+            EXPECT_EQ(hits.light_r[row], tile.light_r[k]) << where;
+            EXPECT_TRUE(close(hits.px[row], p.x) && close(hits.pz[row], p.z)) << where;
+          }
           // The environment's slot: where the light sample and the view are above the horizon.
           const Vec3 l(tile.lx[k], tile.ly[k], tile.lz[k]);
           const Vec3 il = frame.to_local(l);
@@ -385,6 +398,9 @@ TEST(Wavefront, HitsAndSlotsEqualTheOneHitPath) {
             ASSERT_LT(e, ranges.lights_begin) << where;
             EXPECT_EQ(slots.owner[e], double(k)) << where;
             EXPECT_TRUE(close(slots.iz[e], il.z) && close(slots.rays.dx[e], l.x) && close(slots.rays.ox[e], origin.x)) << where;
+            EXPECT_EQ(slots.light_pdf[e], tile.light_pdf[k]) << where;
+            EXPECT_EQ(slots.arriving_r[e], tile.light_r[k]) << where;
+            EXPECT_EQ(slots.arriving_g[e], tile.light_g[k]) << where;
             EXPECT_EQ(slots.rays.tnear[e], eps) << where;
             EXPECT_TRUE(std::isinf(slots.rays.tfar[e])) << where;
           }

@@ -162,9 +162,12 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
   std::vector<char> in_lanes;
   for (std::size_t m = 0; m < materials.size(); ++m) in_lanes.push_back(materials[m]->has_lanes() && !stretch_textures[m]);
   std::vector<LaneLight> lane_lights;
-  for (const LightDesc& light : desc.lights)
+  bool point_lights = false;  // whether the lanes' hits need their positions
+  for (const LightDesc& light : desc.lights) {
     lane_lights.push_back({light.kind == LightDesc::Kind::directional, light.vector.x, light.vector.y, light.vector.z, light.value.r,
                            light.value.g, light.value.b});
+    point_lights = point_lights || light.kind != LightDesc::Kind::directional;
+  }
 
   // The camera ray's hit, its shading frame and the shadow rays' origin; the radiance of a ray that hits
   // nothing. On the stream path a loop of its own over the tile, whose square roots and divisions overlap
@@ -385,6 +388,7 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
       for (int c = 0; c < 4; ++c) sum[c][k] = acc[c];
     }
     tile_hits.resize_to(n);
+    tile_hits.uniform_light = sphere_lanes;
     if (sphere_lanes) {
       // A constant environment's radiance and density, the same for every light sample of the tile.
       std::fill_n(tile_hits.light_pdf.begin(), padded, constant_light.pdf);
@@ -445,7 +449,7 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
       }
       for (std::size_t m = 0; m < materials.size(); ++m) {
         if (present[m])
-          place_hits(tile_hits, cam.position, eps, double(m), tangents[m] ? &*tangents[m] : nullptr, waves[m].hits);
+          place_hits(tile_hits, cam.position, eps, double(m), tangents[m] ? &*tangents[m] : nullptr, point_lights, waves[m].hits);
         else
           waves[m].hits.clear();
       }

@@ -10,6 +10,7 @@
 
 #include <cstdint>
 #include <limits>
+#include <stdexcept>
 
 #include "render/lanes-inl.h"
 #include "render/wavefront.h"
@@ -125,12 +126,15 @@ HWY_INLINE Vec3V normalize(D d, const Vec3V& v) {
 
 }  // namespace
 
-void PlaceHits(const TileHits& tile, const Vec3& camera, double eps, double material, const Vec3* tangent, HitBatch& out) {
+void PlaceHits(const TileHits& tile, const Vec3& camera, double eps, double material, const Vec3* tangent, bool positions, HitBatch& out) {
   const D d;
   const std::size_t n = tile.padded_size(), lanes = hn::Lanes(d);
   const V zero = hn::Zero(d), one = hn::Set(d, 1.0), this_material = hn::Set(d, material), epsilon = hn::Set(d, eps);
   out.clear();
   out.reserve(tile.size() + lanes);
+  out.positions = positions;
+  out.uniform_light.reset();
+  if (tile.uniform_light) out.uniform_light = {tile.light_pdf[0], tile.light_r[0], tile.light_g[0], tile.light_b[0]};
   std::size_t size = 0;
   for (std::size_t k = 0; k < n; k += lanes) {
     const M mine = hn::And(real(d, k, tile.size()), load(d, tile.material, k) == this_material);
@@ -167,11 +171,13 @@ void PlaceHits(const TileHits& tile, const Vec3& camera, double eps, double mate
     put(d, frame.b.x, out.bx), put(d, frame.b.y, out.by), put(d, frame.b.z, out.bz);
     put(d, nrm.x, out.nx), put(d, nrm.y, out.ny), put(d, nrm.z, out.nz);
     put(d, o.x, out.draws.ox), put(d, o.y, out.draws.oy), put(d, o.z, out.draws.oz);
-    put(d, p.x, out.px), put(d, p.y, out.py), put(d, p.z, out.pz);
+    if (positions) put(d, p.x, out.px), put(d, p.y, out.py), put(d, p.z, out.pz);
     put(d, p.x + epsilon * nrm.x, out.origin_x), put(d, p.y + epsilon * nrm.y, out.origin_y), put(d, p.z + epsilon * nrm.z, out.origin_z);
     put(d, load(d, tile.lx, k), out.lx), put(d, load(d, tile.ly, k), out.ly), put(d, load(d, tile.lz, k), out.lz);
-    put(d, load(d, tile.light_pdf, k), out.light_pdf);
-    put(d, load(d, tile.light_r, k), out.light_r), put(d, load(d, tile.light_g, k), out.light_g), put(d, load(d, tile.light_b, k), out.light_b);
+    if (!tile.uniform_light) {
+      put(d, load(d, tile.light_pdf, k), out.light_pdf);
+      put(d, load(d, tile.light_r, k), out.light_r), put(d, load(d, tile.light_g, k), out.light_g), put(d, load(d, tile.light_b, k), out.light_b);
+    }
     put(d, load(d, tile.u1, k), out.draws.u1), put(d, load(d, tile.u2, k), out.draws.u2), put(d, load(d, tile.u3, k), out.draws.u3);
     put(d, hn::Iota(d, double(k)), out.owner);
     size += hn::CountTrue(d, mine);
@@ -196,19 +202,22 @@ void LightSlots(const HitBatch& hits, bool environment, const std::vector<LaneLi
   out.clear();
   out.reserve(n * (1 + lights.size()) + lanes);
   std::size_t size = 0;
-  if (environment)
+  if (environment) {
+    const std::array<double, 4>* uniform = hits.uniform_light ? &*hits.uniform_light : nullptr;
     for (std::size_t k = 0; k < n; k += lanes) {
       const FrameV frame = frame_at(d, hits, k);
       const Vec3V o = view_at(d, hits, k);
       const Vec3V l{load(d, hits.lx, k), load(d, hits.ly, k), load(d, hits.lz, k)};
-      const V pdf = load(d, hits.light_pdf, k);
+      const auto light = [&](int c, const std::vector<double>& column) { return uniform ? hn::Set(d, (*uniform)[c]) : load(d, column, k); };
+      const V pdf = light(0, hits.light_pdf);
       const Vec3V il = frame.to_local(l);
       const M lit = hn::And(real(d, k, hits.size()), hn::And(o.z > zero, hn::And(il.z > zero, pdf > zero)));
       size += append(d, lit,
-                     {o, il, l, one, infinity, load(d, hits.light_r, k), load(d, hits.light_g, k), load(d, hits.light_b, k), pdf,
+                     {o, il, l, one, infinity, light(1, hits.light_r), light(2, hits.light_g), light(3, hits.light_b), pdf,
                       load(d, hits.owner, k)},
                      origin_at(d, hits, k), hn::Set(d, tnear), out, size);
     }
+  }
   ranges.lights_begin = size;
   ranges.light_begin.clear();
   for (const LaneLight& light : lights) {
@@ -297,12 +306,15 @@ HWY_AFTER_NAMESPACE();
 #include "render/simd_dispatch.h"
 namespace facetfit {
 
-void place_hits(const TileHits& tile, const Vec3& camera, double eps, double material, const Vec3* tangent, HitBatch& out, SimdTarget target) {
-  FACETFIT_DISPATCH(target, PlaceHits, tile, camera, eps, material, tangent, out);
+void place_hits(const TileHits& tile, const Vec3& camera, double eps, double material, const Vec3* tangent, bool positions, HitBatch& out,
+                SimdTarget target) {
+  FACETFIT_DISPATCH(target, PlaceHits, tile, camera, eps, material, tangent, positions, out);
 }
 
 void light_slots(const HitBatch& hits, bool environment, const std::vector<LaneLight>& lights, double tnear, ShadowBatch& out,
                  SlotRanges& ranges, SimdTarget target) {
+  for (const LaneLight& light : lights)
+    if (!light.directional && !hits.positions) throw std::invalid_argument("light_slots: a point light needs the hits' positions");
   FACETFIT_DISPATCH(target, LightSlots, hits, environment, lights, tnear, out, ranges);
 }
 
