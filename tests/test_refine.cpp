@@ -205,6 +205,38 @@ class SkewedSource final : public OneSidedMeasurement {
   }
 };
 
+// The metric's residual (fit/measurement.h): the lightness difference itself, except for a pair with a
+// direction past 70 degrees, whose square is the soft L1 loss 2 s^2 (sqrt(1 + r^2 / s^2) - 1): r itself
+// near zero, growing as 2 s |r| far out; its slope against central differences on both sides of zero.
+TEST(Metric, GrazingPairsEnterThroughASoftL1Loss) {
+  const double s = kGrazingScale;
+  EXPECT_FALSE(grazing_pair(Vec3(0.0, 0.0, 1.0), Vec3(std::sin(1.2195), 0.0, std::cos(1.2195))));  // 69.87 degrees
+  EXPECT_TRUE(grazing_pair(Vec3(0.0, 0.0, 1.0), Vec3(std::sin(1.2240), 0.0, std::cos(1.2240))));   // 70.13 degrees
+  EXPECT_TRUE(grazing_pair(Vec3(std::sin(1.3), 0.0, std::cos(1.3)), Vec3(0.0, 0.0, 1.0)));
+  const double cosine = 0.6, lightness = metric_transform(0.2);
+  for (const double model : {0.0, 0.05, 0.2 / 0.6 * (1.0 + 1e-9), 0.3, 1.0, 40.0}) {
+    const MetricResidual plain = metric_residual(model, cosine, lightness, false), loss = metric_residual(model, cosine, lightness, true);
+    const double r = plain.value;
+    EXPECT_NEAR(r, metric_transform(model * cosine) - lightness, 1e-15);
+    if (std::abs(r) > 1e-3 * s) {  // below, the loss written plainly loses its digits to the difference
+      const double want = 2.0 * s * s * (std::sqrt(1.0 + r * r / (s * s)) - 1.0);
+      EXPECT_NEAR(loss.value * loss.value, want, 1e-9 * want) << model;
+    }
+    EXPECT_EQ(std::signbit(loss.value), std::signbit(r)) << model;
+    if (std::abs(r) < 1e-6 * s) {
+      EXPECT_NEAR(loss.value, r, 1e-12 * std::abs(r)) << model;
+    }
+    if (std::abs(r) > 20.0 * s) {
+      EXPECT_NEAR(loss.value * loss.value / (2.0 * s * std::abs(r)), 1.0, 0.06) << model;
+    }
+    const double h = 1e-7 * std::max(1.0, model);
+    const double numeric = (metric_residual(model + h, cosine, lightness, true).value - metric_residual(model - h, cosine, lightness, true).value) / (2.0 * h);
+    if (model > h) {
+      EXPECT_NEAR(loss.slope, numeric, 1e-6 * std::abs(numeric)) << model;
+    }
+  }
+}
+
 // The bins of a source with two one-sided estimates: each bin twice, once per estimate measured, with the
 // estimate's own cosine and lightness (no division by a grazing cosine) and half the bin's weight.
 TEST(MeasuredBinsOneSided, EachBinOncePerMeasuredEstimate) {

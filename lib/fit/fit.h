@@ -25,8 +25,9 @@ namespace facetfit {
 // same options is baked again rather than served (lut/bake.h). Bump when the same input and options give
 // a different fit. 2: an RGL file's refinement reads its two one-sided estimates (fit/measurement.h);
 // 3: the parametric fits solved by fit/small_problem.h; 4: the refinement solved to convergence in two
-// passes, a UTIA file's isotropic fits on its own nodes; 5: its anisotropic lobes on its node pairs.
-constexpr int kFitRevision = 5;
+// passes, a UTIA file's isotropic fits on its own nodes; 5: its anisotropic lobes on its node pairs;
+// 6: the grazing pairs' soft L1 loss (fit/measurement.h).
+constexpr int kFitRevision = 6;
 
 struct FitOptions {
   int resolution = 90;  // intervals of the u grid; R + 1 nodes

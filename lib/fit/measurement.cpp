@@ -148,9 +148,10 @@ double measurement_error(const MeasuredBins& bins, const Brdf& model) {
   for (std::size_t b = 0; b < bins.size(); ++b) {
     const auto f = model.eval(bins.o[b], bins.i[b]);
     const Rgb m = f ? *f : Rgb(0.0);
+    const bool grazing = grazing_pair(bins.o[b], bins.i[b]);
     for (int c = 0; c < 3; ++c) {
       if (!(bins.valid[b] >> c & 1u)) continue;
-      const double r = metric_residual(m[c], bins.cosine[b], bins.lightness[b][c]).value;
+      const double r = metric_residual(m[c], bins.cosine[b], bins.lightness[b][c], grazing).value;
       sum += bins.weight[b] * r * r;
       norm += bins.weight[b];
     }

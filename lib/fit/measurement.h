@@ -3,6 +3,7 @@
 //
 // Metric (docs/extraction.md, "Refinement"): the weighted mean over bins and channels of
 //   (L(f c) - L(y c))^2,   c = (cos theta_i + cos theta_o) / 2,
+// (a soft L1 loss of that difference for the grazing pairs: metric_residual below),
 // y the measurement, f the model, L CIE L*'s lightness function of pi x (over 116). f c is the reflected
 // radiance per unit irradiance, so a residual is a difference of lightness, what CIE Delta E measures of
 // a rendering: compressive on glossy peaks (10-1000), steep but bounded near black, where dark channels
@@ -97,15 +98,32 @@ inline double metric_transform(double x, double* slope = nullptr) {
   return x >= 0.0 ? lightness : 8.0 / 29.0 - lightness;
 }
 
+// Pairs with a direction more than 70 degrees from the normal (docs/extraction.md, "Grazing pairs"):
+// where a gonioreflectometer measures least reliably (an RGL file's last measured elevation is 78.5
+// degrees, its two one-sided estimates part by 27% at 86), and where a residual of several units of
+// lightness says more about the instrument, or about what one isotropic lobe cannot hold (a fabric's
+// weave), than about the surface a rendering shows. Their residuals pass through a soft L1 loss of scale
+// 4 units of L*: quadratic below it, growing as their size rather than its square beyond, so the
+// few-pixel rim no longer pulls the lobe away from the pairs that fill the screen.
+constexpr double kGrazingCos = 0.34202014332566873;  // cos(70 degrees)
+constexpr double kGrazingScale = 4.0 / 116.0;        // 4 units of L*, in the residuals' units (L* / 116)
+inline bool grazing_pair(const Vec3& o, const Vec3& i) { return std::min(o.z, i.z) < kGrazingCos; }
+
 // The metric's per-bin residual of one channel given the measurement's `lightness` (MeasuredBins: the
 // model is nonnegative; the measurement is kept as it is), and its derivative with respect to the model.
+// For a grazing pair, psi(r) = r sqrt(2 / (1 + q)), q = sqrt(1 + r^2 / s^2), s = kGrazingScale: its square
+// is the soft L1 loss 2 s^2 (q - 1), written without the difference that loses digits for small r; its
+// derivative 1 / (q sqrt(2 / (1 + q))) is 1 at r = 0.
 struct MetricResidual {
   double value = 0.0, slope = 0.0;
 };
-inline MetricResidual metric_residual(double model, double cosine, double lightness) {
+inline MetricResidual metric_residual(double model, double cosine, double lightness, bool grazing) {
   double slope = 0.0;
   const double r = metric_transform(std::max(model, 0.0) * cosine, &slope) - lightness;
-  return {r, model >= 0.0 ? cosine * slope : 0.0};
+  const double dr = model >= 0.0 ? cosine * slope : 0.0;
+  if (!grazing) return {r, dr};
+  const double q = std::sqrt(1.0 + (r / kGrazingScale) * (r / kGrazingScale)), s = std::sqrt(2.0 / (1.0 + q));
+  return {r * s, dr / (q * s)};
 }
 
 // Root of the metric's weighted mean square: how far `model` is from the measurement.

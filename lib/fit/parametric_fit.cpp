@@ -166,6 +166,7 @@ class RowCost final : public ceres::CostFunction {
         coat_d_f0 = s_mu * dc.value * gc.value * inv4;
       }
       const double w = std::sqrt(bins_.weight[k]), c = bins_.cosine[k];
+      const bool grazing = grazing_pair(bins_.o[k], bins_.i[k]);
       for (int e = 0; e < 3; ++e) {
         const std::size_t r = 3 * q + std::size_t(e);
         if (!(bins_.valid[k] >> e & 1u)) {
@@ -175,7 +176,7 @@ class RowCost final : public ceres::CostFunction {
         const FresnelTerms fresnel = fresnel_terms(f0[e], f82[e], mu, f82_);
         const double m = body[e] * kInvPi + fresnel.value * lobe + coat;
         // F82-tint can dip below zero for extreme f82: no negative reflectance, and no slope there.
-        const MetricResidual res = metric_residual(m, c, bins_.lightness[k][e]);
+        const MetricResidual res = metric_residual(m, c, bins_.lightness[k][e], grazing);
         residuals[r] = w * res.value;
         if (!jacobians || m < 0.0) continue;
         const double dm = w * res.slope;
@@ -294,6 +295,7 @@ class AnisotropicRowCost final : public ceres::CostFunction {
           lobe_slope[e] = (lobe_at(plus, k) - lobe_at(minus, k)) / (2.0 * kStep);
         }
       const double w = std::sqrt(bins_.weight[k]), c = bins_.cosine[k];
+      const bool grazing = grazing_pair(bins_.o[k], bins_.i[k]);
       for (int e = 0; e < 3; ++e) {
         const std::size_t r = 3 * q + std::size_t(e);
         if (!(bins_.valid[k] >> e & 1u)) {
@@ -302,7 +304,7 @@ class AnisotropicRowCost final : public ceres::CostFunction {
         }
         const FresnelTerms fresnel = fresnel_terms(f0[e], f82[e], bins_.cos_d[k], true);
         const double m = body[e] * kInvPi + fresnel.value * lobe;
-        const MetricResidual res = metric_residual(m, c, bins_.lightness[k][e]);
+        const MetricResidual res = metric_residual(m, c, bins_.lightness[k][e], grazing);
         residuals[r] = w * res.value;
         if (!jacobians || m < 0.0) continue;
         const double dm = w * res.slope;

@@ -77,11 +77,12 @@ class RowCost final : public ceres::CostFunction {
     for (std::size_t b = 0; b < n; ++b) {
       const std::size_t k = row_.begin + b;
       const double s = std::sqrt(bins_.weight[k]), c = bins_.cosine[k], g = g_[k];
+      const bool grazing = grazing_pair(bins_.o[k], bins_.i[k]);
       for (int ch = 0; ch < 3; ++ch) {
         const std::size_t r = 3 * b + std::size_t(ch);
         const bool valid = bins_.valid[k] >> ch & 1u;
         const double m = body[ch] * kInvPi + fresnel[ch] * d * g + coat_[k];
-        const MetricResidual res = valid ? metric_residual(m, c, bins_.lightness[k][ch]) : MetricResidual{};
+        const MetricResidual res = valid ? metric_residual(m, c, bins_.lightness[k][ch], grazing) : MetricResidual{};
         residuals[r] = s * res.value;
         if (!jacobians) continue;
         const double dm = s * res.slope;  // d/dm of the residual: the chain rule for every parameter below
