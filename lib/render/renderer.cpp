@@ -474,8 +474,8 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
       }
       tracer.occluded(rays, blocked);
       // The lanes' rays, added to their hits slot by slot: environment light, BRDF sample, lights, which is
-      // each hit's order of slots. A blocked ray or one cast for nothing adds zero (each pixel has at most
-      // one entry per range, so the additions do not wait on one another).
+      // each hit's order of slots. A blocked ray or one cast for nothing adds zero, with no branch (a pixel
+      // has at most one entry per slot, so the additions of one slot do not wait on one another).
       for (const Wave& w : waves) {
         if (w.hits.size() == 0) continue;
         const ShadowBatch& b = w.shadows;
