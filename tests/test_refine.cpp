@@ -237,6 +237,29 @@ TEST(Metric, GrazingPairsEnterThroughASoftL1Loss) {
   }
 }
 
+// measurement_error reads each bin's pair as grazing or not: two bins, one with the light past 70 degrees,
+// the model a Lambertian surface brighter than both, against the distance written out.
+TEST(Metric, MeasurementErrorAppliesTheLossToGrazingPairsOnly) {
+  MeasuredBins bins;
+  const Vec3 up(0.0, 0.0, 1.0), low(std::sin(1.3), 0.0, std::cos(1.3));  // 74.5 degrees
+  const double albedo = 0.9, measured = 0.05;
+  for (const Vec3& i : {up, low}) {
+    bins.o.push_back(up), bins.i.push_back(i);
+    bins.cosine.push_back(i.z), bins.cos_h.push_back(1.0), bins.cos_d.push_back(1.0);
+    bins.weight.push_back(0.5);
+    bins.lightness.push_back(Rgb(metric_transform(measured * i.z)));
+    bins.valid.push_back(7);
+  }
+  double sum = 0.0;
+  for (std::size_t b = 0; b < 2; ++b) {
+    const double r = metric_transform(albedo / kPi * bins.i[b].z) - bins.lightness[b][0];
+    const double s = kGrazingScale, loss = b == 0 ? r * r : 2.0 * s * s * (std::sqrt(1.0 + r * r / (s * s)) - 1.0);
+    ASSERT_GT(std::abs(r), 2.0 * s);  // the loss differs from the square there
+    sum += 0.5 * 3.0 * loss;
+  }
+  EXPECT_NEAR(measurement_error(bins, LambertBrdf(Rgb(albedo))), std::sqrt(sum / 3.0), 1e-12);
+}
+
 // The bins of a source with two one-sided estimates: each bin twice, once per estimate measured, with the
 // estimate's own cosine and lightness (no division by a grazing cosine) and half the bin's weight.
 TEST(MeasuredBinsOneSided, EachBinOncePerMeasuredEstimate) {

@@ -121,7 +121,7 @@ inline MetricResidual metric_residual(double model, double cosine, double lightn
   double slope = 0.0;
   const double r = metric_transform(std::max(model, 0.0) * cosine, &slope) - lightness;
   const double dr = model >= 0.0 ? cosine * slope : 0.0;
-  if (!grazing) return {r, dr};
+  if (!grazing || !std::isfinite(r)) return {r, dr};  // an infinite r would give inf x 0 below
   const double q = std::sqrt(1.0 + (r / kGrazingScale) * (r / kGrazingScale)), s = std::sqrt(2.0 / (1.0 + q));
   return {r * s, dr / (q * s)};
 }

@@ -67,7 +67,7 @@ struct HitBatch : Columns {
     draws.reserve(n);
   }
   void set_size(std::size_t n) { Columns::set_size(n), draws.resize_to(n); }
-  void clear() { Columns::clear(), draws.clear(); }
+  void clear() { Columns::clear(), draws.clear(), positions = false, uniform_light.reset(); }
 };
 
 // Fills `out` with the tile's hits on material `material` (emptied first), as the renderer's one-hit path
