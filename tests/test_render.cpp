@@ -341,7 +341,8 @@ TEST(Wavefront, HitsAndSlotsEqualTheOneHitPath) {
     if (!uniform) lights.push_back({false, -2.0, 3.0, 1.0, 5, 4, 3});
     TileHits tile;
     tile.resize_to(n);
-    tile.uniform_light = uniform;
+    // Uniform: the value the slots must carry, the columns something else (not to be read).
+    if (uniform) tile.uniform_light = {0.1, 0.3, 0.2, 0.1};
     for (std::size_t k = 0; k < n; ++k) {
       const Vec3 d = glm::normalize(Vec3(u(rng) - 0.5, u(rng) - 0.5, -4.0));
       tile.dx[k] = d.x, tile.dy[k] = d.y, tile.dz[k] = d.z;
@@ -349,8 +350,8 @@ TEST(Wavefront, HitsAndSlotsEqualTheOneHitPath) {
       const Vec3 g = k % 2 ? Vec3(u(rng), u(rng), -u(rng)) : unit();  // a centre, or a triangle's normal
       tile.gx[k] = g.x, tile.gy[k] = g.y, tile.gz[k] = g.z;
       const Vec3 l = unit();
-      tile.lx[k] = l.x, tile.ly[k] = l.y, tile.lz[k] = l.z, tile.light_pdf[k] = k % 5 || uniform ? 0.1 : 0.0;
-      tile.light_r[k] = uniform ? 0.3 : 0.1 * double(k % 4), tile.light_g[k] = 0.2, tile.light_b[k] = 0.1;
+      tile.lx[k] = l.x, tile.ly[k] = l.y, tile.lz[k] = l.z, tile.light_pdf[k] = k % 5 ? 0.1 : 0.0;
+      tile.light_r[k] = 0.1 * double(k % 4), tile.light_g[k] = 0.2, tile.light_b[k] = 0.1;
       tile.u1[k] = u(rng), tile.u2[k] = u(rng), tile.u3[k] = u(rng);
     }
     for (const bool with_tangent : {false, true})
@@ -393,14 +394,15 @@ TEST(Wavefront, HitsAndSlotsEqualTheOneHitPath) {
           // The environment's slot: where the light sample and the view are above the horizon.
           const Vec3 l(tile.lx[k], tile.ly[k], tile.lz[k]);
           const Vec3 il = frame.to_local(l);
-          if (o.z > 0.0 && il.z > 0.0 && tile.light_pdf[k] > 0.0) {
+          const double light_pdf = uniform ? 0.1 : tile.light_pdf[k], light_r = uniform ? 0.3 : tile.light_r[k];
+          if (o.z > 0.0 && il.z > 0.0 && light_pdf > 0.0) {
             const std::size_t e = env_entries++;
             ASSERT_LT(e, ranges.lights_begin) << where;
             EXPECT_EQ(slots.owner[e], double(k)) << where;
             EXPECT_TRUE(close(slots.iz[e], il.z) && close(slots.rays.dx[e], l.x) && close(slots.rays.ox[e], origin.x)) << where;
-            EXPECT_EQ(slots.light_pdf[e], tile.light_pdf[k]) << where;
-            EXPECT_EQ(slots.arriving_r[e], tile.light_r[k]) << where;
-            EXPECT_EQ(slots.arriving_g[e], tile.light_g[k]) << where;
+            EXPECT_EQ(slots.light_pdf[e], light_pdf) << where;
+            EXPECT_EQ(slots.arriving_r[e], light_r) << where;
+            EXPECT_EQ(slots.arriving_g[e], 0.2) << where;
             EXPECT_EQ(slots.rays.tnear[e], eps) << where;
             EXPECT_TRUE(std::isinf(slots.rays.tfar[e])) << where;
           }

@@ -268,9 +268,10 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
     const std::uint64_t sequence = SampleSequence::start(seed, SampleSequence::pixel_key(x, y), s);
     for (int k = 0; k < kSampleNumbers; ++k) u[k] = SampleSequence::number(sequence, k);
   };
-  const auto accumulate = [](double* acc, Rgb radiance, double alpha) {
+  // A sample added to a pixel's sums (r, g, b, alpha): a radiance that is not finite adds nothing.
+  const auto accumulate = [](double& r, double& g, double& b, double& a, Rgb radiance, double alpha) {
     if (!std::isfinite(radiance.r) || !std::isfinite(radiance.g) || !std::isfinite(radiance.b)) radiance = Rgb(0.0);
-    acc[0] += radiance.r, acc[1] += radiance.g, acc[2] += radiance.b, acc[3] += alpha;
+    r += radiance.r, g += radiance.g, b += radiance.b, a += alpha;
   };
 
   RenderedImage image;
@@ -301,7 +302,8 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
           plan(hit, u + 2, nullptr, textured, planned, rays, values);
           for (std::size_t q = 0; q < rays.size(); ++q)
             if (!tracer.occluded(rays[q])) planned.radiance += values[q];
-          accumulate(pixel_accum(x, y), planned.radiance, planned.alpha);
+          double* acc = pixel_accum(x, y);
+          accumulate(acc[0], acc[1], acc[2], acc[3], planned.radiance, planned.alpha);
         }
   };
   // Per material shaded in lanes, a tile's hits for one sample index and their slots.
@@ -388,14 +390,10 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
       for (int c = 0; c < 4; ++c) sum[c][k] = acc[c];
     }
     tile_hits.resize_to(n);
-    tile_hits.uniform_light = sphere_lanes;
-    if (sphere_lanes) {
-      // A constant environment's radiance and density, the same for every light sample of the tile.
-      std::fill_n(tile_hits.light_pdf.begin(), padded, constant_light.pdf);
-      std::fill_n(tile_hits.light_r.begin(), padded, constant_light.radiance.r);
-      std::fill_n(tile_hits.light_g.begin(), padded, constant_light.radiance.g);
-      std::fill_n(tile_hits.light_b.begin(), padded, constant_light.radiance.b);
-    }
+    // A constant environment's density and radiance, the same for every light sample of the tile.
+    tile_hits.uniform_light.reset();
+    if (sphere_lanes)
+      tile_hits.uniform_light = {constant_light.pdf, constant_light.radiance.r, constant_light.radiance.g, constant_light.radiance.b};
     for (int s = first; s < last; ++s) {
       camera_sample_batch(camera, seed, s, samples);
       std::copy_n(samples.dx.begin(), padded, cameras.dx.begin()), std::copy_n(samples.dy.begin(), padded, cameras.dy.begin());
@@ -496,12 +494,8 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
         if (pk.ray_last > pk.ray_first) add_unblocked(blocked, values, pk.ray_first, pk.ray_last, pk.radiance);
         for (int c = 0; c < 3; ++c) radiance[c][k] = pk.radiance[c];
       }
-      // accumulate(), over the tile's columns.
-      for (std::size_t k = 0; k < n; ++k) {
-        const bool finite = std::isfinite(radiance[0][k]) && std::isfinite(radiance[1][k]) && std::isfinite(radiance[2][k]);
-        for (int c = 0; c < 3; ++c) sum[c][k] += finite ? radiance[c][k] : 0.0;
-        sum[3][k] += alpha[k];
-      }
+      for (std::size_t k = 0; k < n; ++k)
+        accumulate(sum[0][k], sum[1][k], sum[2][k], sum[3][k], Rgb(radiance[0][k], radiance[1][k], radiance[2][k]), alpha[k]);
     }
     for (std::size_t k = 0; k < n; ++k) {
       double* acc = pixel_accum(int(samples.x[k]), int(samples.y[k]));

@@ -133,7 +133,7 @@ void PlaceHits(const TileHits& tile, const Vec3& camera, double eps, double mate
   out.clear();
   out.reserve(tile.size() + lanes);
   out.positions = positions;
-  if (tile.uniform_light && tile.size() > 0) out.uniform_light = {tile.light_pdf[0], tile.light_r[0], tile.light_g[0], tile.light_b[0]};
+  out.uniform_light = tile.uniform_light;
   std::size_t size = 0;
   for (std::size_t k = 0; k < n; k += lanes) {
     const M mine = hn::And(real(d, k, tile.size()), load(d, tile.material, k) == this_material);

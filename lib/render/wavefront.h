@@ -28,9 +28,10 @@ struct TileHits : Columns {
   std::vector<double> dx, dy, dz;
   std::vector<double> lx, ly, lz, light_pdf, light_r, light_g, light_b;
   std::vector<double> u1, u2, u3;
-  // Whether light_pdf, light_r, light_g and light_b hold the same value in every entry (a constant
-  // environment's): place_hits() then takes it once instead of a column per hit.
-  bool uniform_light = false;
+  // The light sample's density and radiance (light_pdf, light_r, light_g, light_b) where the same for
+  // every entry (a constant environment's): then those columns are not read, and place_hits() passes the
+  // value on once instead of a column per hit.
+  std::optional<std::array<double, 4>> uniform_light;
   // n pixels, whose columns the caller writes in place.
   void resize_to(std::size_t n) {
     ensure(n, [this](std::size_t m) {
@@ -54,8 +55,7 @@ struct HitBatch : Columns {
   std::vector<double> lx, ly, lz, light_pdf, light_r, light_g, light_b;
   std::vector<double> owner;  // exact in a double
   SampleBatch draws;          // as many entries as hits
-  // The light sample's density and radiance where the same for every hit (TileHits::uniform_light): then
-  // light_pdf, light_r, light_g and light_b are not written.
+  // TileHits::uniform_light, passed on: where set, light_pdf, light_r, light_g and light_b are not written.
   std::optional<std::array<double, 4>> uniform_light;
   // Room for n hits written in place by the lanes; size() stays.
   void reserve(std::size_t n) {
