@@ -75,7 +75,8 @@ struct HitBatch : Columns {
 // camera; the frame of core/frame.h about it (along `tangent` where given); o the direction toward the
 // camera in it; the shadow rays' origin p + eps n. p itself only with `positions` (point lights read it):
 // each column a hit carries costs its compaction, and skipping the 7 a scene does not read (p, and a
-// constant environment's light columns) took 5% off a Lambertian sphere's render.
+// constant environment's light columns) took a Lambertian sphere's render from 243 to 234 ms on one CPU
+// (the mean of five alternated runs, within the machine's noise that day).
 void place_hits(const TileHits& tile, const Vec3& camera, double eps, double material, const Vec3* tangent, bool positions,
                 HitBatch& out, SimdTarget target = SimdTarget::best);
 
