@@ -238,7 +238,7 @@ TEST(TabulatedLanes, EveryBatchLengthAndDegenerateDirectionStayFiniteAndInBounds
       TabulatedNdf ndf = tabulate_ndf(Ndf::isotropic(NdfType::ggx, alpha > 0.0 ? alpha : 0.3));
       if (alpha == 0.0) std::fill(ndf.ndf.begin(), ndf.ndf.end(), 0.0), std::fill(ndf.sigma.begin(), ndf.sigma.end(), 0.0);
       const auto lobe = std::make_shared<TabulatedMicrofacet>(
-          MicrofacetTables{ndf, Smith::correlated, curve, layered ? Rgb(0.2) : Rgb(0.0), layered ? Coat{0.005, 0.04} : Coat{}});
+          MicrofacetTables{ndf, Smith::correlated, curve, layered ? Rgb(0.2) : Rgb(0.0), layered ? Coat{0.005, 0.04} : Coat{}, layered ? 3.0 : 1.0});
       const ShadingModel model(lobe, lobe);
       ASSERT_TRUE(model.tabulated_batch_model());
       for (std::size_t n = 0; n <= 40; ++n)

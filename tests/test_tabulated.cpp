@@ -231,6 +231,37 @@ TEST(Sampling, ChiSquareRejectsAWrongPdf) {
   EXPECT_LT(test::chi_square(observed, expected).p_value, 1e-6);
 }
 
+TEST(Tabulated, MinnaertBodyKeepsItsAlbedoAtNormalIncidence) {
+  // A body alone (the lobe's Fresnel curve zero) with Minnaert's exponent k (model/body.h): its directional
+  // albedo is body cos(theta_o)^(k - 1), by a deterministic integral and by the sampler's estimate (the
+  // body is drawn by the cosine, its weight f cos / pdf).
+  MicrofacetTables tables = fitted_tables(NdfType::ggx, 0.3, Fresnel::one());
+  for (auto& v : tables.fresnel.value) v = Rgb(0.0);
+  tables.body = Rgb(0.5);
+  for (const double k : {1.0, 1.5, 3.0}) {
+    tables.body_exponent = k;
+    const TabulatedMicrofacet model(tables);
+    for (const double theta_o : {0.0, 60.0, 80.0}) {
+      const Vec3 o = direction_at(theta_o);
+      const double expected = 0.5 * std::pow(o.z, k - 1.0);
+      double integral = 0.0;
+      const int m = 2000;
+      for (int a = 0; a < m; ++a) {  // isotropic in phi: one azimuth, 2 pi
+        const double c = (a + 0.5) / m;
+        integral += model.eval(o, Vec3(std::sqrt(1 - c * c), 0.0, c))->g * c / m * 2 * kPi;
+      }
+      EXPECT_NEAR(integral, expected, 1e-3 * expected) << "k " << k << " theta_o " << theta_o;
+      std::mt19937 rng(3);
+      std::uniform_real_distribution<double> u(0.0, 1.0);
+      double estimate = 0.0;
+      const int n = 40000;
+      for (int s = 0; s < n; ++s)
+        if (const auto drawn = model.sample(o, u(rng), u(rng))) estimate += drawn->weight.g / n;
+      EXPECT_NEAR(estimate, expected, 0.02 * expected) << "k " << k << " theta_o " << theta_o;
+    }
+  }
+}
+
 TEST(Tabulated, WhiteFurnace) {
   // F = 1: the albedo is at most 1 (single scattering loses energy to masking), and the sampler's
   // estimate agrees with a deterministic integral of the model.

@@ -1,5 +1,7 @@
 #include "model/analytic.h"
 
+#include "model/body.h"
+
 namespace facetfit {
 
 std::optional<Rgb> MicrofacetBrdf::eval(const Vec3& o, const Vec3& i) const {
@@ -12,7 +14,7 @@ std::optional<Rgb> MicrofacetBrdf::eval(const Vec3& o, const Vec3& i) const {
 
 std::optional<Rgb> LambertBrdf::eval(const Vec3& o, const Vec3& i) const {
   if (i.z <= 0.0 || o.z <= 0.0) return Rgb(0.0);
-  return albedo_ * kInvPi;
+  return albedo_ * (kInvPi * minnaert_factor(exponent_, o.z, i.z));
 }
 
 std::optional<Rgb> SumBrdf::eval(const Vec3& o, const Vec3& i) const {

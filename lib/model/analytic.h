@@ -29,12 +29,14 @@ class MicrofacetBrdf final : public Brdf {
 
 class LambertBrdf final : public Brdf {
  public:
-  explicit LambertBrdf(const Rgb& albedo) : albedo_(albedo) {}
+  // exponent 1: Lambert's law; another: Minnaert's, the albedo at normal incidence (model/body.h).
+  explicit LambertBrdf(const Rgb& albedo, double exponent = 1.0) : albedo_(albedo), exponent_(exponent) {}
   std::optional<Rgb> eval(const Vec3& o, const Vec3& i) const override;
   const Rgb& albedo() const { return albedo_; }
 
  private:
   Rgb albedo_;
+  double exponent_;
 };
 
 // A layered look without the layering: the plain sum of its lobes.

@@ -93,7 +93,8 @@ std::optional<Rgb> TabulatedMicrofacet::eval(const Vec3& o, const Vec3& i) const
   if (!above_horizon(o, i)) return Rgb(0.0);
   const Vec3 h = glm::normalize(i + o);
   const double g2 = smith_g2_from_g1(shared_->tables.smith, g1(o), g1(i));
-  return shared_->tables.body * kInvPi + fresnel(glm::dot(i, h)) * (D(h) * g2 / (4.0 * i.z * o.z)) + Rgb(shared_->tables.coat.eval(o, i));
+  const MicrofacetTables& t = shared_->tables;
+  return t.body * (kInvPi * minnaert_factor(t.body_exponent, o.z, i.z)) + fresnel(glm::dot(i, h)) * (D(h) * g2 / (4.0 * i.z * o.z)) + Rgb(shared_->tables.coat.eval(o, i));
 }
 
 namespace {

@@ -1,8 +1,8 @@
 // The tabulated microfacet BRDF: the fitted tables evaluated, importance-sampled and given a pdf.
 //
-//   f(o, i) = body / pi + F(theta_d) D(h) G2(o, i) / (4 cos(theta_o) cos(theta_i)) + coat(o, i)
+//   f(o, i) = f_body(o, i) + F(theta_d) D(h) G2(o, i) / (4 cos(theta_o) cos(theta_i)) + coat(o, i)
 //
-// with D and sigma (hence G1 = cos / sigma) splines on the theta grid, F the RGB Fresnel curve and G2
+// with f_body Minnaert's body (model/body.h), D and sigma (hence G1 = cos / sigma) splines on the theta grid, F the RGB Fresnel curve and G2
 // the Smith model the fit was made with. sample() picks one of the three parts with probabilities set
 // by their albedos (lobe_weight() and the rest), then draws: for the lobe the distribution of visible
 // normals seen from o, D_o(h) = max(0, o.h) D(h) / sigma(o), reflecting o about h (docs/sampling.md);
@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "core/brdf.h"
+#include "model/body.h"
 #include "model/fresnel_curve.h"
 #include "model/tabulated_ndf.h"
 #include "model/coat.h"
@@ -28,8 +29,9 @@ struct MicrofacetTables {
   TabulatedNdf ndf;
   Smith smith = Smith::correlated;
   FresnelCurve fresnel;
-  Rgb body{0.0};  // Lambertian albedo under the lobe
+  Rgb body{0.0};  // the body's albedo at normal incidence (model/body.h)
   Coat coat;      // optional clear coat over it
+  double body_exponent = 1.0;  // Minnaert's k (model/body.h): 1 is Lambert
 };
 
 // Tables for sampling visible normals. For each view slice s (theta_o at grid node s) and each u interval

@@ -212,6 +212,8 @@ void EvalTabulatedBatch(const TabulatedBatchModel& model, EvaluationBatch& batch
   const int resolution = model.resolution;
   const I row = hn::Set(di, model.resolution + 1);  // nodes per view slice of the running sums
   const V body[3] = {hn::Set(d, model.body.r * kInvPi), hn::Set(d, model.body.g * kInvPi), hn::Set(d, model.body.b * kInvPi)};
+  const bool minnaert = model.body_exponent != 1.0;
+  const V body_power = hn::Set(d, model.body_exponent - 1.0), body_scale = hn::Set(d, 0.5 * (model.body_exponent + 1.0));
   const bool coat = model.coat.present();
   double* out[3] = {batch.r.data(), batch.g.data(), batch.b.data()};
   for (std::size_t k = 0; k < n; k += hn::Lanes(d)) {
@@ -252,7 +254,9 @@ void EvalTabulatedBatch(const TabulatedBatchModel& model, EvaluationBatch& batch
       const V specular = lanes::divide(d, dh * g2, four_cos);
       // f where cos(theta_i) cos(theta_o) does not underflow (above_horizon, core/vec.h)
       const auto formed = hn::And(above, iz * oz > zero);
-      for (int c = 0; c < 3; ++c) hn::StoreU(hn::IfThenElseZero(formed, body[c] + fresnel[c] * specular + coat_f), d, out[c] + k);
+      // Minnaert's factor (k + 1) / 2 (cos_i cos_o)^(k - 1) (model/body.h)
+      const V factor = minnaert ? body_scale * hn::Exp(d, body_power * hn::Log(d, hn::Max(iz * oz, hn::Set(d, 1e-300)))) : one;
+      for (int c = 0; c < 3; ++c) hn::StoreU(hn::IfThenElseZero(formed, body[c] * factor + fresnel[c] * specular + coat_f), d, out[c] + k);
     }
 
     // The lobe's visible normals (TabulatedMicrofacet::measured_visible_normal_pdf): the mass of the
@@ -299,6 +303,7 @@ std::optional<TabulatedBatchModel> TabulatedBatchModel::of(const TabulatedMicrof
   m.smith = tables.smith;
   m.curve = tables.fresnel.value.data();
   m.body = tables.body;
+  m.body_exponent = tables.body_exponent;
   m.azimuth_guess = AzimuthGuess::table().values();
   m.coat = tables.coat;
   m.weights = {lobe_weight, lobe.lobe_weight(), lobe.body_weight(), tables.coat.present() ? lobe.coat_weight() : 0.0};

@@ -31,6 +31,7 @@ struct TabulatedBatchModel {
   const Rgb* curve = nullptr;  // the Fresnel curve's 90 entries
   const double* azimuth_guess = nullptr;  // AzimuthGuess::values() (model/visible_azimuth.h)
   Rgb body{0.0};
+  double body_exponent = 1.0;  // Minnaert's k (model/body.h)
   Coat coat;
   ProposalWeights weights;
 
