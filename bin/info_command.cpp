@@ -23,7 +23,7 @@ nlohmann::json info_json(const Lut& lut) {
                    {"alpha_beckmann", m.alpha_beckmann}, {"f0", rgb(m.f0)}, {"f82", rgb(m.f82)},
                    {"ndf_error_ggx", m.ndf_error_ggx}, {"ndf_error_beckmann", m.ndf_error_beckmann},
                    {"representation", to_string(m.representation)}, {"tolerance", m.tolerance}, {"sampling", m.sampling},
-                   {"body", rgb(m.body)}, {"coat", coat_json(m.coat)}, {"error", m.error},
+                   {"body", rgb(m.body)}, {"body_exponent", m.body_exponent}, {"coat", coat_json(m.coat)}, {"error", m.error},
                    {"error_extraction", m.error_extraction}, {"warnings", m.warnings}};
   const auto parametric = [](const LutMetadata::Parametric& p, double error) {
     return parametric_json(p.alpha, p.body, p.f0, p.f82, p.coat, error);
@@ -58,7 +58,7 @@ void print_info(const Lut& lut) {
               m.ndf_error_ggx, m.alpha_beckmann, m.ndf_error_beckmann);
   std::printf("f0              %.4f %.4f %.4f\nf82             %.4f %.4f %.4f\n", m.f0.r, m.f0.g, m.f0.b, m.f82.r, m.f82.g,
               m.f82.b);
-  std::printf("body            %.4f %.4f %.4f\n", m.body.r, m.body.g, m.body.b);
+  std::printf("body            %.4f %.4f %.4f, Minnaert exponent %.3f\n", m.body.r, m.body.g, m.body.b, m.body_exponent);
   if (m.coat.present()) std::printf("coat            GGX alpha %.5f, f0 %.4f\n", m.coat.alpha, m.coat.f0);
   // Distances from the measurement (0: the paper's method alone, which measures none).
   std::printf("distance        tabulated %.4f (paper's fit %.4f), ggx %.4f, beckmann %.4f, lsq %.4f\n", m.error,

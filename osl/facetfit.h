@@ -23,7 +23,8 @@ struct FacetfitLut {
   int resolution;  // R: nodes 0..R
   int smith;       // 0 masking, 1 correlated, 2 separable
   int sampling;    // sampling rows present
-  color body;      // Lambertian albedo under the lobe (format 2; black in format 1)
+  color body;      // the body's albedo at normal incidence (format 2; black in format 1)
+  float body_exponent;  // its Minnaert exponent k (format 4; 1, Lambert, before): lib/model/body.h
   float coat_alpha;  // GGX clear coat over it, grey Schlick f0; alpha 0: none
   float coat_f0;
   float weight_lobe;  // probabilities of the sampler's parts: lobe, body, then coat (lib/model/tabulated.h)
@@ -226,6 +227,7 @@ FacetfitLut facetfit_open(string file) {
   lut.file = file;
   lut.ok = 0;
   lut.body = color(0);
+  lut.body_exponent = 1.0;
   lut.coat_alpha = 0.0;
   lut.coat_f0 = 0.0;
   lut.weight_lobe = 1.0;
@@ -237,9 +239,10 @@ FacetfitLut facetfit_open(string file) {
   int res[2] = {0, 0};
   int version = 0, resolution = 0, sampling = 0;
   if (gettextureinfo(file, "resolution", res) && gettextureinfo(file, "facetfit:format_version", version) &&
-      gettextureinfo(file, "facetfit:resolution", resolution) && version >= 1 && version <= 3) {
+      gettextureinfo(file, "facetfit:resolution", resolution) && version >= 1 && version <= 4) {
     // Version 3 appends the anisotropic lobe's rows below version 2's, which read as before: the shaders
-    // render the isotropic representation (the rows' t comes from the image's height, read here).
+    // render the isotropic representation (the rows' t comes from the image's height, read here). Version
+    // 4 adds the body's exponent.
     gettextureinfo(file, "facetfit:sampling", sampling);
     lut.width = res[0];
     lut.height = res[1];
@@ -249,6 +252,7 @@ FacetfitLut facetfit_open(string file) {
     lut.ok = lut.smith >= 0 && lut.smith <= 2;
     if (version >= 2) {
       gettextureinfo(file, "facetfit:body", lut.body);
+      if (version >= 4) gettextureinfo(file, "facetfit:body_exponent", lut.body_exponent);
       gettextureinfo(file, "facetfit:coat_alpha", lut.coat_alpha);
       gettextureinfo(file, "facetfit:coat_f0", lut.coat_f0);
       if (!(lut.coat_alpha > 0.0 && lut.coat_f0 > 0.0)) lut.coat_alpha = lut.coat_f0 = 0.0;
@@ -293,7 +297,9 @@ color facetfit_eval(FacetfitLut lut, vector o, vector i) {
   vector h = normalize(i + o);
   float g2 = facetfit_G2(lut, facetfit_G1(lut, i), facetfit_G1(lut, o));
   float theta_d = facetfit_angle(length(cross(i, h)), dot(i, h));
-  return lut.body / FACETFIT_PI + facetfit_fresnel(lut, theta_d) * (facetfit_D(lut, h) * g2 / (4.0 * i[2] * o[2])) +
+  // Minnaert's body: (k + 1) / 2 (cos_i cos_o)^(k - 1) times Lambert's
+  float k = lut.body_exponent, minnaert = k == 1.0 ? 1.0 : 0.5 * (k + 1.0) * pow(i[2] * o[2], k - 1.0);
+  return lut.body * (minnaert / FACETFIT_PI) + facetfit_fresnel(lut, theta_d) * (facetfit_D(lut, h) * g2 / (4.0 * i[2] * o[2])) +
          color(facetfit_coat_eval(lut, o, i));
 }
 

@@ -104,7 +104,7 @@ TEST(Cli, JsonHasExactlyTheDocumentedKeys) {
   const auto j = nlohmann::json::parse(r.out);
   std::vector<std::string> keys;
   for (const auto& item : j.items()) keys.push_back(item.key());
-  EXPECT_EQ(keys, (std::vector<std::string>{"alpha_beckmann", "alpha_ggx", "anisotropic", "beckmann", "body", "coat", "error",
+  EXPECT_EQ(keys, (std::vector<std::string>{"alpha_beckmann", "alpha_ggx", "anisotropic", "beckmann", "body", "body_exponent", "coat", "error",
                                             "error_extraction", "f0", "f82", "ggx", "iterations", "lsq", "refine",
                                             "residual", "seconds", "source", "warnings"}));
   for (const char* fit : {"ggx", "beckmann", "lsq"}) {

@@ -163,6 +163,15 @@ TEST(Lut, AnisotropicLobeRoundTrip) {
     for (int c = 0; c < 3; ++c) EXPECT_NEAR(b[c], a[c], 1e-5 * std::max(1.0, a[c]));
     EXPECT_NEAR(read_back.pdf(o, i), in_memory.pdf(o, i), 1e-5 * std::max(1.0, in_memory.pdf(o, i)));
   }
+  // With a Minnaert body too, version 4, which announces its anisotropic rows.
+  FitResult minnaert = fit;
+  minnaert.lobe.body_exponent = 1.5;
+  write_lut(dir.file("k.exr"), make_lut(minnaert, fitter.quadrature(), "a.bin", "", 0.02, true));
+  const Lut with_k = read_lut(dir.file("k.exr"));
+  EXPECT_EQ(with_k.meta.format_version, kLutBodyExponentVersion);
+  ASSERT_TRUE(with_k.anisotropic);
+  EXPECT_EQ(with_k.anisotropic->ndf, lut.anisotropic->ndf);
+  EXPECT_NEAR(with_k.meta.anisotropic_ggx.alpha.alpha_x, want.alpha.alpha_x, 1e-6);
   // Without the anisotropic fit, version 2 as before.
   FitResult isotropic = fit;
   isotropic.anisotropic.reset();
@@ -180,6 +189,44 @@ TEST(Lut, AnisotropicLobeRoundTrip) {
   }
   EXPECT_NE(error_of([&] { read_lut(dir.file("bad.exr")); }).find("bad.exr: facetfit:anisotropic_resolution or facetfit:anisotropic_phi_count"),
             std::string::npos);
+}
+
+TEST(Lut, ABodyExponentMakesVersionFour) {
+  // A Minnaert body (model/body.h) is carried by version 4 only: a Lambertian body's LUT stays version 2,
+  // which earlier readers take; they refuse version 4 rather than render its body as Lambert's.
+  TempDir dir;
+  Baked b = fit_of(MicrofacetBrdf(Ndf::isotropic(NdfType::ggx, 0.2), Smith::correlated, Fresnel::one()));
+  b.fit.lobe.body = Rgb(0.4, 0.3, 0.2);
+  b.fit.lobe.body_exponent = 1.6;
+  write_lut(dir.file("k.exr"), make_lut(b.fit, b.fitter.quadrature(), "x", "", 0.02, true));
+  const Lut lut = read_lut(dir.file("k.exr"));
+  EXPECT_EQ(lut.meta.format_version, kLutBodyExponentVersion);
+  EXPECT_FALSE(lut.anisotropic);
+  EXPECT_NEAR(lut.tables.body_exponent, 1.6, 1e-6);
+  const TabulatedMicrofacet in_memory(b.fit.lobe.tables(b.fit.smith)), read_back = lut.model();
+  const Vec3 o = spherical_direction(1.2, 0.0), i = spherical_direction(1.3, 2.0);
+  const Rgb a = *in_memory.eval(o, i), c = *read_back.eval(o, i);
+  for (int k = 0; k < 3; ++k) EXPECT_NEAR(c[k], a[k], 1e-5 * a[k]);
+  // The body's part: 0.4 / pi ((k + 1) / 2 (cos_o cos_i)^(k - 1) - 1) more than a Lambertian body's.
+  MicrofacetTables lambert = b.fit.lobe.tables(b.fit.smith);
+  lambert.body_exponent = 1.0;
+  const double body_part = a.r - TabulatedMicrofacet(lambert).eval(o, i)->r;
+  EXPECT_NEAR(body_part, 0.4 / kPi * (1.3 * std::pow(std::cos(1.2) * std::cos(1.3), 0.6) - 1.0), 1e-9);
+  // An exponent outside [1, 3], or none, is refused naming the attribute.
+  auto in = OIIO::ImageInput::open(dir.file("k.exr"));
+  OIIO::ImageSpec spec = in->spec();
+  std::vector<float> px(std::size_t(spec.width) * std::size_t(spec.height) * std::size_t(spec.nchannels));
+  ASSERT_TRUE(in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, px.data()));
+  for (const float value : {0.5f, std::nanf(""), 3.5f}) {
+    spec.attribute("facetfit:body_exponent", value);
+    auto out = OIIO::ImageOutput::create(dir.file("bad.exr"));
+    ASSERT_TRUE(out->open(dir.file("bad.exr"), spec) && out->write_image(OIIO::TypeDesc::FLOAT, px.data()) && out->close());
+    const std::string e = error_of([&] { read_lut(dir.file("bad.exr")); });
+    EXPECT_NE(e.find("bad.exr: facetfit:body_exponent is missing or outside [1, 3]"), std::string::npos) << value << ": " << e;
+  }
+  b.fit.lobe.body_exponent = 1.0;
+  write_lut(dir.file("one.exr"), make_lut(b.fit, b.fitter.quadrature(), "x", "", 0.02, true));
+  EXPECT_EQ(read_lut(dir.file("one.exr")).meta.format_version, kLutFormatVersion);
 }
 
 // LUTs are written and read through OpenEXR itself (io/image_file.h); OpenImageIO, an independent reader

@@ -24,6 +24,7 @@
 #include "model/theta_grid.h"
 #include "io/image_file.h"
 #include "lut/lut.h"
+#include "model/analytic.h"
 #include "model/ndf.h"
 #include "support/tensor_file.h"
 #include "test_util.h"
@@ -238,6 +239,14 @@ class OslModel : public ::testing::TestWithParam<std::string> {
     // One LUT fitted with the masking form, so that a Smith model other than the default is read.
     const RunResult masking = facetfit("bake builtin:silver-ggx-0.60 --smith masking -o " + luts_->file("masking"));
     ASSERT_EQ(masking.status, 0) << masking.err;
+    // A body darker toward grazing angles (Minnaert's exponent 1.4, model/body.h): a format 4 LUT.
+    MerlTable::tabulate(SumBrdf({std::make_shared<LambertBrdf>(Rgb(0.5, 0.3, 0.1), 1.4),
+                                 std::make_shared<MicrofacetBrdf>(Ndf::isotropic(NdfType::ggx, 0.2), Smith::correlated,
+                                                                  Fresnel::schlick(Rgb(0.04)))}))
+        .write(luts_->file("minnaert-ggx-0.20.binary"));
+    const RunResult minnaert = facetfit("bake " + luts_->file("minnaert-ggx-0.20.binary") + " -o " + luts_->path().string());
+    ASSERT_EQ(minnaert.status, 0) << minnaert.err;
+    ASSERT_EQ(read_lut(luts_->file("minnaert-ggx-0.20.exr")).meta.format_version, kLutBodyExponentVersion);
     compile_shaders(*luts_);
   }
   static void TearDownTestSuite() {
@@ -430,7 +439,8 @@ TEST_P(OslModel, SampleEqualsLibrary) {
 
 INSTANTIATE_TEST_SUITE_P(Materials, OslModel,
                          ::testing::Values("gold-ggx-0.15", "silver-ggx-0.60", "copper-beckmann-0.30", "blue-clearcoat-paint",
-                                           "masking/silver-ggx-0.60", "gold-ggx-0.15+stretch", "blue-clearcoat-paint+stretch"),
+                                           "minnaert-ggx-0.20", "masking/silver-ggx-0.60", "gold-ggx-0.15+stretch",
+                                           "blue-clearcoat-paint+stretch"),
                          [](const ::testing::TestParamInfo<std::string>& param) {
                            std::string name = param.param;
                            std::replace_if(name.begin(), name.end(), [](char c) { return !std::isalnum(static_cast<unsigned char>(c)); }, '_');
@@ -680,7 +690,7 @@ TEST_F(OslSphere, MaterialShaderMatchesReferenceParametric) {
   }
 }
 
-// An anisotropic input's LUT (format 3): the material shader's GGX closure takes the 2D extraction's
+// An anisotropic input's LUT (format 3 or 4): the material shader's GGX closure takes the 2D extraction's
 // alphas and axis, the reference renderer the LUT's anisotropic tabulated lobe, both along world up. The
 // input is an RGL file of GGX 0.45 x 0.2 turned 30 degrees, F = 1 (the tests' tensor writer).
 TEST_F(OslSphere, MaterialShaderRendersAnAnisotropicLut) {
@@ -690,7 +700,8 @@ TEST_F(OslSphere, MaterialShaderRendersAnAnisotropicLut) {
   const RunResult r = facetfit("bake " + work_->file("aniso-ggx.bsdf") + " -o " + work_->path().string());
   ASSERT_EQ(r.status, 0) << r.err;
   const std::string lut = work_->file("aniso-ggx.exr");
-  ASSERT_EQ(read_lut(lut).meta.format_version, kLutAnisotropicVersion);
+  const int version = read_lut(lut).meta.format_version;  // 4 where the isotropic fit's body is Minnaert's
+  ASSERT_TRUE(version == kLutAnisotropicVersion || version == kLutBodyExponentVersion) << version;
   // facetfit's world up (0, 1, 0) is Blender's (0, 0, 1).
   // The reference renders the same model, the LUT's anisotropic GGX fit (a ggx material with the LUT).
   const nlohmann::json reference = {{"type", "ggx"}, {"file", lut}, {"tangent", {0.0, 1.0, 0.0}}};

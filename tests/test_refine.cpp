@@ -58,6 +58,40 @@ TEST(Refine, LambertPlusGgxThroughTheMerlWriter) {
   expect_rgb_near(r.f0, Rgb(0.04), 0.005, "tabulated f0");
 }
 
+TEST(Refine, MinnaertBodyPlusGgxThroughTheMerlWriter) {
+  // A body darker toward grazing angles (Minnaert, k = 1.3: model/body.h) under GGX 0.2: the tabulated
+  // representation gives back its exponent and albedo, and its LUT (format 4) renders them.
+  const Rgb albedo(0.5, 0.3, 0.1);
+  const SumBrdf truth({std::make_shared<LambertBrdf>(albedo, 1.3), ggx(0.2, Fresnel::schlick(Rgb(0.04)))});
+  const fs::path file = fs::path(::testing::TempDir()) / "minnaert_ggx.binary";
+  MerlTable::tabulate(truth).write(file.string());
+  FitOptions options;
+  options.refine = FitOptions::Refine::full;
+  const Fitter fitter(options);
+  const FitResult r = fitter.fit(MerlTable::read(file.string()));
+  ASSERT_TRUE(r.ok()) << r.problem;
+  EXPECT_NEAR(r.lobe.body_exponent, 1.3, 0.01);
+  std::printf("[ minnaert ] exponent %.4f, body %.4f %.4f %.4f, alpha_ggx %.4f\n", r.lobe.body_exponent, r.body().r, r.body().g, r.body().b, r.alpha_ggx);
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(r.body()[c], albedo[c], 0.01 * albedo[c]) << "channel " << c;
+  EXPECT_NEAR(r.alpha_ggx, 0.2, 0.2 * 0.01);
+  expect_rgb_near(r.f0, Rgb(0.04), 0.005, "tabulated f0");
+  // A Lambertian body has no exponent to find: the Lambert + GGX material above keeps k = 1.
+  const FitResult lambert = fit_full(SumBrdf({std::make_shared<LambertBrdf>(albedo), ggx(0.2, Fresnel::schlick(Rgb(0.04)))}));
+  EXPECT_NEAR(lambert.lobe.body_exponent, 1.0, 1e-3);
+
+  const fs::path lut_file = fs::path(::testing::TempDir()) / "minnaert_ggx.exr";
+  write_lut(lut_file.string(), make_lut(r, fitter.quadrature(), "minnaert", "0", 0.02, true));
+  const Lut lut = read_lut(lut_file.string());
+  EXPECT_EQ(lut.meta.format_version, kLutBodyExponentVersion);
+  EXPECT_NEAR(lut.tables.body_exponent, r.lobe.body_exponent, 1e-6);
+  const TabulatedMicrofacet model = lut.model();
+  for (const double grazing : {0.0, 0.6, 1.2}) {  // theta_i 0 to 69 degrees, the view at 40
+    const Vec3 i(std::sin(grazing), 0.0, std::cos(grazing)), o(-std::sin(0.7), 0.1, std::cos(0.7));
+    const Rgb f = *model.eval(glm::normalize(o), i), expected = *truth.eval(glm::normalize(o), i);
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(f[c], expected[c], 0.02 * expected[c]) << "theta_i " << grazing << ", channel " << c;
+  }
+}
+
 TEST(Refine, CoatOverLambertPlusGgx) {
   const Rgb albedo(0.2, 0.3, 0.6);
   const SumBrdf truth({ggx(0.03, Fresnel::schlick(Rgb(0.04))), std::make_shared<LambertBrdf>(albedo),
@@ -114,9 +148,12 @@ TEST(Refine, RefinementJacobianMatchesCentralDifferences) {
       for (int j = 0; j < FresnelCurve::kSize; ++j) at.fresnel.value[std::size_t(j)] = Rgb(0.9, 0.5, 0.04) * (1.0 + 0.001 * j);
       at.body = Rgb(0.3, 0.15, 0.05);
       if (coat) at.coat = Coat{0.05, 0.04};
-      for (const MeasuredBins* bins : {&merl, &utia})
-        EXPECT_LT(refine_jacobian_error(*bins, quad, Smith::correlated, at), 1e-4)
-            << (bins == &merl ? "merl" : "utia") << " alpha " << alpha << " coat " << coat;
+      for (const double exponent : {1.0, 1.4})  // the body's Minnaert exponent (model/body.h)
+        for (const MeasuredBins* bins : {&merl, &utia}) {
+          at.body_exponent = exponent;
+          EXPECT_LT(refine_jacobian_error(*bins, quad, Smith::correlated, at), 1e-4)
+              << (bins == &merl ? "merl" : "utia") << " alpha " << alpha << " coat " << coat << " exponent " << exponent;
+        }
     }
 }
 
@@ -340,7 +377,7 @@ TEST(RefineRgl, NeverWorseThanTheExtraction) {
     const MerlTable table = load_table(entry.path().string());
     const MeasuredBins bins = error_bins(table);
     const auto distance = [&](const FitResult& r) {
-      return measurement_error(bins, TabulatedMicrofacet(MicrofacetTables{r.ndf(), r.smith, r.fresnel(), r.body(), r.lobe.coat}, {}));
+      return measurement_error(bins, TabulatedMicrofacet(r.lobe.tables(r.smith), {}));
     };
     const FitResult before = paper.fit(table), after = full.fit(table);
     ASSERT_TRUE(before.ok() && after.ok()) << entry.path();

@@ -77,7 +77,7 @@ void Fitter::refine_on_measurement(const MerlTable& table, FitResult& result) co
   const MeasuredBins fit_bins = solve_bins(table), parametric = parametric_bins(table), bins = error_bins(table);
   const Smith smith = options_.smith;
   const auto error_of = [&](const LobeFit& lobe) {
-    return measurement_error(bins, TabulatedMicrofacet(MicrofacetTables{lobe.ndf, smith, lobe.fresnel, lobe.body, lobe.coat}, {}));
+    return measurement_error(bins, TabulatedMicrofacet(lobe.tables(smith), {}));
   };
   result.error_extraction = result.error = error_of(result.lobe);
 

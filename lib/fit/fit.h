@@ -26,8 +26,8 @@ namespace facetfit {
 // a different fit. 2: an RGL file's refinement reads its two one-sided estimates (fit/measurement.h);
 // 3: the parametric fits solved by fit/small_problem.h; 4: the refinement solved to convergence in two
 // passes, a UTIA file's isotropic fits on its own nodes; 5: its anisotropic lobes on its node pairs;
-// 6: the grazing pairs' soft L1 loss (fit/measurement.h).
-constexpr int kFitRevision = 6;
+// 6: the grazing pairs' soft L1 loss (fit/measurement.h); 7: the tabulated body's Minnaert exponent (model/body.h).
+constexpr int kFitRevision = 7;
 
 struct FitOptions {
   int resolution = 90;  // intervals of the u grid; R + 1 nodes

@@ -72,7 +72,7 @@ std::vector<std::string> plausibility_warnings(const MerlTable& table, const Fit
       if (c82 >= 0) out.push_back(std::string(name) + format(" fit: f82 above 1 (%.3f, ", f82) + MerlTable::channel_name(c82) + ")");
     }
   // Directional albedo of the measurement and of the tabulated representation.
-  const TabulatedMicrofacet model(MicrofacetTables{fit.ndf(), fit.smith, fit.fresnel(), fit.body(), fit.lobe.coat}, {});
+  const TabulatedMicrofacet model(fit.lobe.tables(fit.smith), {});
   for (const auto& [what, brdf] : {std::pair<const char*, const Brdf*>{"measurement", &table}, {"tabulated fit", &model}}) {
     for (const double degrees : {0.0, 30.0, 60.0, 80.0}) {
       const auto [c, v] = above(directional_albedo(*brdf, spherical_direction(degrees * kPi / 180.0, 0.0)), 1.0);

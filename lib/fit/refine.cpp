@@ -51,46 +51,56 @@ NodeWeights fresnel_entries(double theta_d) {
   return merged(index, weight, 2);
 }
 
+struct PassTerms {
+  std::vector<double> g, coat, log_cosines;
+};
+
 // The residuals of one row (bins sharing theta_h and theta_d): 3 per bin. Parameter blocks: body (3),
-// the row's Fresnel entries (3 each), then its D nodes (1 each). `g` holds G2 / (4 cos_i cos_o) per bin
-// for this pass.
+// the body's exponent k (1), the row's Fresnel entries (3 each), then its D nodes (1 each), with the
+// pass's fixed terms per bin.
 class RowCost final : public ceres::CostFunction {
  public:
-  RowCost(const MeasuredBins& bins, const MeasuredBins::Row& row, const std::vector<double>& g,
-          const std::vector<double>& coat, NodeWeights fresnel, NodeWeights nodes)
-      : bins_(bins), row_(row), g_(g), coat_(coat), fresnel_(std::move(fresnel)), nodes_(std::move(nodes)) {
+  RowCost(const MeasuredBins& bins, const MeasuredBins::Row& row, const PassTerms& terms, NodeWeights fresnel, NodeWeights nodes)
+      : bins_(bins), row_(row), terms_(terms), fresnel_(std::move(fresnel)), nodes_(std::move(nodes)) {
     set_num_residuals(int(3 * (row.end - row.begin)));
     mutable_parameter_block_sizes()->push_back(3);
+    mutable_parameter_block_sizes()->push_back(1);
     for (std::size_t e = 0; e < fresnel_.node.size(); ++e) mutable_parameter_block_sizes()->push_back(3);
     for (std::size_t q = 0; q < nodes_.node.size(); ++q) mutable_parameter_block_sizes()->push_back(1);
   }
 
   bool Evaluate(double const* const* p, double* residuals, double** jacobians) const override {
     const double* body = p[0];
-    const std::size_t nf = fresnel_.node.size(), first_node = 1 + nf;
+    const double exponent = p[1][0];
+    const std::size_t nf = fresnel_.node.size(), first_fresnel = 2, first_node = first_fresnel + nf;
     double fresnel[3] = {0.0, 0.0, 0.0};
     for (std::size_t e = 0; e < nf; ++e)
-      for (int ch = 0; ch < 3; ++ch) fresnel[ch] += fresnel_.weight[e] * p[1 + e][ch];
+      for (int ch = 0; ch < 3; ++ch) fresnel[ch] += fresnel_.weight[e] * p[first_fresnel + e][ch];
     double d = 0.0;
     for (std::size_t q = 0; q < nodes_.node.size(); ++q) d += nodes_.weight[q] * p[first_node + q][0];
     const std::size_t n = row_.end - row_.begin;
     for (std::size_t b = 0; b < n; ++b) {
       const std::size_t k = row_.begin + b;
-      const double s = std::sqrt(bins_.weight[k]), c = bins_.cosine[k], g = g_[k];
+      const double s = std::sqrt(bins_.weight[k]), c = bins_.cosine[k], g = terms_.g[k];
       const bool grazing = grazing_pair(bins_.o[k], bins_.i[k]);
+      // Minnaert's factor b = (k + 1) / 2 x^(k - 1), x = cos_o cos_i, and db/dk = x^(k - 1) (1/2 + (k + 1)/2 ln x).
+      const double ln_x = terms_.log_cosines[k], power = exponent == 1.0 ? 1.0 : std::exp((exponent - 1.0) * ln_x);
+      const double factor = 0.5 * (exponent + 1.0) * power, dfactor = power * (0.5 + 0.5 * (exponent + 1.0) * ln_x);
       for (int ch = 0; ch < 3; ++ch) {
         const std::size_t r = 3 * b + std::size_t(ch);
         const bool valid = bins_.valid[k] >> ch & 1u;
-        const double m = body[ch] * kInvPi + fresnel[ch] * d * g + coat_[k];
+        const double m = body[ch] * kInvPi * factor + fresnel[ch] * d * g + terms_.coat[k];
         const MetricResidual res = valid ? metric_residual(m, c, bins_.lightness[k][ch], grazing) : MetricResidual{};
         residuals[r] = s * res.value;
         if (!jacobians) continue;
         const double dm = s * res.slope;  // d/dm of the residual: the chain rule for every parameter below
         if (jacobians[0])
-          for (int e = 0; e < 3; ++e) jacobians[0][3 * r + std::size_t(e)] = e == ch ? dm * kInvPi : 0.0;
+          for (int e = 0; e < 3; ++e) jacobians[0][3 * r + std::size_t(e)] = e == ch ? dm * kInvPi * factor : 0.0;
+        if (jacobians[1]) jacobians[1][r] = dm * body[ch] * kInvPi * dfactor;
         for (std::size_t f = 0; f < nf; ++f)
-          if (jacobians[1 + f])
-            for (int e = 0; e < 3; ++e) jacobians[1 + f][3 * r + std::size_t(e)] = e == ch ? dm * fresnel_.weight[f] * d * g : 0.0;
+          if (jacobians[first_fresnel + f])
+            for (int e = 0; e < 3; ++e)
+              jacobians[first_fresnel + f][3 * r + std::size_t(e)] = e == ch ? dm * fresnel_.weight[f] * d * g : 0.0;
         for (std::size_t q = 0; q < nodes_.node.size(); ++q)
           if (jacobians[first_node + q]) jacobians[first_node + q][r] = dm * fresnel[ch] * g * nodes_.weight[q];
       }
@@ -101,8 +111,7 @@ class RowCost final : public ceres::CostFunction {
  private:
   const MeasuredBins& bins_;
   const MeasuredBins::Row& row_;
-  const std::vector<double>& g_;
-  const std::vector<double>& coat_;
+  const PassTerms& terms_;
   NodeWeights fresnel_, nodes_;
 };
 
@@ -150,15 +159,19 @@ SecondDifference<3> fresnel_smoothness(double weight, int e0, int e1, int e2) {
   return {k / h0, -k * (1.0 / h0 + 1.0 / h1), k / h1};
 }
 
-// G2 / (4 cos_i cos_o) of the lobe's NDF and its coat's f, per bin: what a pass holds fixed.
-void pass_terms(const MeasuredBins& bins, Smith smith, const LobeFit& lobe, std::vector<double>& g, std::vector<double>& coat) {
+// Per bin, what a pass holds fixed: G2 / (4 cos_i cos_o) of the lobe's NDF, its coat's f, and
+// ln(cos_i cos_o) for the body's factor.
+PassTerms pass_terms(const MeasuredBins& bins, Smith smith, const LobeFit& lobe) {
   const G1Table g1(lobe.ndf);
-  g.resize(bins.size()), coat.resize(bins.size());
+  PassTerms t;
+  t.g.resize(bins.size()), t.coat.resize(bins.size()), t.log_cosines.resize(bins.size());
   for (std::size_t k = 0; k < bins.size(); ++k) {
     const double mi = bins.i[k].z, mo = bins.o[k].z;
-    g[k] = smith_g2_from_g1(smith, g1(mo), g1(mi)) / (4.0 * mi * mo);
-    coat[k] = lobe.coat.eval(bins.o[k], bins.i[k]);
+    t.g[k] = smith_g2_from_g1(smith, g1(mo), g1(mi)) / (4.0 * mi * mo);
+    t.coat[k] = lobe.coat.eval(bins.o[k], bins.i[k]);
+    t.log_cosines[k] = std::log(mi * mo);
   }
+  return t;
 }
 
 }  // namespace
@@ -187,10 +200,11 @@ LobeFit refine_lobe(const MeasuredBins& bins, const Quadrature& quad, Smith smit
   normalize_ndf(fit.ndf, quad);
   std::vector<double> d = fit.ndf.ndf;
   std::vector<double> body = {fit.body.r, fit.body.g, fit.body.b};
+  double exponent = clamp(fit.body_exponent, 1.0, kMaxBodyExponent);
   std::vector<std::array<double, 3>> fresnel(FresnelCurve::kSize);
   for (int j = 0; j < FresnelCurve::kSize; ++j)
     for (int c = 0; c < 3; ++c) fresnel[std::size_t(j)][std::size_t(c)] = clamp(fit.fresnel.value[std::size_t(j)][c], 0.0, 1.0);
-  std::vector<double> g, coat;
+  PassTerms terms;
   std::vector<NodeWeights> row_nodes, row_entries;
   row_nodes.reserve(bins.rows.size());
   row_entries.reserve(bins.rows.size());
@@ -216,13 +230,13 @@ LobeFit refine_lobe(const MeasuredBins& bins, const Quadrature& quad, Smith smit
   };
 
   for (int pass = 0; pass < options.passes; ++pass) {
-    pass_terms(bins, smith, fit, g, coat);  // G2 of the current NDF (the coat is held: the same every pass)
+    terms = pass_terms(bins, smith, fit);  // G2 of the current NDF (the coat is held: the same every pass)
     SmallProblem problem;
     for (std::size_t r = 0; r < bins.rows.size(); ++r) {
-      std::vector<double*> blocks{body.data()};
+      std::vector<double*> blocks{body.data(), &exponent};
       for (int e : row_entries[r].node) blocks.push_back(fresnel[std::size_t(e)].data());
       for (int n : row_nodes[r].node) blocks.push_back(&d[std::size_t(n)]);
-      problem.AddResidualBlock(new RowCost(bins, bins.rows[r], g, coat, row_entries[r], row_nodes[r]), nullptr, blocks);
+      problem.AddResidualBlock(new RowCost(bins, bins.rows[r], terms, row_entries[r], row_nodes[r]), nullptr, blocks);
     }
     std::vector<double*> all_nodes;
     for (double& v : d) all_nodes.push_back(&v);
@@ -241,6 +255,7 @@ LobeFit refine_lobe(const MeasuredBins& bins, const Quadrature& quad, Smith smit
     }
     // Bounds, not a clamp afterwards: left free, the solve trades negative nodes against each other.
     for (int c = 0; c < 3; ++c) problem.SetParameterLowerBound(body.data(), c, 0.0);
+    problem.SetParameterLowerBound(&exponent, 0, 1.0), problem.SetParameterUpperBound(&exponent, 0, kMaxBodyExponent);
     // A Fresnel factor is a reflectance: in [0, 1] (above 1 the fit would trade the NDF's scale for it).
     for (int j : knots)
       for (int c = 0; c < 3; ++c)
@@ -256,6 +271,7 @@ LobeFit refine_lobe(const MeasuredBins& bins, const Quadrature& quad, Smith smit
       for (double& v : f) v = std::min(v * area, 1.0);
   }
   fit.body = Rgb(body[0], body[1], body[2]);
+  fit.body_exponent = exponent;
   for (int j = 0; j < FresnelCurve::kSize; ++j) {
     int e[2];
     double w[2];
@@ -267,19 +283,19 @@ LobeFit refine_lobe(const MeasuredBins& bins, const Quadrature& quad, Smith smit
 }
 
 double refine_jacobian_error(const MeasuredBins& bins, const Quadrature& quad, Smith smith, const LobeFit& at) {
-  std::vector<double> g, coat;
-  pass_terms(bins, smith, at, g, coat);
+  const PassTerms terms = pass_terms(bins, smith, at);
   std::vector<double> d = at.ndf.ndf, body = {at.body.r, at.body.g, at.body.b};
+  double exponent = at.body_exponent;
   std::vector<std::array<double, 3>> fresnel(FresnelCurve::kSize);
   for (int j = 0; j < FresnelCurve::kSize; ++j)
     for (int c = 0; c < 3; ++c) fresnel[std::size_t(j)][std::size_t(c)] = at.fresnel.value[std::size_t(j)][c];
   double worst = 0.0;
   for (const MeasuredBins::Row& row : bins.rows) {
     NodeWeights entries = fresnel_entries(row.theta_d), nodes = ndf_nodes(quad.grid(), row.theta_h);
-    std::vector<double*> blocks{body.data()};
+    std::vector<double*> blocks{body.data(), &exponent};
     for (int e : entries.node) blocks.push_back(fresnel[std::size_t(e)].data());
     for (int n : nodes.node) blocks.push_back(&d[std::size_t(n)]);
-    worst = std::max(worst, jacobian_error(RowCost(bins, row, g, coat, std::move(entries), std::move(nodes)), blocks));
+    worst = std::max(worst, jacobian_error(RowCost(bins, row, terms, std::move(entries), std::move(nodes)), blocks));
   }
   return worst;
 }

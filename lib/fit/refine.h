@@ -19,6 +19,7 @@
 #include "fit/fresnel_fit.h"
 #include "fit/measurement.h"
 #include "fit/quadrature.h"
+#include "model/tabulated.h"
 #include "model/tabulated_ndf.h"
 #include "model/coat.h"
 #include "model/smith.h"
@@ -29,8 +30,12 @@ namespace facetfit {
 struct LobeFit {
   TabulatedNdf ndf;
   FresnelCurve fresnel;
-  Rgb body{0.0};  // Lambertian albedo
+  Rgb body{0.0};  // albedo at normal incidence (model/body.h)
   Coat coat;      // held as it is by the refinement
+  double body_exponent = 1.0;  // Minnaert's k (model/body.h)
+
+  // What the tabulated model evaluates.
+  MicrofacetTables tables(Smith smith) const { return {ndf, smith, fresnel, body, coat, body_exponent}; }
 };
 
 struct RefineOptions {

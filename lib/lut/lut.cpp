@@ -72,7 +72,7 @@ Lut make_lut(const FitResult& fit, const Quadrature& quadrature, const std::stri
              double tolerance, bool with_sampling) {
   if (!fit.ok()) fail(source, "no LUT for a meaningless fit: " + fit.problem);
   Lut lut;
-  lut.tables = {fit.ndf(), fit.smith, fit.fresnel(), fit.body(), fit.lobe.coat};
+  lut.tables = fit.lobe.tables(fit.smith);
   if (with_sampling) lut.sampling = VisibleNormalTables::build(fit.ndf());
   LutMetadata& m = lut.meta;
   m.source = source;
@@ -86,6 +86,7 @@ Lut make_lut(const FitResult& fit, const Quadrature& quadrature, const std::stri
   m.f0 = fit.f0;
   m.f82 = fit.f82;
   m.body = fit.body();
+  m.body_exponent = fit.lobe.body_exponent;
   m.coat = fit.lobe.coat;
   const auto parametric = [](const ParametricFit& p) { return LutMetadata::Parametric{p.alpha, p.body, p.f0, p.f82, p.coat}; };
   m.ggx = parametric(fit.ggx);
@@ -120,6 +121,7 @@ Lut make_lut(const FitResult& fit, const Quadrature& quadrature, const std::stri
     m.anisotropic_phi_count = lut.anisotropic->phi_count;
     m.anisotropic_ggx = fit.anisotropic->ggx;
   }
+  if (m.body_exponent != 1.0) m.format_version = kLutBodyExponentVersion;
   return lut;
 }
 
@@ -171,6 +173,7 @@ void write_lut(const std::string& path, const Lut& lut) {
   spec.set(key("representation_code"), representation_code(m.representation));
   spec.set(key("tolerance"), float(m.tolerance));
   set_color(spec, "body", m.body);
+  if (m.format_version >= kLutBodyExponentVersion) spec.set(key("body_exponent"), float(m.body_exponent));
   spec.set(key("coat_alpha"), float(m.coat.alpha));
   spec.set(key("coat_f0"), float(m.coat.f0));
   for (const auto& [name, p] : {std::pair{"ggx", &m.ggx}, {"beckmann", &m.beckmann}, {"lsq", &m.lsq}}) {
@@ -269,9 +272,9 @@ Lut read_lut(const std::string& path) {
   const ImageSpec& spec = image.spec();
   const int version = spec.get_int(key("format_version"), -1);
   if (version < 0) fail(path, "not a facetfit LUT (no facetfit:format_version attribute)");
-  if (version < 1 || version > kLutAnisotropicVersion)
+  if (version < 1 || version > kLutBodyExponentVersion)
     fail(path, "LUT format version " + std::to_string(version) + "; this facetfit reads versions 1 to " +
-                   std::to_string(kLutAnisotropicVersion));
+                   std::to_string(kLutBodyExponentVersion));
 
   Lut lut;
   LutMetadata& m = lut.meta;
@@ -317,6 +320,11 @@ Lut read_lut(const std::string& path) {
     const auto body = get_color(spec, "body");
     if (!body) fail(path, "facetfit LUT version 2 without facetfit:body");
     m.body = *body;
+    if (version >= kLutBodyExponentVersion) {
+      m.body_exponent = spec.get_float(key("body_exponent"), -1.0f);
+      if (!(m.body_exponent >= 1.0 && m.body_exponent <= kMaxBodyExponent))
+        fail(path, "facetfit:body_exponent is missing or outside [1, " + std::to_string(int(kMaxBodyExponent)) + "]");
+    }
     m.coat = {spec.get_float(key("coat_alpha")), spec.get_float(key("coat_f0"))};
     for (const auto& [name, p] : {std::pair{"ggx", &m.ggx}, {"beckmann", &m.beckmann}, {"lsq", &m.lsq}}) {
       const std::string n = name;
@@ -334,7 +342,8 @@ Lut read_lut(const std::string& path) {
     m.error_extraction = spec.get_float(key("error_extraction"));
   }
 
-  if (version == kLutAnisotropicVersion) {
+  // Version 3 always has the anisotropic rows; version 4 where it says so.
+  if (version == kLutAnisotropicVersion || (version == kLutBodyExponentVersion && spec.get_int(key("anisotropic_phi_count"), 0) > 0)) {
     m.anisotropic_resolution = spec.get_int(key("anisotropic_resolution"), -1);
     m.anisotropic_phi_count = spec.get_int(key("anisotropic_phi_count"), -1);
     // Bounded before anything is sized from them; the quadrature's own limits.
@@ -381,6 +390,7 @@ Lut read_lut(const std::string& path) {
                                                    get(LutLayout::kFresnelRow, x, 2));
   lut.tables.smith = m.smith;
   lut.tables.body = m.body;
+  lut.tables.body_exponent = m.body_exponent;
   lut.tables.coat = m.coat;
   if (m.sampling) {
     lut.sampling.resolution = m.resolution;

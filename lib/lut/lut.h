@@ -14,8 +14,12 @@ namespace facetfit {
 // Version 2 adds the body and the parametric fits on the whole measurement; version 1 LUTs (no body)
 // still read, with a zero body. Version 3 is version 2 with the anisotropic lobe's rows appended (written
 // only for a fit that has one: LUTs without it stay version 2, which readers of version 2 take).
+// Version 4 adds facetfit:body_exponent (Minnaert's k of the tabulated body, model/body.h), with or
+// without the anisotropic rows; it is written only when k is not 1, so a Lambertian body's LUT stays
+// version 2 or 3 and earlier readers, which would render the body Lambertian, refuse the others.
 constexpr int kLutFormatVersion = 2;
 constexpr int kLutAnisotropicVersion = 3;
+constexpr int kLutBodyExponentVersion = 4;
 
 // Which model a renderer should use for this material.
 enum class Representation { tabulated, ggx, beckmann };
@@ -33,7 +37,8 @@ struct LutMetadata {
   double residual = 0.0;
   double alpha_ggx = 0.0, alpha_beckmann = 0.0;  // moment estimates of the tabulated NDF
   Rgb f0{0.0}, f82{0.0};
-  Rgb body{0.0};  // Lambertian albedo of the tabulated representation
+  Rgb body{0.0};  // the tabulated representation's body albedo at normal incidence (model/body.h)
+  double body_exponent = 1.0;  // and its Minnaert exponent
   // The parametric representations fitted on the whole measurement (alpha, body, F82-tint f0 and f82),
   // and the classical baseline (Lambert + GGX + Schlick).
   Coat coat;      // of the tabulated representation

@@ -35,6 +35,7 @@ nlohmann::json fit_record(const std::string& source, const FitResult& fit, doubl
     j["f82"] = rgb(fit.f82);
     j["refine"] = fit.refined ? "full" : "none";
     j["body"] = rgb(fit.body());
+    j["body_exponent"] = fit.lobe.body_exponent;
     j["coat"] = coat_json(fit.lobe.coat);
     j["error"] = fit.error;
     j["error_extraction"] = fit.error_extraction;

@@ -294,7 +294,9 @@ PYBIND11_MODULE(_facetfit, m) {
            py::arg("theta"))
       .def_property_readonly("fresnel", [](const Fit& f) { return fresnel_array(f.result.fresnel()); }, "RGB Fresnel at fresnel_theta_d, (90, 3)")
       .def_property_readonly_static("fresnel_theta_d", [](const py::object&) { return fresnel_theta_d(); })
-      .def_property_readonly("body", [](const Fit& f) { return rgb_array(f.result.body()); }, "Lambertian albedo")
+      .def_property_readonly("body", [](const Fit& f) { return rgb_array(f.result.body()); }, "body albedo at normal incidence")
+      .def_property_readonly("body_exponent", [](const Fit& f) { return f.result.lobe.body_exponent; },
+                             "the body's Minnaert exponent (1: Lambert)")
       .def_property_readonly("alpha_ggx", [](const Fit& f) { return f.result.alpha_ggx; })
       .def_property_readonly("alpha_beckmann", [](const Fit& f) { return f.result.alpha_beckmann; })
       .def_property_readonly("error", [](const Fit& f) { return f.result.error; })
@@ -305,7 +307,7 @@ PYBIND11_MODULE(_facetfit, m) {
                              "everything as `facetfit fit --json` prints it (parametric fits, coat, errors)")
       .def("model", [](const Fit& f) {
         if (!f.result.ok()) throw Error(f.source + ": " + f.result.problem);
-        return tabulated_model(MicrofacetTables{f.result.ndf(), f.result.smith, f.result.fresnel(), f.result.body(), f.result.lobe.coat});
+        return tabulated_model(f.result.lobe.tables(f.result.smith));
       }, "The tabulated model: body + tabulated lobe + coat.")
       .def(
           "write_lut",
@@ -335,6 +337,7 @@ PYBIND11_MODULE(_facetfit, m) {
       .def_property_readonly("sigma", [](const Lut& l) { return vector_array(l.tables.ndf.sigma); })
       .def_property_readonly("fresnel", [](const Lut& l) { return fresnel_array(l.tables.fresnel); })
       .def_property_readonly("body", [](const Lut& l) { return rgb_array(l.tables.body); })
+      .def_property_readonly("body_exponent", [](const Lut& l) { return l.tables.body_exponent; })
       .def_property_readonly("source", [](const Lut& l) { return l.meta.source; })
       .def_property_readonly("representation", [](const Lut& l) { return std::string(to_string(l.meta.representation)); })
       .def_property_readonly("alpha_ggx", [](const Lut& l) { return l.meta.alpha_ggx; })
