@@ -101,9 +101,9 @@ inline double metric_transform(double x, double* slope = nullptr) {
 // Pairs with a direction more than 70 degrees from the normal (docs/extraction.md, "Grazing pairs"):
 // where a gonioreflectometer measures least reliably (an RGL file's last measured elevation is 78.5
 // degrees, its two one-sided estimates part by 27% at 86), and where a residual of several units of
-// lightness says more about the instrument, or about what one isotropic lobe cannot hold (a fabric's
-// weave), than about the surface a rendering shows. Their residuals pass through a soft L1 loss of scale
-// 4 units of L*: quadratic below it, growing as their size rather than its square beyond, so the
+// lightness says more about the instrument, or about what one isotropic lobe cannot hold, than about
+// the surface a rendering shows. Their residuals pass through a soft L1 loss of scale 4 units of L*:
+// quadratic below it, growing as their size rather than its square beyond, so the
 // few-pixel rim no longer pulls the lobe away from the pairs that fill the screen.
 constexpr double kGrazingCos = 0.34202014332566873;  // cos(70 degrees)
 constexpr double kGrazingScale = 4.0 / 116.0;        // 4 units of L*, in the residuals' units (L* / 116)

@@ -2,8 +2,9 @@
 //
 //   f_body(o, i) = body / pi * (k + 1) / 2 * (cos(theta_o) cos(theta_i))^(k - 1),   1 <= k <= kMaxBodyExponent
 //
-// k = 1 is Lambert. k > 1 darkens the body toward grazing angles on both sides, as the weave of a fabric
-// shadows its own fibres (satin_rosaline's measurement: docs/extraction.md). `body` stays the directional
+// k = 1 is Lambert. k > 1 darkens the body toward grazing angles on both sides, as where the light reaches
+// a pigment and leaves it through an interface whose transmission falls toward grazing (a vinyl film's
+// clear layer: satin_rosaline's measurement, docs/extraction.md; paper). `body` stays the directional
 // albedo at normal incidence: int f_body cos(theta_i) d(omega_i) = body cos(theta_o)^(k - 1). k < 1 is
 // left out: it brightens without bound at grazing angles.
 #pragma once
