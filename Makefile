@@ -74,10 +74,10 @@ osl-docs: build osl-host
 bench: build
 	scripts/bench.sh $(BUILD)
 
-# Regenerates docs/accuracy.md (ground-truth fits) and docs/accuracy-real.md (real RGL materials against Mitsuba 3).
+# Regenerates docs/accuracy.md: ground-truth fits, then the real RGL materials against Mitsuba 3's renders.
 accuracy: build
 	$(BUILD)/bench/facetfit_accuracy docs/accuracy.md ../shared/data/rgl
-	scripts/real_accuracy.sh $(BUILD)/bin/facetfit docs/accuracy-real.md ../shared/data
+	scripts/real_accuracy.sh $(BUILD)/bin/facetfit docs/accuracy.md ../shared/data
 
 clean:
 	rm -rf build

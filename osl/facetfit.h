@@ -252,7 +252,10 @@ FacetfitLut facetfit_open(string file) {
     lut.ok = lut.smith >= 0 && lut.smith <= 2;
     if (version >= 2) {
       gettextureinfo(file, "facetfit:body", lut.body);
-      if (version >= 4) gettextureinfo(file, "facetfit:body_exponent", lut.body_exponent);
+      if (version >= 4) {
+        gettextureinfo(file, "facetfit:body_exponent", lut.body_exponent);
+        if (!(lut.body_exponent >= 1.0 && lut.body_exponent <= 3.0)) lut.ok = 0;  // the C++ reader refuses it too
+      }
       gettextureinfo(file, "facetfit:coat_alpha", lut.coat_alpha);
       gettextureinfo(file, "facetfit:coat_f0", lut.coat_f0);
       if (!(lut.coat_alpha > 0.0 && lut.coat_f0 > 0.0)) lut.coat_alpha = lut.coat_f0 = 0.0;

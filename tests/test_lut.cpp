@@ -169,6 +169,7 @@ TEST(Lut, AnisotropicLobeRoundTrip) {
   write_lut(dir.file("k.exr"), make_lut(minnaert, fitter.quadrature(), "a.bin", "", 0.02, true));
   const Lut with_k = read_lut(dir.file("k.exr"));
   EXPECT_EQ(with_k.meta.format_version, kLutBodyExponentVersion);
+  EXPECT_NEAR(with_k.tables.body_exponent, 1.5, 1e-6);
   ASSERT_TRUE(with_k.anisotropic);
   EXPECT_EQ(with_k.anisotropic->ndf, lut.anisotropic->ndf);
   EXPECT_NEAR(with_k.meta.anisotropic_ggx.alpha.alpha_x, want.alpha.alpha_x, 1e-6);
@@ -217,8 +218,11 @@ TEST(Lut, ABodyExponentMakesVersionFour) {
   OIIO::ImageSpec spec = in->spec();
   std::vector<float> px(std::size_t(spec.width) * std::size_t(spec.height) * std::size_t(spec.nchannels));
   ASSERT_TRUE(in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, px.data()));
-  for (const float value : {0.5f, std::nanf(""), 3.5f}) {
-    spec.attribute("facetfit:body_exponent", value);
+  for (const float value : {0.5f, std::nanf(""), 3.5f, -1.0f}) {
+    if (value == -1.0f)  // none at all
+      spec.erase_attribute("facetfit:body_exponent");
+    else
+      spec.attribute("facetfit:body_exponent", value);
     auto out = OIIO::ImageOutput::create(dir.file("bad.exr"));
     ASSERT_TRUE(out->open(dir.file("bad.exr"), spec) && out->write_image(OIIO::TypeDesc::FLOAT, px.data()) && out->close());
     const std::string e = error_of([&] { read_lut(dir.file("bad.exr")); });

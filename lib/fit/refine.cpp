@@ -271,7 +271,9 @@ LobeFit refine_lobe(const MeasuredBins& bins, const Quadrature& quad, Smith smit
       for (double& v : f) v = std::min(v * area, 1.0);
   }
   fit.body = Rgb(body[0], body[1], body[2]);
-  fit.body_exponent = exponent;
+  // An exponent that does nothing visible is Lambert's: within 1e-3 of 1 (f_body moves by under 0.5% even
+  // where both cosines are 0.01), or over a body too faint to see; the LUT then stays version 2 or 3.
+  fit.body_exponent = std::abs(exponent - 1.0) < 1e-3 || std::max({body[0], body[1], body[2]}) < 1e-3 ? 1.0 : exponent;
   for (int j = 0; j < FresnelCurve::kSize; ++j) {
     int e[2];
     double w[2];

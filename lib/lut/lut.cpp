@@ -356,7 +356,7 @@ Lut read_lut(const std::string& path) {
                spec.get_float(key("anisotropic_ggx_angle"))};
     const auto g_body = get_color(spec, "anisotropic_ggx_body"), g_f0 = get_color(spec, "anisotropic_ggx_f0"),
                g_f82 = get_color(spec, "anisotropic_ggx_f82");
-    if (!g_body || !g_f0 || !g_f82) fail(path, "facetfit LUT version 3 without facetfit:anisotropic_ggx_body, _f0 or _f82");
+    if (!g_body || !g_f0 || !g_f82) fail(path, "facetfit LUT with an anisotropic lobe without facetfit:anisotropic_ggx_body, _f0 or _f82");
     g.body = *g_body, g.f0 = *g_f0, g.f82 = *g_f82;
     g.error = spec.get_float(key("anisotropic_ggx_error"));
   }

@@ -59,7 +59,7 @@ struct LutMetadata {
   Representation representation = Representation::tabulated;
   double tolerance = 0.0;  // the NDF error a parametric fit was allowed when choosing the representation
   bool sampling = true;    // sampling tables present (absent with --eval-only)
-  // The anisotropic lobe (version 3): its grid's resolution and azimuths (0: none), and the anisotropic
+  // The anisotropic lobe (version 3, or 4 where announced): its grid's resolution and azimuths (0: none), and the anisotropic
   // GGX fit (fit/fit.h, AnisotropicFit::ggx: principal alphas, axis, body, F82-tint Fresnel).
   int anisotropic_resolution = 0, anisotropic_phi_count = 0;
   AnisotropicParametricFit anisotropic_ggx;
@@ -82,7 +82,7 @@ struct LutLayout {
 struct Lut {
   MicrofacetTables tables;
   VisibleNormalTables sampling;  // empty when baked with --eval-only
-  std::optional<AnisotropicTables> anisotropic;  // version 3
+  std::optional<AnisotropicTables> anisotropic;  // version 3, or 4 with facetfit:anisotropic_phi_count
   LutMetadata meta;
 
   TabulatedMicrofacet model() const { return TabulatedMicrofacet(tables, sampling); }

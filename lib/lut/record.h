@@ -9,9 +9,9 @@
 namespace facetfit {
 
 // The record's layout: part of the bake cache's key, so that a cache written before a change of keys (2: the
-// `anisotropic` key; 3: anisotropic inputs bake LUT version 3; 4: the anisotropic record and LUT carry the anisotropic GGX fit with its body) is baked again rather than served with the old
+// `anisotropic` key; 3: anisotropic inputs bake LUT version 3; 4: the anisotropic record and LUT carry the anisotropic GGX fit with its body; 5: `body_exponent`) is baked again rather than served with the old
 // outputs. Bump with every such change.
-constexpr int kRecordVersion = 4;
+constexpr int kRecordVersion = 5;
 
 // The JSON text of `j` (indented when indent >= 0). Strings that are not UTF-8 (a file name's bytes)
 // are written with U+FFFD in place of the bad bytes rather than failing the whole write.

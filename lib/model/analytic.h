@@ -33,6 +33,7 @@ class LambertBrdf final : public Brdf {
   explicit LambertBrdf(const Rgb& albedo, double exponent = 1.0) : albedo_(albedo), exponent_(exponent) {}
   std::optional<Rgb> eval(const Vec3& o, const Vec3& i) const override;
   const Rgb& albedo() const { return albedo_; }
+  double exponent() const { return exponent_; }
 
  private:
   Rgb albedo_;

@@ -37,7 +37,9 @@ ShadingModel::ShadingModel(std::shared_ptr<const Brdf> brdf, std::shared_ptr<con
     tabulated_f_ = brdf_.get() == static_cast<const Brdf*>(tabulated);
     if (const auto* table = dynamic_cast<const MerlTable*>(brdf_.get())) merl_batch_model_ = MerlBatchModel::of(*table);
   }
-  if (const auto* lambert = dynamic_cast<const LambertBrdf*>(brdf_.get()); lambert && lobe_weight_ == 0.0) lambert_albedo_ = lambert->albedo();
+  // The Lambert lanes hold Lambert's law alone, not Minnaert's.
+  if (const auto* lambert = dynamic_cast<const LambertBrdf*>(brdf_.get()); lambert && lambert->exponent() == 1.0 && lobe_weight_ == 0.0)
+    lambert_albedo_ = lambert->albedo();
 }
 
 Rgb ShadingModel::f(const Vec3& o, const Vec3& i) const {
