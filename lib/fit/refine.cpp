@@ -9,6 +9,7 @@
 #include <memory>
 
 #include "fit/small_problem.h"
+#include "model/body.h"
 
 namespace facetfit {
 
@@ -83,9 +84,8 @@ class RowCost final : public ceres::CostFunction {
       const std::size_t k = row_.begin + b;
       const double s = std::sqrt(bins_.weight[k]), c = bins_.cosine[k], g = terms_.g[k];
       const bool grazing = grazing_pair(bins_.o[k], bins_.i[k]);
-      // Minnaert's factor b = (k + 1) / 2 x^(k - 1), x = cos_o cos_i, and db/dk = x^(k - 1) (1/2 + (k + 1)/2 ln x).
-      const double ln_x = terms_.log_cosines[k], power = exponent == 1.0 ? 1.0 : std::exp((exponent - 1.0) * ln_x);
-      const double factor = 0.5 * (exponent + 1.0) * power, dfactor = power * (0.5 + 0.5 * (exponent + 1.0) * ln_x);
+      const MinnaertFactor minnaert = minnaert_factor_of_log(exponent, terms_.log_cosines[k]);
+      const double factor = minnaert.value, dfactor = minnaert.d_exponent;
       for (int ch = 0; ch < 3; ++ch) {
         const std::size_t r = 3 * b + std::size_t(ch);
         const bool valid = bins_.valid[k] >> ch & 1u;

@@ -15,11 +15,21 @@ namespace facetfit {
 
 inline constexpr double kMaxBodyExponent = 3.0;
 
+// b = (k + 1) / 2 x^(k - 1), x = cos_o cos_i, from ln x, and db/dk = x^(k - 1) (1/2 + (k + 1) / 2 ln x): what
+// a fit of k needs (fit/refine.cpp holds ln x per measured pair).
+struct MinnaertFactor {
+  double value, d_exponent;
+};
+inline MinnaertFactor minnaert_factor_of_log(double k, double log_cosines) {
+  const double power = k == 1.0 ? 1.0 : std::exp((k - 1.0) * log_cosines);
+  return {0.5 * (k + 1.0) * power, power * (0.5 + 0.5 * (k + 1.0) * log_cosines)};
+}
+
 // (k + 1) / 2 (cos_o cos_i)^(k - 1): f_body = body / pi times this. 1 for a Lambertian body (k = 1).
 inline double minnaert_factor(double k, double cos_o, double cos_i) {
   if (k == 1.0) return 1.0;
   const double x = cos_o * cos_i;
-  return x > 0.0 ? 0.5 * (k + 1.0) * std::pow(x, k - 1.0) : 0.0;
+  return x > 0.0 ? minnaert_factor_of_log(k, std::log(x)).value : 0.0;
 }
 
 }  // namespace facetfit

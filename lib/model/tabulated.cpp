@@ -92,9 +92,10 @@ Rgb TabulatedMicrofacet::fresnel(double cos_d) const { return shared_->tables.fr
 std::optional<Rgb> TabulatedMicrofacet::eval(const Vec3& o, const Vec3& i) const {
   if (!above_horizon(o, i)) return Rgb(0.0);
   const Vec3 h = glm::normalize(i + o);
-  const double g2 = smith_g2_from_g1(shared_->tables.smith, g1(o), g1(i));
   const MicrofacetTables& t = shared_->tables;
-  return t.body * (kInvPi * minnaert_factor(t.body_exponent, o.z, i.z)) + fresnel(glm::dot(i, h)) * (D(h) * g2 / (4.0 * i.z * o.z)) + Rgb(shared_->tables.coat.eval(o, i));
+  const double g2 = smith_g2_from_g1(t.smith, g1(o), g1(i));
+  return t.body * (kInvPi * minnaert_factor(t.body_exponent, o.z, i.z)) + fresnel(glm::dot(i, h)) * (D(h) * g2 / (4.0 * i.z * o.z)) +
+         Rgb(t.coat.eval(o, i));
 }
 
 namespace {
