@@ -314,6 +314,36 @@ TEST(Tabulated, ExtremesStayFinite) {
   }
 }
 
+// The guide to the running sums brackets the node every u draws (the last node whose sum is <= u), and the
+// density per cos(theta_h) is each interval's mass over its band: for a peak narrower than a node (alpha
+// 0.005, where most intervals hold no mass and the guide's steps are widest) and a broad lobe.
+TEST(Tabulated, CdfGuideBracketsEveryDrawAndTheDensityIsMassOverBand) {
+  for (double alpha : {0.005, 0.3, 1.5}) {
+    const TabulatedMicrofacet model(fitted_tables(NdfType::ggx, alpha, Fresnel::one()));
+    const VisibleNormalTables& tables = model.sampling();
+    const int r = tables.resolution, guide = TabulatedMicrofacet::kCdfGuide;
+    ASSERT_EQ(model.cdf_guide().size(), std::size_t(r + 1) * (guide + 1));
+    ASSERT_EQ(model.visible_density().size(), std::size_t(r + 1) * r);
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<double> uniform(0.0, 1.0);
+    for (int s = 0; s <= r; ++s) {
+      const double* cdf = tables.cdf.data() + std::size_t(s) * (r + 1);
+      for (int n = 0; n < 200; ++n) {
+        const double u = n < 2 ? double(n) / guide : uniform(rng);  // also a u on an entry itself
+        const int node = int(std::upper_bound(cdf, cdf + r + 1, u) - cdf) - 1;
+        const int g = std::min(int(u * guide), guide - 1);
+        const std::int64_t* entry = model.cdf_guide().data() + std::size_t(s) * (guide + 1) + g;
+        EXPECT_LE(entry[0], node) << alpha << " slice " << s << " u " << u;
+        EXPECT_GE(entry[1], node) << alpha << " slice " << s << " u " << u;
+      }
+      for (int j = 0; j < r; ++j) {
+        const double band = model.cos_nodes()[std::size_t(j)] - model.cos_nodes()[std::size_t(j) + 1];
+        EXPECT_NEAR(model.visible_density()[std::size_t(s) * r + j] * band, tables.mass(s, j), 1e-15) << alpha << " " << s << " " << j;
+      }
+    }
+  }
+}
+
 // The azimuth's CDF a sin(phi) + b phi on [0, phi_max], written out here independently of
 // model/visible_azimuth.cpp, and its root for a target by bisection to the last bit.
 struct AzimuthCdf {

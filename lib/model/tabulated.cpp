@@ -63,6 +63,21 @@ TabulatedMicrofacet::TabulatedMicrofacet(MicrofacetTables tables, VisibleNormalT
   shared->sampling = std::move(sampling);
   for (int j = 0; j < shared->tables.ndf.grid.size(); ++j) shared->cos_nodes.push_back(std::cos(shared->tables.ndf.grid.theta(j)));
   shared->g1.emplace(shared->tables.ndf);
+  if (!shared->sampling.empty()) {
+    const int r = shared->sampling.resolution;
+    for (int s = 0; s <= r; ++s) {
+      for (int j = 0; j < r; ++j) {
+        const double band = shared->cos_nodes[std::size_t(j)] - shared->cos_nodes[std::size_t(j) + 1];
+        shared->visible_density.push_back(band > 0.0 ? shared->sampling.mass(s, j) / band : 0.0);
+      }
+      std::int64_t node = 0;
+      for (int g = 0; g <= kCdfGuide; ++g) {
+        const double u = double(g) / kCdfGuide;
+        while (node < r && shared->sampling.cdf_at(s, int(node) + 1) <= u) ++node;
+        shared->cdf_guide.push_back(node);
+      }
+    }
+  }
   shared->parts = ProposalParts(shared->tables.fresnel.value[0], shared->tables.body, shared->tables.coat);
   shared_ = std::move(shared);
 }
@@ -129,15 +144,15 @@ double TabulatedMicrofacet::measured_visible_normal_pdf(const Vec3& o, const Vec
   if (o.z <= 0.0 || h.z <= 0.0 || oh <= 0.0 || shared_->sampling.empty()) return 0.0;
   const ThetaGrid& grid = shared_->tables.ndf.grid;
   const GridPosition view = locate(grid, o.z), normal = locate(grid, h.z);
-  const double band = shared_->cos_nodes[std::size_t(normal.j)] - shared_->cos_nodes[std::size_t(normal.j) + 1];
-  if (!(band > 0.0)) return 0.0;
   // The two view slices around o, mixed linearly in u (sample() picks one with these weights).
-  const double mass = (1.0 - view.t) * shared_->sampling.mass(view.j, normal.j) + view.t * shared_->sampling.mass(view.j + 1, normal.j);
+  const double* density = shared_->visible_density.data() + std::size_t(view.j) * grid.resolution + normal.j;
+  const double per_cos = (1.0 - view.t) * density[0] + view.t * density[grid.resolution];
+  if (!(per_cos > 0.0)) return 0.0;
   // Azimuth: exactly max(0, o.h) over its phi integral at this theta_h.
   const double sin_o = std::sqrt(std::max(0.0, 1.0 - o.z * o.z)), sin_h = std::sqrt(std::max(0.0, 1.0 - h.z * h.z));
   const double phi_total = positive_phi_integral(sin_o * sin_h, o.z * h.z);
   if (!(phi_total > 0.0)) return 0.0;
-  return mass / band * oh / phi_total;  // d(omega) = d(cos theta) d(phi)
+  return per_cos * oh / phi_total;  // d(omega) = d(cos theta) d(phi)
 }
 
 double TabulatedMicrofacet::pdf(const Vec3& o, const Vec3& i) const {

@@ -9,6 +9,7 @@
 // for the body the cosine; for the coat its GGX visible normals. pdf() is the mixture's.
 #pragma once
 
+#include <cstdint>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -88,6 +89,14 @@ class TabulatedMicrofacet final : public Brdf, public Proposal {
   // What SIMD kernels read (render/tabulated_batch.h): cos(theta_j) at the grid's nodes, and G1's table.
   const std::vector<double>& cos_nodes() const { return shared_->cos_nodes; }
   const G1Table& g1_table() const { return *shared_->g1; }
+  // The visible normals' density per unit cos(theta_h) in interval j of view slice s, mass(s, j) /
+  // (cos_j - cos_{j+1}) (0 for an empty band), at s R + j; empty without sampling tables.
+  const std::vector<double>& visible_density() const { return shared_->visible_density; }
+  // A guide to the running sums: at s (kCdfGuide + 1) + g, the last node of slice s whose sum is <= g /
+  // kCdfGuide. The node a u in [g, g + 1) / kCdfGuide draws lies between entries g and g + 1, so a search
+  // starts there instead of over the whole slice. kCdfGuide is a power of two: u kCdfGuide is exact.
+  static constexpr int kCdfGuide = 64;
+  const std::vector<std::int64_t>& cdf_guide() const { return shared_->cdf_guide; }
   bool can_sample() const override { return !shared_->sampling.empty(); }
 
   // The same lobe under another stretch: shares the tables, so it is cheap enough to make per shading
@@ -101,6 +110,8 @@ class TabulatedMicrofacet final : public Brdf, public Proposal {
     VisibleNormalTables sampling;
     std::vector<double> cos_nodes;  // cos(theta_j)
     std::optional<G1Table> g1;      // G1 without an arc cosine and a spline per call
+    std::vector<double> visible_density;
+    std::vector<std::int64_t> cdf_guide;
     ProposalParts parts;
   };
   std::shared_ptr<const Shared> shared_;

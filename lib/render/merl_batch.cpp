@@ -67,14 +67,14 @@ void EvalMerlBatch(const MerlBatchModel& model, EvaluationBatch& batch) {
     hx = hn::IfThenElseZero(long_enough, hx / safe_len), hy = hn::IfThenElseZero(long_enough, hy / safe_len);
     hz = hn::IfThenElse(long_enough, hz / safe_len, one);
     const V ct = hn::Min(hn::Max(hz, hn::Set(d, -1.0)), one);
-    const V theta_h = hn::Acos(d, ct);
+    const V theta_h = lanes::acos(d, ct);
     const V r = hn::Sqrt(hx * hx + hy * hy);
     const auto turned = r > zero;
     const V inv_r = lanes::reciprocal(d, hn::IfThenElse(turned, r, one));
     const V c = hn::IfThenElse(turned, hx * inv_r, one), s = hn::IfThenElseZero(turned, hy * inv_r);
     const V tx = c * ix + s * iy, ty = hn::Neg(s) * ix + c * iy, tz = iz;
     const V dx = ct * tx - r * tz, dy = ty, dz = r * tx + ct * tz;
-    const V theta_d = hn::Acos(d, hn::Min(hn::Max(dz, hn::Set(d, -1.0)), one));
+    const V theta_d = lanes::acos(d, hn::Min(hn::Max(dz, hn::Set(d, -1.0)), one));
     V phi_d = atan2(d, dy, dx);
     phi_d = hn::IfThenElse(phi_d < zero, phi_d + pi, phi_d);  // reciprocity: period pi
     phi_d = hn::IfThenElse(phi_d >= pi, phi_d - pi, phi_d);

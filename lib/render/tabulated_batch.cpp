@@ -8,6 +8,7 @@
 #include <hwy/highway.h>
 #include <hwy/contrib/math/math-inl.h>
 
+#include "model/tabulated.h"
 #include "model/visible_azimuth.h"
 #include "render/lanes-inl.h"
 #include "render/tabulated_batch.h"
@@ -29,10 +30,10 @@ struct GridPosition {
   I j;
   V t;
 };
-GridPosition locate(D d, V c, int resolution) {
+HWY_INLINE GridPosition locate(D d, V c, int resolution) {
   const DI di;
-  const V theta = hn::Acos(d, hn::Min(hn::Max(c, hn::Set(d, -1.0)), hn::Set(d, 1.0)));
-  const V x = hn::Min(hn::Sqrt(hn::Max(hn::Zero(d), theta) / hn::Set(d, 0.5 * kPi)), hn::Set(d, 1.0)) * hn::Set(d, double(resolution));
+  const V theta = lanes::acos(d, hn::Min(hn::Max(c, hn::Set(d, -1.0)), hn::Set(d, 1.0)));
+  const V x = hn::Min(lanes::sqrt(d, hn::Max(hn::Zero(d), theta) * hn::Set(d, 2.0 / kPi)), hn::Set(d, 1.0)) * hn::Set(d, double(resolution));
   const I j = hn::Min(hn::ConvertTo(di, x), hn::Set(di, resolution - 1));
   return {j, x - hn::ConvertTo(d, j)};
 }
@@ -77,7 +78,7 @@ V positive_phi_integral(D d, V a, V b) {
   const auto whole = a <= b;
   const V safe_a = hn::IfThenElse(whole, hn::Set(d, 1.0), a);
   const V ratio = hn::Max(lanes::divide(d, hn::Neg(b), safe_a), hn::Set(d, -1.0));
-  const V part = hn::Set(d, 2.0) * (hn::Sqrt(hn::Max(hn::Zero(d), a * a - b * b)) + b * hn::Acos(d, ratio));
+  const V part = hn::Set(d, 2.0) * (hn::Sqrt(hn::Max(hn::Zero(d), a * a - b * b)) + b * lanes::acos(d, ratio));
   return hn::IfThenElse(whole, hn::Set(d, 2.0 * kPi) * b, part);
 }
 
@@ -111,7 +112,7 @@ lanes::CosSin sample_phi(D d, const double* guess, V a, V b, V u) {
   const V zero = hn::Zero(d), one = hn::Set(d, 1.0), two = hn::Set(d, 2.0), half = hn::Set(d, 0.5), pi = hn::Set(d, kPi);
   const auto whole = a <= b;
   const V ratio = hn::Min(hn::Max(lanes::divide(d, hn::Neg(b), hn::IfThenElse(whole, one, a)), hn::Set(d, -1.0)), one);
-  const V phi_max = hn::IfThenElse(whole, pi, hn::Acos(d, ratio));
+  const V phi_max = hn::IfThenElse(whole, pi, lanes::acos(d, ratio));
   const auto lower = u < half;
   const V sign = hn::IfThenElse(lower, hn::Set(d, -1.0), one);
   u = hn::IfThenElse(lower, two * u, two * u - one);
@@ -150,8 +151,8 @@ lanes::CosSin sample_phi(D d, const double* guess, V a, V b, V u) {
 }
 
 // o reflected about a normal drawn from the lobe's visible normals seen from o: i
-// (TabulatedMicrofacet::lobe_direction, unstretched), to be refused where i.z <= 0. `top_step`: the largest power of two <= the grid's resolution.
-lanes::Direction lobe_direction(D d, const TabulatedBatchModel& model, int top_step, V ox, V oy, V oz, V u1, V u2) {
+// (TabulatedMicrofacet::lobe_direction, unstretched), to be refused where i.z <= 0.
+lanes::Direction lobe_direction(D d, const TabulatedBatchModel& model, V ox, V oy, V oz, V u1, V u2) {
   const DI di;
   const V zero = hn::Zero(d), one = hn::Set(d, 1.0);
   const int r = model.resolution;
@@ -163,14 +164,16 @@ lanes::Direction lobe_direction(D d, const TabulatedBatchModel& model, int top_s
   u = hn::Min(hn::Max(u, zero), hn::Set(d, 1.0 - 1e-16));
   const I slice = hn::IfThenElse(hn::RebindMask(di, first), view.j, view.j + hn::Set(di, 1));
   // The interval of theta_h: the last node of the slice's running sums <= u (sample_cdf: zero-mass
-  // intervals are never chosen), by bisection.
+  // intervals are never chosen), by bisection between the guide's entries around u.
   const I row = slice * hn::Set(di, r + 1), last = hn::Set(di, r);
-  I k = hn::Zero(di);
-  for (int step = top_step; step > 0; step >>= 1) {
-    const I probe = k + hn::Set(di, step);
-    const V at = hn::GatherIndex(d, model.cdf, row + hn::Min(probe, last));
-    const auto take = hn::And(hn::RebindMask(d, hn::Set(di, r + 1) > probe), at <= u);
-    k = hn::IfThenElse(hn::RebindMask(di, take), probe, k);
+  constexpr int guide = TabulatedMicrofacet::kCdfGuide;
+  const I at = slice * hn::Set(di, guide + 1) + hn::Min(hn::ConvertTo(di, u * hn::Set(d, double(guide))), hn::Set(di, guide - 1));
+  I k = hn::GatherIndex(di, model.cdf_guide, at), top = hn::GatherIndex(di, model.cdf_guide, at + hn::Set(di, 1));
+  // The running sum at node k is <= u; the last such node is at most `top`.
+  for (auto open = top > k; !hn::AllFalse(di, open); open = top > k) {
+    const I probe = hn::ShiftRight<1>(k + top + hn::Set(di, 1));
+    const auto take = hn::RebindMask(di, hn::GatherIndex(d, model.cdf, row + probe) <= u);
+    k = hn::IfThenElse(take, probe, k), top = hn::IfThenElse(take, top, probe - hn::Set(di, 1));
   }
   k = hn::Min(k, last - hn::Set(di, 1));
   const V c0 = hn::GatherIndex(d, model.cdf, row + k), c1 = hn::GatherIndex(d, model.cdf, row + k + hn::Set(di, 1));
@@ -197,10 +200,8 @@ lanes::Direction lobe_direction(D d, const TabulatedBatchModel& model, int top_s
 
 void SampleTabulatedBatch(const TabulatedBatchModel& model, SampleBatch& batch) {
   const D d;
-  int top_step = 1;
-  while (top_step * 2 <= model.resolution) top_step *= 2;
   lanes::sample_proposal(d, model.weights, model.coat, batch, [&](V ox, V oy, V oz, V u1, V u2, V, V) {
-    return lobe_direction(d, model, top_step, ox, oy, oz, u1, u2);
+    return lobe_direction(d, model, ox, oy, oz, u1, u2);
   });
 }
 
@@ -210,7 +211,6 @@ void EvalTabulatedBatch(const TabulatedBatchModel& model, EvaluationBatch& batch
   const std::size_t n = batch.padded_size();
   const V zero = hn::Zero(d), one = hn::Set(d, 1.0), four = hn::Set(d, 4.0);
   const int resolution = model.resolution;
-  const I row = hn::Set(di, model.resolution + 1);  // nodes per view slice of the running sums
   const V body[3] = {hn::Set(d, model.body.r * kInvPi), hn::Set(d, model.body.g * kInvPi), hn::Set(d, model.body.b * kInvPi)};
   const bool minnaert = model.body_exponent != 1.0;
   const V body_power = hn::Set(d, model.body_exponent - 1.0), body_scale = hn::Set(d, 0.5 * (model.body_exponent + 1.0));
@@ -259,21 +259,25 @@ void EvalTabulatedBatch(const TabulatedBatchModel& model, EvaluationBatch& batch
       for (int c = 0; c < 3; ++c) hn::StoreU(hn::IfThenElseZero(formed, body[c] * factor + fresnel[c] * specular + coat_f), d, out[c] + k);
     }
 
-    // The lobe's visible normals (TabulatedMicrofacet::measured_visible_normal_pdf): the mass of the
-    // normal's theta_h interval, mixed linearly between the two view slices around o, spread uniformly in
-    // cos(theta_h) and over phi as max(0, o.h); reflected about h, d(omega_i) = 4 (o.h) d(omega_h).
+    // The lobe's visible normals (TabulatedMicrofacet::measured_visible_normal_pdf): the density per
+    // cos(theta_h) of the normal's interval, mixed linearly between the two view slices around o, spread
+    // over phi as max(0, o.h); reflected about h, d(omega_i) = 4 (o.h) d(omega_h).
+    // A light's slots take f alone (shading_batch.h): where no lane of the vector asks, no density.
+    if (hn::AllFalse(d, hn::LoadU(d, batch.with_pdf.data() + k) != zero)) {
+      hn::StoreU(zero, d, batch.pdf.data() + k);
+      continue;
+    }
     const GridPosition view = locate(d, oz, resolution);
-    const I at = view.j * row + normal.j;
-    const V mass_lo = hn::GatherIndex(d, model.cdf, at + hn::Set(di, 1)) - hn::GatherIndex(d, model.cdf, at);
-    const V mass_hi = hn::GatherIndex(d, model.cdf, at + row + hn::Set(di, 1)) - hn::GatherIndex(d, model.cdf, at + row);
-    const V mass = (one - view.t) * mass_lo + view.t * mass_hi;
-    const V band = hn::GatherIndex(d, model.cos_nodes, normal.j) - hn::GatherIndex(d, model.cos_nodes, normal.j + hn::Set(di, 1));
+    const I at = view.j * hn::Set(di, resolution) + normal.j;
+    const V per_cos_lo = hn::GatherIndex(d, model.visible_density, at);
+    const V per_cos_hi = hn::GatherIndex(d, model.visible_density, at + hn::Set(di, resolution));
+    const V per_cos = (one - view.t) * per_cos_lo + view.t * per_cos_hi;
     const V sin_o = hn::Sqrt(hn::Max(zero, one - oz * oz)), sin_h = hn::Sqrt(hn::Max(zero, one - hz * hz));
     const V phi_total = positive_phi_integral(d, sin_o * sin_h, oz * hz);
-    const auto visible = hn::And(hn::And(o_faces_h, h_up), hn::And(band > zero, phi_total > zero));
-    const V safe_band = hn::IfThenElse(visible, band, one), safe_total = hn::IfThenElse(visible, phi_total, one);
-    // mass / band (o.h) / total / (4 o.h): o.h cancels.
-    const V lobe_pdf = hn::IfThenElseZero(visible, lanes::divide(d, mass, four * safe_band * safe_total));
+    const auto visible = hn::And(hn::And(o_faces_h, h_up), hn::And(per_cos > zero, phi_total > zero));
+    const V safe_total = hn::IfThenElse(visible, phi_total, one);
+    // per_cos (o.h) / total / (4 o.h): o.h cancels.
+    const V lobe_pdf = hn::IfThenElseZero(visible, lanes::divide(d, per_cos, four * safe_total));
     hn::StoreU(hn::IfThenElseZero(above, lanes::mixture_density(d, model.weights, coat, lobe_pdf, coat_pdf, iz)), d, batch.pdf.data() + k);
   }
 }
@@ -285,7 +289,6 @@ HWY_AFTER_NAMESPACE();
 
 #if HWY_ONCE
 #include "render/simd_dispatch.h"
-#include "model/tabulated.h"
 
 namespace facetfit {
 
@@ -298,6 +301,8 @@ std::optional<TabulatedBatchModel> TabulatedBatchModel::of(const TabulatedMicrof
   m.ndf = tables.ndf.ndf.data();
   m.cos_nodes = lobe.cos_nodes().data();
   m.cdf = lobe.sampling().cdf.data();
+  m.visible_density = lobe.visible_density().data();
+  m.cdf_guide = lobe.cdf_guide().data();
   m.g1_ratios = lobe.g1_table().ratios();
   m.g1_size = lobe.g1_table().size();
   m.smith = tables.smith;

@@ -5,6 +5,7 @@
 // lookups are Highway's; the azimuth's Newton steps take sines and cosines from a series of their own.
 #pragma once
 
+#include <cstdint>
 #include <optional>
 
 #include "core/vec.h"
@@ -24,6 +25,9 @@ struct TabulatedBatchModel {
   const double* ndf = nullptr;
   const double* cos_nodes = nullptr;
   const double* cdf = nullptr;
+  // TabulatedMicrofacet::visible_density() and cdf_guide().
+  const double* visible_density = nullptr;
+  const std::int64_t* cdf_guide = nullptr;
   // G1 / cos(theta) at cos(theta) = (m / g1_size)^2, m = 0..g1_size (model/tabulated_ndf.h, G1Table).
   const double* g1_ratios = nullptr;
   int g1_size = 0;
