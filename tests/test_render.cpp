@@ -20,7 +20,6 @@
 #include "render/renderer.h"
 #include "render/camera_batch.h"
 #include "render/environment.h"
-#include "render/environment_batch.h"
 #include "render/ggx_batch.h"
 #include "render/merl_batch.h"
 #include "render/shading.h"
@@ -327,22 +326,22 @@ INSTANTIATE_TEST_SUITE_P(Render, RayStreams, ::testing::Values(R"({"builtin": "s
 // arithmetic: each hit placed as Frame (core/frame.h) places it, with and without a tangent, on spheres
 // and triangles; each light's and the environment's slot where it lights the hit and nowhere else, with
 // its direction in the frame, its ray and what arrives along it. Both with a light sample's radiance and
-// density per hit (a map's) and a point light (which reads the hits' positions), and with the same
-// radiance and density for every hit (a constant environment's) and a directional light alone (no
-// positions).
+// density per hit (a map's) and a point light (which reads the hits' positions), and with no light sample
+// (a constant environment's: no slot of its own, BRDF samples weighing 1) and a directional light alone
+// (no positions). Then the slots' values against the one-hit path's formulas.
 TEST(Wavefront, HitsAndSlotsEqualTheOneHitPath) {
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> u(0.0, 1.0);
   const auto unit = [&] { return glm::normalize(Vec3(u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5) + Vec3(1e-3)); };
   const Vec3 camera(0.2, 0.5, 4.0), tangent(0.3, 1.0, 0.2);
   const double eps = 2e-4;
-  for (const auto& [uniform, n] : {std::pair<bool, std::size_t>{false, 1}, {false, 5}, {false, 37}, {true, 1}, {true, 5}, {true, 37}}) {
+  for (const auto& [constant, n] : {std::pair<bool, std::size_t>{false, 1}, {false, 5}, {false, 37}, {true, 1}, {true, 5}, {true, 37}}) {
     std::vector<LaneLight> lights = {{true, 0.3, 1.0, 0.5, 3, 2, 1}};
-    if (!uniform) lights.push_back({false, -2.0, 3.0, 1.0, 5, 4, 3});
+    if (!constant) lights.push_back({false, -2.0, 3.0, 1.0, 5, 4, 3});
     TileHits tile;
     tile.resize_to(n);
-    // Uniform: the value the slots must carry, the columns something else (not to be read).
-    if (uniform) tile.uniform_light = {0.1, 0.3, 0.2, 0.1};
+    // Constant: the light sample's columns hold something (not to be read).
+    tile.light_sampled = !constant;
     for (std::size_t k = 0; k < n; ++k) {
       const Vec3 d = glm::normalize(Vec3(u(rng) - 0.5, u(rng) - 0.5, -4.0));
       tile.dx[k] = d.x, tile.dy[k] = d.y, tile.dz[k] = d.z;
@@ -356,15 +355,15 @@ TEST(Wavefront, HitsAndSlotsEqualTheOneHitPath) {
     }
     for (const bool with_tangent : {false, true})
       for (const SimdTarget target : kSimdTargets) {
-        const std::string where = std::to_string(n) + (with_tangent ? " tangent " : " ") + (uniform ? "uniform " : "") + simd_target_name(target);
+        const std::string where = std::to_string(n) + (with_tangent ? " tangent " : " ") + (constant ? "constant " : "") + simd_target_name(target);
         HitBatch hits;
-        place_hits(tile, camera, eps, 0.0, with_tangent ? &tangent : nullptr, !uniform, hits, target);
+        place_hits(tile, camera, eps, 0.0, with_tangent ? &tangent : nullptr, !constant, hits, target);
         ShadowBatch slots;
         SlotRanges ranges;
-        if (uniform) {
-          EXPECT_THROW(light_slots(hits, true, {{false, -2.0, 3.0, 1.0, 5, 4, 3}}, eps, slots, ranges, target), std::invalid_argument);
+        if (constant) {
+          EXPECT_THROW(light_slots(hits, {{false, -2.0, 3.0, 1.0, 5, 4, 3}}, eps, slots, ranges, target), std::invalid_argument);
         }
-        light_slots(hits, true, lights, eps, slots, ranges, target);
+        light_slots(hits, lights, eps, slots, ranges, target);
         const auto close = [](double a, double b) { return std::abs(a - b) <= 1e-12 * std::max(1.0, std::abs(b)); };
         // The one-hit path, hit by hit of material 0, slot by slot.
         std::size_t row = 0, env_entries = 0;
@@ -386,7 +385,7 @@ TEST(Wavefront, HitsAndSlotsEqualTheOneHitPath) {
                                      {hits.origin_x[row], origin.x}, {hits.origin_y[row], origin.y}, {hits.origin_z[row], origin.z},
                                      {hits.draws.u1[row], tile.u1[k]}, {hits.draws.u3[row], tile.u3[k]}})
             ASSERT_TRUE(close(a, b)) << where << " hit " << k << ": " << a << " against " << b;
-          if (!uniform) {
+          if (!constant) {
             EXPECT_EQ(hits.light_pdf[row], tile.light_pdf[k]) << where;
             EXPECT_EQ(hits.light_r[row], tile.light_r[k]) << where;
             EXPECT_TRUE(close(hits.px[row], p.x) && close(hits.pz[row], p.z)) << where;
@@ -394,8 +393,8 @@ TEST(Wavefront, HitsAndSlotsEqualTheOneHitPath) {
           // The environment's slot: where the light sample and the view are above the horizon.
           const Vec3 l(tile.lx[k], tile.ly[k], tile.lz[k]);
           const Vec3 il = frame.to_local(l);
-          const double light_pdf = uniform ? 0.1 : tile.light_pdf[k], light_r = uniform ? 0.3 : tile.light_r[k];
-          if (o.z > 0.0 && il.z > 0.0 && light_pdf > 0.0) {
+          const double light_pdf = tile.light_pdf[k], light_r = tile.light_r[k];
+          if (!constant && o.z > 0.0 && il.z > 0.0 && light_pdf > 0.0) {
             const std::size_t e = env_entries++;
             ASSERT_LT(e, ranges.lights_begin) << where;
             EXPECT_EQ(slots.owner[e], double(k)) << where;
@@ -448,41 +447,34 @@ TEST(Wavefront, HitsAndSlotsEqualTheOneHitPath) {
                       close(slots.rays.dz[e], world.z) && close(slots.rays.oy[e], hits.origin_y[r]))
               << where << " row " << r;
           EXPECT_EQ(slots.arriving_b[e], 0.1) << where;
-          EXPECT_EQ(slots.light_pdf[e], 1.0 / (4.0 * kPi)) << where;
+          EXPECT_EQ(slots.light_pdf[e], 0.0) << where;
           EXPECT_TRUE(std::isinf(slots.rays.tfar[e])) << where;
           ++e;
         }
         EXPECT_EQ(e, slots.size()) << where;
+        // The values (the one-hit path's, render/renderer.cpp): an environment light sample f L cos w / p_light,
+        // a light's f E cos, a BRDF sample f cos / p L w, w by the power heuristic, 1 against a density of 0
+        // (a constant environment's, or a map's where it is black); none cast for a BRDF sample of density 0.
+        const auto heuristic = [](double a, double b) { return a * a / (a * a + b * b); };
+        for (std::size_t q = 0; q < slots.size(); ++q) {
+          slots.r[q] = 0.5 + 0.01 * double(q % 7), slots.g[q] = 0.2, slots.b[q] = 0.1;
+          slots.pdf[q] = q % 6 == 5 ? 0.0 : 0.3 + 0.1 * double(q % 5);
+          if (q >= ranges.brdf_begin && !constant) slots.light_pdf[q] = q % 4 == 0 ? 0.0 : 0.2;  // a map looked up
+        }
+        shadow_values(slots, ranges, target);
+        for (std::size_t q = 0; q < slots.size(); ++q) {
+          const double f = slots.r[q], arriving = slots.arriving_r[q], cos_i = slots.iz[q], pdf = slots.pdf[q], light_pdf = slots.light_pdf[q];
+          double want = f * arriving * cos_i;  // a light
+          if (q < ranges.lights_begin) want = f * arriving * cos_i * heuristic(light_pdf, pdf) / light_pdf;
+          if (q >= ranges.brdf_begin) {
+            EXPECT_EQ(slots.casts[q], pdf > 0.0 ? 1.0 : 0.0) << where << " entry " << q;
+            if (!(pdf > 0.0)) continue;
+            want = f * cos_i / pdf * arriving * (light_pdf > 0.0 ? heuristic(pdf, light_pdf) : 1.0);
+          }
+          EXPECT_TRUE(close(slots.value_r[q], want)) << where << " entry " << q << ": " << slots.value_r[q] << " against " << want;
+        }
       }
   }
-}
-
-TEST(Environment, ConstantLightSamplesInSimdLanesEqualSample) {
-  const Environment env = Environment::constant(Rgb(0.3));
-  std::mt19937 rng(5);
-  std::uniform_real_distribution<double> u(0.0, 1.0);
-  for (const SimdTarget target : kSimdTargets)
-    for (std::size_t n : {1, 3, 4, 15, 16, 17, 61}) {
-      SphereSampleBatch batch;
-      std::vector<std::pair<double, double>> numbers;
-      // The ends of [0, 1) too (the poles, phi = 0 and just short of 2 pi), and the azimuths where the
-      // lanes' cos_sin_turn folds its angle or its series is at its ends (phi = pi/2, pi, 3 pi/2).
-      const double u2_at[] = {0.0, 0.25, std::nextafter(0.5, 0.0), 0.5, 0.75, std::nextafter(1.0, 0.0), 1e-300};
-      for (std::size_t k = 0; k < n; ++k) {
-        const double u1 = k == 0 ? 0.0 : k == 1 ? std::nextafter(1.0, 0.0) : u(rng), u2 = k < 7 ? u2_at[k] : u(rng);
-        numbers.emplace_back(u1, u2);
-        batch.push(u1, u2);
-      }
-      sample_uniform_sphere_batch(batch, target);
-      for (std::size_t k = 0; k < n; ++k) {
-        // To a few ulp of 1: the lanes' cos_sin_turn (render/lanes-inl.h) against the C library's.
-        const Vec3 want = env.sample(numbers[k].first, numbers[k].second).d, got = batch.d(k);
-        EXPECT_NEAR(got.x, want.x, 1e-15) << k << " u2 " << numbers[k].second;
-        EXPECT_NEAR(got.y, want.y, 1e-15) << k;
-        EXPECT_NEAR(got.z, want.z, 1e-15) << k << " u2 " << numbers[k].second;
-        EXPECT_NEAR(glm::length(got), 1.0, 1e-12) << k;
-      }
-    }
 }
 
 TEST(Camera, SamplesInSimdLanesEqualOneAtATime) {

@@ -14,7 +14,6 @@
 #include "model/proposal.h"
 #include "model/tabulated.h"
 #include "render/camera_batch.h"
-#include "render/environment_batch.h"
 #include "render/ggx_batch.h"
 #include "render/merl_batch.h"
 #include "render/shading.h"
@@ -274,22 +273,6 @@ TEST(MerlLanes, EveryBatchLengthAndDegenerateDirectionStayFiniteAndInBounds) {
           for (const double v : {e.r[k], e.g[k], e.b[k]}) ASSERT_TRUE(std::isfinite(v)) << "pair " << k;
       }
   }
-}
-
-TEST(EnvironmentLanes, EveryBatchLengthAndTheEndsOfTheUnitIntervalStayOnTheSphere) {
-  // As above for the constant environment's light samples (render/environment_batch.h): any length from 0
-  // to 40 under the sanitizers, and numbers at 0 and just below 1 (the poles, phi = 0 and 2 pi).
-  const double ends[] = {0.0, std::nextafter(1.0, 0.0), 0.5, 1e-300, 0.25};
-  for (std::size_t n = 0; n <= 40; ++n)
-    for (const SimdTarget target : kSimdTargets) {
-      SphereSampleBatch b;
-      for (std::size_t k = 0; k < n; ++k) b.push(ends[k % 5], ends[(k * 3 + 1) % 5]);
-      sample_uniform_sphere_batch(b, target);
-      for (std::size_t k = 0; k < n; ++k) {
-        for (const double v : {b.x[k], b.y[k], b.z[k]}) ASSERT_TRUE(std::isfinite(v)) << "sample " << k;
-        EXPECT_NEAR(glm::length(b.d(k)), 1.0, 1e-12) << "sample " << k;
-      }
-    }
 }
 
 TEST(CameraLanes, EveryBatchLengthAndTheImageCornersGiveUnitDirections) {

@@ -18,7 +18,6 @@
 #include "model/tabulated_anisotropic.h"
 #include "render/camera_batch.h"
 #include "render/environment.h"
-#include "render/environment_batch.h"
 #include "render/shading_batch.h"
 #include "render/texture.h"
 #include "render/tracer.h"
@@ -138,7 +137,9 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
 
   // Shading at a hit yields its shadow rays and their values, in slot order: the environment's light
   // sample and a BRDF sample (each weighted against the other by multiple importance sampling), then each
-  // light. plan() makes them for one hit, evaluating one pair at a time: the one-ray path for every hit,
+  // light. A constant environment is lit by the BRDF sample alone: a light sample, uniform over the sphere,
+  // adds nothing the BRDF's proposal does not already draw better (every model's proposal holds the
+  // cosine, so the estimate stays unbiased), and weighted against it, it added noise (docs/render-speed.md). plan() makes them for one hit, evaluating one pair at a time: the one-ray path for every hit,
   // the stream path for a lobe textured per hit and for models without SIMD lanes (queuing their work
   // would only add the queue's cost). The stream path makes the slots of a tile's other hits material by
   // material in SIMD lanes (render/wavefront.h).
@@ -158,6 +159,8 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
     std::optional<ShadingModel> model;
   };
   const double infinity = std::numeric_limits<double>::infinity();
+  // Whether the environment gets a light sample per hit (a map), or the BRDF sample alone (constant).
+  const bool light_sampled = env && !env->is_constant();
   // Per material: whether the stream path shades its hits in lanes.
   std::vector<char> in_lanes;
   for (std::size_t m = 0; m < materials.size(); ++m) in_lanes.push_back(materials[m]->has_lanes() && !stretch_textures[m]);
@@ -191,10 +194,8 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
     planned.o = planned.frame.to_local(-dir);
     planned.origin = p + eps * n;
   };
-  // The shadow rays of a hit placed by place(), with u[2..6], and their values; `light_d`, where not null,
-  // is the environment's sample drawn with u[2..3] beforehand (a constant environment's, in SIMD lanes on
-  // the stream path).
-  const auto plan = [&](const Hit& hit, const double* u, const Vec3* light_d, Textured& textured, Planned& planned,
+  // The shadow rays of a hit placed by place(), with u[2..6], and their values.
+  const auto plan = [&](const Hit& hit, const double* u, Textured& textured, Planned& planned,
                         std::vector<Ray>& rays, std::vector<Rgb>& values) {
     planned.ray_first = planned.ray_last = rays.size();
     if (!hit.found()) return;
@@ -224,18 +225,20 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
       values.push_back(value);
     };
     if (env && o.z > 0.0) {
-      // Light sampling, weighted against the BRDF's proposal.
-      const Environment::Sample ls = light_d ? env->lookup(*light_d) : env->sample(u[0], u[1]);
-      const Vec3 il = frame.to_local(ls.d);
-      if (il.z > 0.0 && ls.pdf > 0.0) {
-        const ShadingModel::Evaluation e = model.eval(o, il, true);
-        cast(ls.d, infinity, e.f * ls.radiance * (il.z * power_heuristic(ls.pdf, e.pdf) / ls.pdf));
+      // Light sampling of a map, weighted against the BRDF's proposal.
+      if (light_sampled) {
+        const Environment::Sample ls = env->sample(u[0], u[1]);
+        const Vec3 il = frame.to_local(ls.d);
+        if (il.z > 0.0 && ls.pdf > 0.0) {
+          const ShadingModel::Evaluation e = model.eval(o, il, true);
+          cast(ls.d, infinity, e.f * ls.radiance * (il.z * power_heuristic(ls.pdf, e.pdf) / ls.pdf));
+        }
       }
-      // BRDF sampling, weighted against the environment's.
+      // BRDF sampling, weighted against the map's light sampling.
       if (const auto i = model.sample_direction(o, u[2], u[3], u[4])) {
         const Environment::Sample at = env->lookup(frame.to_world(*i));  // its d: the world direction
         const ShadingModel::Evaluation e = model.eval(o, *i, true);
-        if (e.pdf > 0.0) cast(at.d, infinity, e.f * (i->z / e.pdf) * at.radiance * power_heuristic(e.pdf, at.pdf));
+        if (e.pdf > 0.0) cast(at.d, infinity, e.f * (i->z / e.pdf) * at.radiance * (light_sampled ? power_heuristic(e.pdf, at.pdf) : 1.0));
       }
     }
     for (const LightDesc& light : desc.lights) {
@@ -299,7 +302,7 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
           rays.clear(), values.clear();
           const Hit hit = tracer.intersect(ray);
           place(hit, ray.dir, planned);
-          plan(hit, u + 2, nullptr, textured, planned, rays, values);
+          plan(hit, u + 2, textured, planned, rays, values);
           for (std::size_t q = 0; q < rays.size(); ++q)
             if (!tracer.occluded(rays[q])) planned.radiance += values[q];
           double* acc = pixel_accum(x, y);
@@ -325,7 +328,6 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
     std::vector<char> blocked;
     Textured textured;
     std::vector<Wave> waves;
-    SphereSampleBatch light_samples;
     CameraSampleBatch samples;
     TileHits tile_hits;
     std::vector<char> present;  // per material: whether the lanes shade some hit of this sample index
@@ -338,9 +340,9 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
     std::vector<std::uint32_t> planned_pixels;
   };
   tbb::enumerable_thread_specific<TileSpace> tile_spaces;
-  // A constant environment's radiance and density in every direction (the lanes' environment light and
-  // BRDF samples take them); zero otherwise, where the lanes' BRDF samples look the map up.
-  const Environment::Sample constant_light = env && env->is_constant() ? env->lookup(Vec3(0.0, 0.0, 1.0)) : Environment::Sample{Vec3(0.0), Rgb(0.0), 0.0};
+  // A constant environment's radiance in every direction (the lanes' BRDF samples take it); zero otherwise,
+  // where the lanes' BRDF samples look the map up.
+  const Rgb constant_radiance = env && env->is_constant() ? env->radiance(Vec3(0.0, 0.0, 1.0)) : Rgb(0.0);
   // Every pixel of the tile at once, one sample index after the other: camera rays, shading, then shadow
   // rays, as streams (Embree's for triangles; coherent camera rays travel together) and evaluations in
   // batches.
@@ -372,9 +374,6 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
     std::fill_n(cameras.ox.begin(), padded, cam.position.x), std::fill_n(cameras.oy.begin(), padded, cam.position.y);
     std::fill_n(cameras.oz.begin(), padded, cam.position.z), std::fill_n(cameras.tnear.begin(), padded, 0.0);
     std::fill_n(cameras.tfar.begin(), padded, infinity);
-    // A constant environment's light samples, drawn in SIMD lanes for the whole tile.
-    const bool sphere_lanes = env && env->is_constant();
-    SphereSampleBatch& light_samples = space.light_samples;
     // At most two environment rays and one per light per sample: room for all from the start, so that the
     // first sample of a tile does not grow them piece by piece.
     const std::size_t most = n * (2 + desc.lights.size());
@@ -390,20 +389,12 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
       for (int c = 0; c < 4; ++c) sum[c][k] = acc[c];
     }
     tile_hits.resize_to(n);
-    // A constant environment's density and radiance, the same for every light sample of the tile.
-    tile_hits.uniform_light.reset();
-    if (sphere_lanes)
-      tile_hits.uniform_light = {constant_light.pdf, constant_light.radiance.r, constant_light.radiance.g, constant_light.radiance.b};
+    tile_hits.light_sampled = light_sampled;
     for (int s = first; s < last; ++s) {
       camera_sample_batch(camera, seed, s, samples);
       std::copy_n(samples.dx.begin(), padded, cameras.dx.begin()), std::copy_n(samples.dy.begin(), padded, cameras.dy.begin());
       std::copy_n(samples.dz.begin(), padded, cameras.dz.begin());
       tracer.intersect(cameras, hits, true);
-      if (sphere_lanes) {
-        light_samples.resize_to(n);
-        std::copy_n(samples.u[2].begin(), padded, light_samples.u1.begin()), std::copy_n(samples.u[3].begin(), padded, light_samples.u2.begin());
-        sample_uniform_sphere_batch(light_samples);
-      }
       rays.clear(), values.clear();
       // Each pixel's hit: shaded here one at a time where its material has no lanes, otherwise given to
       // the lanes in the tile's columns.
@@ -417,9 +408,8 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
         if (!hit.found() || !in_lanes[material]) {
           Planned& pk = planned[k];
           place(hit, samples.d(k), pk);
-          const Vec3 light_d = sphere_lanes ? light_samples.d(k) : Vec3(0.0);
           const double u[5] = {samples.u[2][k], samples.u[3][k], samples.u[4][k], samples.u[5][k], samples.u[6][k]};
-          plan(hit, u, sphere_lanes ? &light_d : nullptr, textured, pk, rays, values);
+          plan(hit, u, textured, pk, rays, values);
           alpha[k] = pk.alpha;
           planned_pixels.push_back(std::uint32_t(k));
           continue;
@@ -431,7 +421,7 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
         const bool sphere = object.kind == ObjectDesc::Kind::sphere;
         const Vec3 g = sphere ? object.center : hit.ng;
         tile_hits.sphere[k] = sphere ? 1.0 : 0.0, tile_hits.gx[k] = g.x, tile_hits.gy[k] = g.y, tile_hits.gz[k] = g.z;
-        if (env && !sphere_lanes) {
+        if (light_sampled) {
           const Environment::Sample ls = env->sample(samples.u[2][k], samples.u[3][k]);
           tile_hits.lx[k] = ls.d.x, tile_hits.ly[k] = ls.d.y, tile_hits.lz[k] = ls.d.z, tile_hits.light_pdf[k] = ls.pdf;
           tile_hits.light_r[k] = ls.radiance.r, tile_hits.light_g[k] = ls.radiance.g, tile_hits.light_b[k] = ls.radiance.b;
@@ -441,10 +431,6 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
       std::copy_n(samples.dz.begin(), padded, tile_hits.dz.begin());
       std::copy_n(samples.u[4].begin(), padded, tile_hits.u1.begin()), std::copy_n(samples.u[5].begin(), padded, tile_hits.u2.begin());
       std::copy_n(samples.u[6].begin(), padded, tile_hits.u3.begin());
-      if (sphere_lanes) {  // its directions, drawn in lanes above
-        std::copy_n(light_samples.x.begin(), padded, tile_hits.lx.begin()), std::copy_n(light_samples.y.begin(), padded, tile_hits.ly.begin());
-        std::copy_n(light_samples.z.begin(), padded, tile_hits.lz.begin());
-      }
       for (std::size_t m = 0; m < materials.size(); ++m) {
         if (present[m])
           place_hits(tile_hits, cam.position, eps, double(m), tangents[m] ? &*tangents[m] : nullptr, point_lights, waves[m].hits);
@@ -454,12 +440,12 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
       for (std::size_t m = 0; m < materials.size(); ++m) {
         Wave& w = waves[m];
         if (w.hits.size() == 0) continue;
-        light_slots(w.hits, bool(env), lane_lights, eps, w.shadows, w.ranges);
+        light_slots(w.hits, lane_lights, eps, w.shadows, w.ranges);
         if (env) {
           materials[m]->sample_directions(w.hits.draws, true);
           const std::size_t brdf_begin = w.shadows.size();
-          brdf_slots(w.hits, constant_light.radiance, eps, w.shadows);
-          if (!sphere_lanes)
+          brdf_slots(w.hits, constant_radiance, eps, w.shadows);
+          if (light_sampled)
             for (std::size_t e = brdf_begin; e < w.shadows.size(); ++e) {
               const Environment::Sample ls = env->lookup({w.shadows.rays.dx[e], w.shadows.rays.dy[e], w.shadows.rays.dz[e]});
               w.shadows.arriving_r[e] = ls.radiance.r, w.shadows.arriving_g[e] = ls.radiance.g, w.shadows.arriving_b[e] = ls.radiance.b;

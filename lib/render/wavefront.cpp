@@ -133,7 +133,7 @@ void PlaceHits(const TileHits& tile, const Vec3& camera, double eps, double mate
   out.clear();
   out.reserve(tile.size() + lanes);
   out.positions = positions;
-  out.uniform_light = tile.uniform_light;
+  out.light_sampled = tile.light_sampled;
   std::size_t size = 0;
   for (std::size_t k = 0; k < n; k += lanes) {
     const M mine = hn::And(real(d, k, tile.size()), load(d, tile.material, k) == this_material);
@@ -172,8 +172,8 @@ void PlaceHits(const TileHits& tile, const Vec3& camera, double eps, double mate
     put(d, o.x, out.draws.ox), put(d, o.y, out.draws.oy), put(d, o.z, out.draws.oz);
     if (positions) put(d, p.x, out.px), put(d, p.y, out.py), put(d, p.z, out.pz);
     put(d, p.x + epsilon * nrm.x, out.origin_x), put(d, p.y + epsilon * nrm.y, out.origin_y), put(d, p.z + epsilon * nrm.z, out.origin_z);
-    put(d, load(d, tile.lx, k), out.lx), put(d, load(d, tile.ly, k), out.ly), put(d, load(d, tile.lz, k), out.lz);
-    if (!tile.uniform_light) {
+    if (tile.light_sampled) {
+      put(d, load(d, tile.lx, k), out.lx), put(d, load(d, tile.ly, k), out.ly), put(d, load(d, tile.lz, k), out.lz);
       put(d, load(d, tile.light_pdf, k), out.light_pdf);
       put(d, load(d, tile.light_r, k), out.light_r), put(d, load(d, tile.light_g, k), out.light_g), put(d, load(d, tile.light_b, k), out.light_b);
     }
@@ -192,7 +192,7 @@ HWY_INLINE Vec3V origin_at(D d, const HitBatch& h, std::size_t k) {
   return {load(d, h.origin_x, k), load(d, h.origin_y, k), load(d, h.origin_z, k)};
 }
 
-void LightSlots(const HitBatch& hits, bool environment, const std::vector<LaneLight>& lights, double tnear, ShadowBatch& out,
+void LightSlots(const HitBatch& hits, const std::vector<LaneLight>& lights, double tnear, ShadowBatch& out,
                 SlotRanges& ranges) {
   const D d;
   const std::size_t n = hits.padded_size(), lanes = hn::Lanes(d);
@@ -201,18 +201,16 @@ void LightSlots(const HitBatch& hits, bool environment, const std::vector<LaneLi
   out.clear();
   out.reserve(n * (1 + lights.size()) + lanes);
   std::size_t size = 0;
-  if (environment) {
-    const std::array<double, 4>* uniform = hits.uniform_light ? &*hits.uniform_light : nullptr;
+  if (hits.light_sampled) {
     for (std::size_t k = 0; k < n; k += lanes) {
       const FrameV frame = frame_at(d, hits, k);
       const Vec3V o = view_at(d, hits, k);
       const Vec3V l{load(d, hits.lx, k), load(d, hits.ly, k), load(d, hits.lz, k)};
-      const auto light = [&](int c, const std::vector<double>& column) { return uniform ? hn::Set(d, (*uniform)[c]) : load(d, column, k); };
-      const V pdf = light(0, hits.light_pdf);
+      const V pdf = load(d, hits.light_pdf, k);
       const Vec3V il = frame.to_local(l);
       const M lit = hn::And(real(d, k, hits.size()), hn::And(o.z > zero, hn::And(il.z > zero, pdf > zero)));
       size += append(d, lit,
-                     {o, il, l, one, infinity, light(1, hits.light_r), light(2, hits.light_g), light(3, hits.light_b), pdf,
+                     {o, il, l, one, infinity, load(d, hits.light_r, k), load(d, hits.light_g, k), load(d, hits.light_b, k), pdf,
                       load(d, hits.owner, k)},
                      origin_at(d, hits, k), hn::Set(d, tnear), out, size);
     }
@@ -253,13 +251,13 @@ void BrdfSlots(const HitBatch& hits, const Rgb& radiance, double tnear, ShadowBa
   const V zero = hn::Zero(d), one = hn::Set(d, 1.0), infinity = hn::Set(d, std::numeric_limits<double>::infinity());
   std::size_t size = out.size();
   out.reserve(size + n + lanes);
-  const V r = hn::Set(d, radiance.r), g = hn::Set(d, radiance.g), b = hn::Set(d, radiance.b), pdf = hn::Set(d, 1.0 / (4.0 * kPi));
+  const V r = hn::Set(d, radiance.r), g = hn::Set(d, radiance.g), b = hn::Set(d, radiance.b);
   for (std::size_t k = 0; k < n; k += lanes) {
     const FrameV frame = frame_at(d, hits, k);
     const Vec3V o{load(d, samples.ox, k), load(d, samples.oy, k), load(d, samples.oz, k)};
     const Vec3V i{load(d, samples.ix, k), load(d, samples.iy, k), load(d, samples.iz, k)};
     const M found = hn::And(real(d, k, hits.size()), load(d, samples.found, k) != zero);
-    size += append(d, found, {o, i, frame.to_world(i), one, infinity, r, g, b, pdf, load(d, hits.owner, k)}, origin_at(d, hits, k),
+    size += append(d, found, {o, i, frame.to_world(i), one, infinity, r, g, b, zero, load(d, hits.owner, k)}, origin_at(d, hits, k),
                    hn::Set(d, tnear), out, size);
   }
   out.set_size(size);
@@ -275,14 +273,14 @@ void ShadowValues(ShadowBatch& batch, const SlotRanges& ranges) {
     const M env_light = index < hn::Set(d, double(ranges.lights_begin));
     const M brdf = index >= hn::Set(d, double(ranges.brdf_begin));
     const V pdf = load(d, batch.pdf, k), light_pdf = load(d, batch.light_pdf, k), cos_i = load(d, batch.iz, k);
-    // environment light: f L cos w(light, brdf) / p_light; BRDF sample: f cos / p_brdf L w(brdf, light);
-    // light: f E cos
+    // environment light: f L cos w(light, brdf) / p_light; BRDF sample: f cos / p_brdf L w(brdf, light),
+    // w = 1 where the environment has no light sample (light_pdf 0: a constant one); light: f E cos
     // The power heuristic w(a, b) = a^2 / (a^2 + b^2), both ways.
     const V light_pdf2 = light_pdf * light_pdf, pdf2 = pdf * pdf, sum = light_pdf2 + pdf2;
     const V env_factor = lanes::divide(d, cos_i * lanes::divide(d, light_pdf2, sum), hn::IfThenElse(env_light, light_pdf, one));
     const M has_density = pdf > zero;
     const V brdf_factor = lanes::divide(d, cos_i, hn::IfThenElse(has_density, pdf, one));
-    const V brdf_weight = lanes::divide(d, pdf2, sum);
+    const V brdf_weight = hn::IfThenElse(light_pdf > zero, lanes::divide(d, pdf2, hn::IfThenElse(light_pdf > zero, sum, one)), one);
     const V f[3] = {load(d, batch.r, k), load(d, batch.g, k), load(d, batch.b, k)};
     const V arriving[3] = {load(d, batch.arriving_r, k), load(d, batch.arriving_g, k), load(d, batch.arriving_b, k)};
     double* value[3] = {batch.value_r.data(), batch.value_g.data(), batch.value_b.data()};
@@ -310,11 +308,11 @@ void place_hits(const TileHits& tile, const Vec3& camera, double eps, double mat
   FACETFIT_DISPATCH(target, PlaceHits, tile, camera, eps, material, tangent, positions, out);
 }
 
-void light_slots(const HitBatch& hits, bool environment, const std::vector<LaneLight>& lights, double tnear, ShadowBatch& out,
-                 SlotRanges& ranges, SimdTarget target) {
+void light_slots(const HitBatch& hits, const std::vector<LaneLight>& lights, double tnear, ShadowBatch& out, SlotRanges& ranges,
+                 SimdTarget target) {
   for (const LaneLight& light : lights)
     if (!light.directional && !hits.positions) throw std::invalid_argument("light_slots: a point light needs the hits' positions");
-  FACETFIT_DISPATCH(target, LightSlots, hits, environment, lights, tnear, out, ranges);
+  FACETFIT_DISPATCH(target, LightSlots, hits, lights, tnear, out, ranges);
 }
 
 void brdf_slots(const HitBatch& hits, const Rgb& radiance, double tnear, ShadowBatch& out, SimdTarget target) {

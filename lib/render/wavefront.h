@@ -3,15 +3,13 @@
 // instead of one hit at a time. One hit at a time, making the requests, the BRDF samples' directions and the
 // shadow rays' values took half of a GGX sphere's render (docs/render-speed.md).
 //
-// Per hit the slots are, in this order: the environment's light sample, the BRDF sample (both with an
-// environment), then each light. A slot that lights nothing (below the horizon, no direction found) casts
+// Per hit the slots are, in this order: the environment's light sample (a map's; a constant environment
+// has none, render/renderer.cpp), the BRDF sample (with an environment), then each light. A slot that lights nothing (below the horizon, no direction found) casts
 // no ray. The renderer adds a hit's unblocked rays in slot order, as its one-ray-at-a-time path does.
 #pragma once
 
-#include <array>
 #include <cstddef>
 #include <cstdint>
-#include <optional>
 #include <vector>
 
 #include "render/shading_batch.h"
@@ -28,10 +26,9 @@ struct TileHits : Columns {
   std::vector<double> dx, dy, dz;
   std::vector<double> lx, ly, lz, light_pdf, light_r, light_g, light_b;
   std::vector<double> u1, u2, u3;
-  // The light sample's density and radiance (light_pdf, light_r, light_g, light_b) where the same for
-  // every entry (a constant environment's): then those columns are not read, and place_hits() passes the
-  // value on once instead of a column per hit.
-  std::optional<std::array<double, 4>> uniform_light;
+  // Whether the environment's light sample columns (lx ... light_b) hold one: a map's. Without, they are
+  // not read, and place_hits() does not pass them on.
+  bool light_sampled = false;
   // n pixels, whose columns the caller writes in place.
   void resize_to(std::size_t n) {
     ensure(n, [this](std::size_t m) {
@@ -55,8 +52,8 @@ struct HitBatch : Columns {
   std::vector<double> lx, ly, lz, light_pdf, light_r, light_g, light_b;
   std::vector<double> owner;  // exact in a double
   SampleBatch draws;          // as many entries as hits
-  // TileHits::uniform_light, passed on: where set, light_pdf, light_r, light_g and light_b are not written.
-  std::optional<std::array<double, 4>> uniform_light;
+  bool light_sampled = false;  // TileHits::light_sampled, passed on: without, lx ... light_b are not written
+
   // Room for n hits written in place by the lanes; size() stays.
   void reserve(std::size_t n) {
     ensure(n, [this](std::size_t m) {
@@ -67,7 +64,7 @@ struct HitBatch : Columns {
     draws.reserve(n);
   }
   void set_size(std::size_t n) { Columns::set_size(n), draws.resize_to(n); }
-  void clear() { Columns::clear(), draws.clear(), positions = false, uniform_light.reset(); }
+  void clear() { Columns::clear(), draws.clear(), positions = false, light_sampled = false; }
 };
 
 // Fills `out` with the tile's hits on material `material` (emptied first), as the renderer's one-hit path
@@ -116,19 +113,21 @@ struct SlotRanges {
   std::vector<std::size_t> light_begin;
 };
 
-// Appends to `out` (emptied first) the evaluations of the environment's light samples (`environment`) and of
-// the lights, for the hits' padded_size() entries, and the ranges.
+// Appends to `out` (emptied first) the evaluations of the environment's light samples (where the hits hold
+// them: light_sampled) and of the lights, for the hits' padded_size() entries, and the ranges.
 // The shadow rays start at the hits' origins and ignore what lies nearer than `tnear`.
-void light_slots(const HitBatch& hits, bool environment, const std::vector<LaneLight>& lights, double tnear, ShadowBatch& out,
-                 SlotRanges& ranges, SimdTarget target = SimdTarget::best);
+void light_slots(const HitBatch& hits, const std::vector<LaneLight>& lights, double tnear, ShadowBatch& out, SlotRanges& ranges,
+                 SimdTarget target = SimdTarget::best);
 
 // Appends the BRDF samples found (hits.draws, drawn) as evaluations with their world directions, arriving
-// `radiance` at density 1 / 4 pi: a constant environment's (the caller replaces both under a map).
+// `radiance` at environment density 0: a constant environment's, which no light sample weighs them
+// against (the caller replaces both under a map).
 void brdf_slots(const HitBatch& hits, const Rgb& radiance, double tnear, ShadowBatch& out, SimdTarget target = SimdTarget::best);
 
 // The value of each entry's shadow ray from its evaluation (ShadowBatch::r, g, b, pdf), as the one-hit
 // path computes it: multiple importance sampling by the power heuristic for the environment's light and
-// BRDF samples, a light's value times the cosine; casts 0 for a BRDF sample of zero density.
+// BRDF samples (a BRDF sample weighs 1 where its direction's environment density is 0), a light's value
+// times the cosine; casts 0 for a BRDF sample of zero density.
 void shadow_values(ShadowBatch& batch, const SlotRanges& ranges, SimdTarget target = SimdTarget::best);
 
 }  // namespace facetfit
