@@ -404,8 +404,14 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
       for (std::size_t k = 0; k < n; ++k) {
         const Hit& hit = hits[k];
         tile_hits.material[k] = -1.0;
-        const std::size_t material = hit.found() ? std::size_t(object_material[std::size_t(hit.object)]) : 0;
-        if (!hit.found() || !in_lanes[material]) {
+        if (!hit.found()) {  // the environment seen past everything, as place() has it
+          const Rgb background = !env ? Rgb(0.0) : light_sampled ? env->radiance(samples.d(k)) : constant_radiance;
+          for (int c = 0; c < 3; ++c) radiance[c][k] = background[c];
+          alpha[k] = 0.0;
+          continue;
+        }
+        const std::size_t material = std::size_t(object_material[std::size_t(hit.object)]);
+        if (!in_lanes[material]) {
           Planned& pk = planned[k];
           place(hit, samples.d(k), pk);
           const double u[5] = {samples.u[2][k], samples.u[3][k], samples.u[4][k], samples.u[5][k], samples.u[6][k]};
@@ -480,8 +486,12 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
         if (pk.ray_last > pk.ray_first) add_unblocked(blocked, values, pk.ray_first, pk.ray_last, pk.radiance);
         for (int c = 0; c < 3; ++c) radiance[c][k] = pk.radiance[c];
       }
-      for (std::size_t k = 0; k < n; ++k)
-        accumulate(sum[0][k], sum[1][k], sum[2][k], sum[3][k], Rgb(radiance[0][k], radiance[1][k], radiance[2][k]), alpha[k]);
+      // As accumulate(), in a form the compiler vectorizes: x - x is 0 for a finite x, NaN otherwise.
+      for (std::size_t k = 0; k < n; ++k) {
+        const double r = radiance[0][k], g = radiance[1][k], b = radiance[2][k];
+        const bool finite = (r - r) + (g - g) + (b - b) == 0.0;
+        sum[0][k] += finite ? r : 0.0, sum[1][k] += finite ? g : 0.0, sum[2][k] += finite ? b : 0.0, sum[3][k] += alpha[k];
+      }
     }
     for (std::size_t k = 0; k < n; ++k) {
       double* acc = pixel_accum(int(samples.x[k]), int(samples.y[k]));
