@@ -272,25 +272,25 @@ void ShadowValues(ShadowBatch& batch, const SlotRanges& ranges) {
     const V index = hn::Iota(d, double(k));
     const M env_light = index < hn::Set(d, double(ranges.lights_begin));
     const M brdf = index >= hn::Set(d, double(ranges.brdf_begin));
-    const V pdf = load(d, batch.pdf, k), light_pdf = load(d, batch.light_pdf, k), cos_i = load(d, batch.iz, k);
-    // environment light: f L cos w(light, brdf) / p_light; BRDF sample: f cos / p_brdf L w(brdf, light),
-    // w = 1 where the environment has no light sample (light_pdf 0: a constant one); light: f E cos
-    // The power heuristic w(a, b) = a^2 / (a^2 + b^2), both ways.
-    const V light_pdf2 = light_pdf * light_pdf, pdf2 = pdf * pdf, sum = light_pdf2 + pdf2;
-    const V env_factor = lanes::divide(d, cos_i * lanes::divide(d, light_pdf2, sum), hn::IfThenElse(env_light, light_pdf, one));
-    const M has_density = pdf > zero;
-    const V brdf_factor = lanes::divide(d, cos_i, hn::IfThenElse(has_density, pdf, one));
-    const V brdf_weight = hn::IfThenElse(light_pdf > zero, lanes::divide(d, pdf2, hn::IfThenElse(light_pdf > zero, sum, one)), one);
+    const V pdf = load(d, batch.pdf, k), cos_i = load(d, batch.iz, k);
+    // value = f x arriving x factor. A light: factor cos. The environment's light sample and the BRDF's,
+    // each weighted against the other by the power heuristic w(p, q) = p^2 / (p^2 + q^2), p its own
+    // density and q the other's: factor = cos w(p, q) / p = cos p / (p^2 + q^2), one division (a BRDF
+    // sample against q = 0, a constant environment's, weighs 1: cos / p). Where both densities are so
+    // small that p^2 + q^2 underflows, nothing.
+    V factor = cos_i;
+    const M weighted = hn::Or(env_light, brdf);
+    if (!hn::AllFalse(d, weighted)) {
+      const V light_pdf = load(d, batch.light_pdf, k), sum = light_pdf * light_pdf + pdf * pdf;
+      const M some = sum > zero;
+      const V mis = hn::IfThenElseZero(some, lanes::divide(d, cos_i * hn::IfThenElse(env_light, light_pdf, pdf), hn::IfThenElse(some, sum, one)));
+      factor = hn::IfThenElse(weighted, mis, cos_i);
+    }
+    double* value[3] = {batch.value_r.data(), batch.value_g.data(), batch.value_b.data()};
     const V f[3] = {load(d, batch.r, k), load(d, batch.g, k), load(d, batch.b, k)};
     const V arriving[3] = {load(d, batch.arriving_r, k), load(d, batch.arriving_g, k), load(d, batch.arriving_b, k)};
-    double* value[3] = {batch.value_r.data(), batch.value_g.data(), batch.value_b.data()};
-    for (int c = 0; c < 3; ++c) {
-      const V light_value = f[c] * arriving[c] * cos_i;
-      const V env_value = f[c] * arriving[c] * env_factor;
-      const V brdf_value = f[c] * brdf_factor * arriving[c] * brdf_weight;
-      hn::StoreU(hn::IfThenElse(env_light, env_value, hn::IfThenElse(brdf, brdf_value, light_value)), d, value[c] + k);
-    }
-    hn::StoreU(hn::IfThenElse(hn::AndNot(has_density, brdf), zero, one), d, batch.casts.data() + k);
+    for (int c = 0; c < 3; ++c) hn::StoreU(f[c] * arriving[c] * factor, d, value[c] + k);
+    hn::StoreU(hn::IfThenElse(hn::AndNot(pdf > zero, brdf), zero, one), d, batch.casts.data() + k);
   }
 }
 
