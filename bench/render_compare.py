@@ -282,7 +282,7 @@ def main(facetfit, mitsuba_python, dst, rgl=None):
     # its time is what the pipeline around any material's BRDF costs.
     floor = facetfit_run(facetfit, work, {"type": "lambert", "albedo": [0.8, 0.8, 0.8]}, 64, one_cpu)[0]
     stages.append(("both, with a Lambertian sphere instead (its sampling and evaluation next to free: what every material pays)", floor))
-    lut_one_cpu = facetfit_run(facetfit, work, cases[1][1], 64, one_cpu)[0]
+    lut_one_cpu = facetfit_run(facetfit, work, cases[1][1], 64, one_cpu)[0] if llvm else None  # against Mitsuba's LLVM time
     stages.append(("both (the scene above)", scaling[0][1]))
     # Noise at 64 spp, on the spheres both renderers render themselves (not the proxies).
     variant = "llvm_ad_rgb" if llvm else "scalar_rgb"

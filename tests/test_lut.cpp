@@ -338,6 +338,27 @@ TEST(Lut, BadFilesGetOneClearLine) {
     ASSERT_TRUE(out->open(dir.file("negative.exr"), spec) && out->write_image(OIIO::TypeDesc::FLOAT, px.data()) && out->close());
   }
   EXPECT_NE(error_of([&] { read_lut(dir.file("negative.exr")); }).find("column 0: D must be >= 0 and sigma > 0"), std::string::npos);
+  // A sampling row that is no CDF (falling, or not from 0 to 1): the samplers search it as running sums,
+  // the SIMD one from a guide built on that order, and would disagree.
+  for (const bool falls : {true, false}) {
+    auto in = OIIO::ImageInput::open(dir.file("good.exr"));
+    OIIO::ImageSpec spec = in->spec();
+    std::vector<float> px(std::size_t(spec.width) * std::size_t(spec.height) * std::size_t(spec.nchannels));
+    ASSERT_TRUE(in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, px.data()));
+    const auto at = [&](int row, int x) { return (std::size_t(row) * std::size_t(spec.width) + std::size_t(x)) * std::size_t(spec.nchannels); };
+    const int row = LutLayout::kSamplingRow + 5;
+    ASSERT_LT(px[at(row, 10)], px[at(row, 40)]);
+    if (falls) {
+      px[at(row, 11)] = px[at(row, 10)] * 0.5f;
+    } else {  // running to 0.5
+      for (int x = 0; x < spec.width; ++x) px[at(row, x)] *= 0.5f;
+    }
+    const std::string file = dir.file(falls ? "falling-cdf.exr" : "cdf-to-half.exr");
+    auto out = OIIO::ImageOutput::create(file);
+    ASSERT_TRUE(out->open(file, spec) && out->write_image(OIIO::TypeDesc::FLOAT, px.data()) && out->close());
+    const std::string e = error_of([&] { read_lut(file); });
+    EXPECT_NE(e.find(falls ? "row 8, column 11: the sampling CDF falls" : "row 8: the sampling CDF must run from 0 to 1"), std::string::npos) << e;
+  }
 }
 
 }  // namespace

@@ -266,8 +266,8 @@ TEST(Tracer, SpheresAndTrianglesTogether) {
   }
 }
 
-// Everything that makes shadow rays: an environment (light and BRDF samples: the sky's map, or a constant
-// one whose light samples the stream path draws in SIMD lanes), both kinds of light, a plane the spheres
+// Everything that makes shadow rays: an environment (the sky's map: light and BRDF samples; or a constant
+// one: BRDF samples alone), both kinds of light, a plane the spheres
 // shadow, and the proposals of every kind (closed-form GGX, tabulated Beckmann, a measured table, a LUT
 // whose frame follows a tangent).
 class RayStreams : public ::testing::TestWithParam<const char*> {};
@@ -455,22 +455,28 @@ TEST(Wavefront, HitsAndSlotsEqualTheOneHitPath) {
         // The values (the one-hit path's, render/renderer.cpp): an environment light sample f L cos w / p_light,
         // a light's f E cos, a BRDF sample f cos / p L w, w by the power heuristic, 1 against a density of 0
         // (a constant environment's, or a map's where it is black); none cast for a BRDF sample of density 0.
-        const auto heuristic = [](double a, double b) { return a * a / (a * a + b * b); };
+        // Densities so small that their squares underflow (1e-170) too, against 0 and against another.
         for (std::size_t q = 0; q < slots.size(); ++q) {
           slots.r[q] = 0.5 + 0.01 * double(q % 7), slots.g[q] = 0.2, slots.b[q] = 0.1;
-          slots.pdf[q] = q % 6 == 5 ? 0.0 : 0.3 + 0.1 * double(q % 5);
-          if (q >= ranges.brdf_begin && !constant) slots.light_pdf[q] = q % 4 == 0 ? 0.0 : 0.2;  // a map looked up
+          slots.pdf[q] = q % 6 == 5 ? 0.0 : q % 6 == 4 ? 1e-170 : 0.3 + 0.1 * double(q % 5);
+          if (q >= ranges.brdf_begin && !constant) slots.light_pdf[q] = q % 4 == 0 ? 0.0 : q % 4 == 1 ? 3e-170 : 0.2;  // a map looked up
         }
         shadow_values(slots, ranges, target);
         for (std::size_t q = 0; q < slots.size(); ++q) {
           const double f = slots.r[q], arriving = slots.arriving_r[q], cos_i = slots.iz[q], pdf = slots.pdf[q], light_pdf = slots.light_pdf[q];
           double want = f * arriving * cos_i;  // a light
-          if (q < ranges.lights_begin) want = f * arriving * cos_i * heuristic(light_pdf, pdf) / light_pdf;
+          // w(p, q) / p = p / (p^2 + q^2) in long double, whose exponent holds the squares of 1e-170.
+          const auto weight_over = [](long double own, long double other) { return double(own / (own * own + other * other)); };
+          if (q < ranges.lights_begin) want = f * arriving * cos_i * weight_over(light_pdf, pdf);
           if (q >= ranges.brdf_begin) {
             EXPECT_EQ(slots.casts[q], pdf > 0.0 ? 1.0 : 0.0) << where << " entry " << q;
             if (!(pdf > 0.0)) continue;
-            want = f * cos_i / pdf * arriving * (light_pdf > 0.0 ? heuristic(pdf, light_pdf) : 1.0);
+            want = f * cos_i * arriving * weight_over(pdf, light_pdf);
+            if (light_pdf == 0.0) {
+              EXPECT_TRUE(close(want, f * cos_i / pdf * arriving)) << where;  // weighs 1
+            }
           }
+          ASSERT_TRUE(std::isfinite(slots.value_r[q])) << where << " entry " << q;
           EXPECT_TRUE(close(slots.value_r[q], want)) << where << " entry " << q << ": " << slots.value_r[q] << " against " << want;
         }
       }
@@ -672,6 +678,15 @@ TEST(Shading, TabulatedInSimdLanesEqualsOnePairAtATime) {
           }
           eval_tabulated_batch(*model.tabulated_batch_model(), lanes, target), model.eval(reference, false);
           sample_tabulated_batch(*model.tabulated_batch_model(), drawn, target), model.sample_directions(one_by_one, false);
+          // Pairs that ask for f alone (a light's): the same f, and no density.
+          EvaluationBatch f_only;
+          for (std::size_t k = 0; k < n; ++k) f_only.push(lanes.o(k), lanes.i(k), false);
+          eval_tabulated_batch(*model.tabulated_batch_model(), f_only, target);
+          for (std::size_t k = 0; k < n; ++k) {
+            ASSERT_EQ(f_only.pdf[k], 0.0) << where << " pair " << k;
+            ASSERT_EQ(f_only.r[k], lanes.r[k]) << where << " pair " << k;
+            ASSERT_EQ(f_only.b[k], lanes.b[k]) << where << " pair " << k;
+          }
           for (std::size_t k = 0; k < n; ++k) {
             ASSERT_EQ(drawn.found[k], one_by_one.found[k]) << where << " sample " << k;
             if (!one_by_one.found[k]) continue;

@@ -226,9 +226,10 @@ TEST(GgxLanes, EveryBatchLengthAndDegenerateDirectionStayFiniteAndInBounds) {
 }
 
 TEST(TabulatedLanes, EveryBatchLengthAndDegenerateDirectionStayFiniteAndInBounds) {
-  // As above for a LUT's kernel (render/tabulated_batch.h), whose grid lookups gather: an index past a
+  // As above for a LUT's kernels (render/tabulated_batch.h), whose grid lookups gather: an index past a
   // table shows under the sanitizers. The NDF from a peak a node wide to a flat one, and all zero (no facet
-  // visible: sampling tables uniform, sigma zero).
+  // visible: sampling tables uniform, sigma zero). The sampler too, whose search of the running sums runs
+  // until every lane has closed its bracket: numbers at 0 and just below 1, the ends of the guide.
   const Vec3 degenerate[] = {{0, 0, 1}, {1, 0, 0}, {0, -1, 0}, {0.6, 0, 0.8}, {-0.6, 0, -0.8}, {0, 0, -1}, {1e-300, 0, 1}, {0.9999999, 0, 1e-12}};
   FresnelCurve curve;
   for (auto& v : curve.value) v = Rgb(0.5, 0.6, 0.7);
@@ -251,6 +252,15 @@ TEST(TabulatedLanes, EveryBatchLengthAndDegenerateDirectionStayFiniteAndInBounds
               EXPECT_EQ(e.pdf[k], 0.0);
             }
           }
+          const double ends[] = {0.0, std::nextafter(1.0, 0.0), 0.5, 1e-300, 0.015625};
+          SampleBatch s;
+          for (std::size_t k = 0; k < n; ++k) s.push(glm::normalize(degenerate[k % 8]), ends[k % 5], ends[(k * 3 + 1) % 5], ends[(k + 2) % 5]);
+          sample_tabulated_batch(*model.tabulated_batch_model(), s, target);
+          for (std::size_t k = 0; k < n; ++k)
+            if (s.found[k] != 0.0) {
+              EXPECT_GT(s.oz[k], 0.0);
+              for (const double v : {s.ix[k], s.iy[k], s.iz[k]}) ASSERT_TRUE(std::isfinite(v)) << "alpha " << alpha << " sample " << k;
+            }
         }
     }
 }

@@ -329,7 +329,9 @@ TEST(Tabulated, CdfGuideBracketsEveryDrawAndTheDensityIsMassOverBand) {
     for (int s = 0; s <= r; ++s) {
       const double* cdf = tables.cdf.data() + std::size_t(s) * (r + 1);
       for (int n = 0; n < 200; ++n) {
-        const double u = n < 2 ? double(n) / guide : uniform(rng);  // also a u on an entry itself
+        // Also a u on a guide entry, the last below 1, and one on a node's sum (inside a run of empty
+        // intervals where the peak leaves them).
+        const double u = n < 2 ? double(n) / guide : n == 2 ? std::nextafter(1.0, 0.0) : n == 3 ? cdf[r / 2] : n == 4 ? cdf[r - 1] : uniform(rng);
         const int node = int(std::upper_bound(cdf, cdf + r + 1, u) - cdf) - 1;
         const int g = std::min(int(u * guide), guide - 1);
         const std::int64_t* entry = model.cdf_guide().data() + std::size_t(s) * (guide + 1) + g;

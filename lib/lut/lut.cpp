@@ -395,8 +395,17 @@ Lut read_lut(const std::string& path) {
   if (m.sampling) {
     lut.sampling.resolution = m.resolution;
     lut.sampling.cdf.resize(std::size_t(nodes) * nodes);
-    for (int s = 0; s < nodes; ++s)
-      for (int x = 0; x < nodes; ++x) lut.sampling.cdf[std::size_t(s) * nodes + x] = get(LutLayout::kSamplingRow + s, x, 0);
+    for (int s = 0; s < nodes; ++s) {
+      double* row = lut.sampling.cdf.data() + std::size_t(s) * nodes;
+      for (int x = 0; x < nodes; ++x) row[x] = get(LutLayout::kSamplingRow + s, x, 0);
+      // The samplers search each row as running sums (sample_cdf, the lanes' guide): 0 to 1, never falling.
+      for (int x = 1; x < nodes; ++x)
+        if (!(row[x] >= row[x - 1]))
+          fail(path, "row " + std::to_string(LutLayout::kSamplingRow + s) + ", column " + std::to_string(x) +
+                         ": the sampling CDF falls (or is not a number)");
+      if (row[0] != 0.0 || row[nodes - 1] != 1.0)
+        fail(path, "row " + std::to_string(LutLayout::kSamplingRow + s) + ": the sampling CDF must run from 0 to 1");
+    }
   }
   if (m.anisotropic_phi_count > 0) {
     AnisotropicTables a;

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 #include "core/frame.h"
 #include "core/piecewise_constant.h"
@@ -63,6 +64,8 @@ TabulatedMicrofacet::TabulatedMicrofacet(MicrofacetTables tables, VisibleNormalT
   shared->sampling = std::move(sampling);
   for (int j = 0; j < shared->tables.ndf.grid.size(); ++j) shared->cos_nodes.push_back(std::cos(shared->tables.ndf.grid.theta(j)));
   shared->g1.emplace(shared->tables.ndf);
+  if (!shared->sampling.empty() && shared->sampling.resolution != shared->tables.ndf.grid.resolution)
+    throw std::invalid_argument("TabulatedMicrofacet: sampling tables of another resolution than the NDF's");
   if (!shared->sampling.empty()) {
     const int r = shared->sampling.resolution;
     for (int s = 0; s <= r; ++s) {

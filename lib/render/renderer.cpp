@@ -139,7 +139,8 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
   // sample and a BRDF sample (each weighted against the other by multiple importance sampling), then each
   // light. A constant environment is lit by the BRDF sample alone: a light sample, uniform over the sphere,
   // adds nothing the BRDF's proposal does not already draw better (every model's proposal holds the
-  // cosine, so the estimate stays unbiased), and weighted against it, it added noise (docs/render-speed.md). plan() makes them for one hit, evaluating one pair at a time: the one-ray path for every hit,
+  // cosine, so the estimate stays unbiased), and weighted against it, it added noise (docs/render-speed.md).
+  // plan() makes them for one hit, evaluating one pair at a time: the one-ray path for every hit,
   // the stream path for a lobe textured per hit and for models without SIMD lanes (queuing their work
   // would only add the queue's cost). The stream path makes the slots of a tile's other hits material by
   // material in SIMD lanes (render/wavefront.h).
@@ -336,7 +337,7 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
     // as on the one-ray path). Added in columns, not through Planned, so that the lanes' values land with
     // no branch and the sums run in SIMD (perf: a third of the tile loop's time was these additions).
     std::vector<double> radiance[3], alpha, sum[4];
-    // The pixels shaded by plan() (misses, models without lanes): their radiance is Planned's.
+    // The pixels shaded by plan() (models without lanes): their radiance is Planned's.
     std::vector<std::uint32_t> planned_pixels;
   };
   tbb::enumerable_thread_specific<TileSpace> tile_spaces;

@@ -1,6 +1,7 @@
 // The reference renderer: render/tracer.h for visibility, direct lighting from the environment (a map
-// with multiple importance sampling, a constant one by BRDF sampling) and the scene's lights, oneTBB over tiles, a fixed random sequence per
-// pixel (the same scene and settings give the same image on any number of threads).
+// with multiple importance sampling, a constant one by BRDF sampling) and the scene's lights, oneTBB over
+// tiles, a fixed random sequence per pixel (the same scene and settings give the same image on any number
+// of threads).
 #pragma once
 
 #include <cstdint>

@@ -2,7 +2,8 @@
 // render/ggx_batch.h does for GGX: ShadingModel's sample_direction and eval (f(o, i) and the sampling
 // density) with the model as BRDF and proposal, or as the proposal alone (its density), every term theirs
 // in the same order, so the two agree to rounding (tests/test_render.cpp). The arc cosines of the grid
-// lookups are Highway's; the azimuth's Newton steps take sines and cosines from a series of their own.
+// lookups are render/lanes-inl.h's (Highway's polynomial); the azimuth's Newton steps take sines and
+// cosines from a series of their own.
 #pragma once
 
 #include <cstdint>
@@ -44,7 +45,8 @@ struct TabulatedBatchModel {
   static std::optional<TabulatedBatchModel> of(const TabulatedMicrofacet& lobe, double lobe_weight);
 };
 
-// Fills the batch's r, g, b and pdf for its padded_size() pairs; zero where o or i is below the horizon.
+// Fills the batch's r, g, b and pdf for its padded_size() pairs; zero where o or i is below the horizon,
+// and pdf zero for a vector of pairs none of which asks for it (EvaluationBatch::with_pdf).
 // `target`: which SIMD code runs (render/simd_targets.h; the tests run each). Without `with_f`, pdf alone: the
 // density of a model the lobe only samples (a measured table's fitted LUT).
 void eval_tabulated_batch(const TabulatedBatchModel& model, EvaluationBatch& batch, SimdTarget target = SimdTarget::best, bool with_f = true);

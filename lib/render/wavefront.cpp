@@ -276,14 +276,21 @@ void ShadowValues(ShadowBatch& batch, const SlotRanges& ranges) {
     // value = f x arriving x factor. A light: factor cos. The environment's light sample and the BRDF's,
     // each weighted against the other by the power heuristic w(p, q) = p^2 / (p^2 + q^2), p its own
     // density and q the other's: factor = cos w(p, q) / p = cos p / (p^2 + q^2), one division (a BRDF
-    // sample against q = 0, a constant environment's, weighs 1: cos / p). Where both densities are so
-    // small that p^2 + q^2 underflows, nothing.
+    // sample against q = 0, a constant environment's, weighs 1: cos / p). Where p^2 + q^2 underflows
+    // (densities below 1e-154) and p > 0, cos / (p + q (q / p)), the same without the squares; where p is
+    // 0, nothing.
     V factor = cos_i;
     const M weighted = hn::Or(env_light, brdf);
     if (!hn::AllFalse(d, weighted)) {
       const V light_pdf = load(d, batch.light_pdf, k), sum = light_pdf * light_pdf + pdf * pdf;
-      const M some = sum > zero;
-      const V mis = hn::IfThenElseZero(some, lanes::divide(d, cos_i * hn::IfThenElse(env_light, light_pdf, pdf), hn::IfThenElse(some, sum, one)));
+      const V p = hn::IfThenElse(env_light, light_pdf, pdf), q = hn::IfThenElse(env_light, pdf, light_pdf);
+      const M some = sum >= hn::Set(d, std::numeric_limits<double>::min());  // not underflowed
+      V mis = hn::IfThenElseZero(some, lanes::divide(d, cos_i * p, hn::IfThenElse(some, sum, one)));
+      const M tiny = hn::AndNot(some, hn::And(weighted, p > zero));
+      if (HWY_UNLIKELY(!hn::AllFalse(d, tiny))) {
+        const V safe_p = hn::IfThenElse(tiny, p, one);
+        mis = hn::IfThenElse(tiny, cos_i / (safe_p + q * (q / safe_p)), mis);
+      }
       factor = hn::IfThenElse(weighted, mis, cos_i);
     }
     double* value[3] = {batch.value_r.data(), batch.value_g.data(), batch.value_b.data()};

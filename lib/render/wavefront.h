@@ -4,8 +4,8 @@
 // shadow rays' values took half of a GGX sphere's render (docs/render-speed.md).
 //
 // Per hit the slots are, in this order: the environment's light sample (a map's; a constant environment
-// has none, render/renderer.cpp), the BRDF sample (with an environment), then each light. A slot that lights nothing (below the horizon, no direction found) casts
-// no ray. The renderer adds a hit's unblocked rays in slot order, as its one-ray-at-a-time path does.
+// has none, render/renderer.cpp), the BRDF sample (with an environment), then each light. A slot that
+// lights nothing (below the horizon, no direction found) casts no ray. The renderer adds a hit's unblocked rays in slot order, as its one-ray-at-a-time path does.
 #pragma once
 
 #include <cstddef>
@@ -71,9 +71,10 @@ struct HitBatch : Columns {
 // places a hit: p = camera + t d; the normal from the sphere's centre or the triangle's, turned toward the
 // camera; the frame of core/frame.h about it (along `tangent` where given); o the direction toward the
 // camera in it; the shadow rays' origin p + eps n. p itself only with `positions` (point lights read it):
-// each column a hit carries costs its compaction, and skipping the 7 a scene does not read (p, and a
-// constant environment's light columns) took a Lambertian sphere's render from 243 to 234 ms on one CPU
-// (the mean of five alternated runs, within the machine's noise that day).
+// each column a hit carries costs its compaction, and skipping those a scene does not read (p; the light
+// sample's direction, density and radiance where the environment has none) took a Lambertian sphere's
+// render from 243 to 234 ms on one CPU (the mean of five alternated runs, within the machine's noise that
+// day).
 void place_hits(const TileHits& tile, const Vec3& camera, double eps, double material, const Vec3* tangent, bool positions,
                 HitBatch& out, SimdTarget target = SimdTarget::best);
 
@@ -87,7 +88,8 @@ struct LaneLight {
 
 // The evaluations the slots need (the EvaluationBatch a material's eval() fills) and, per evaluation, its
 // shadow ray (from the hit's shadow-ray origin along the world direction, up to the light), the radiance
-// arriving along it if nothing blocks it, the environment's density of the direction (0 for a light) and
+// arriving along it if nothing blocks it, the environment's density of the direction (0 for a light, and
+// for a BRDF sample under a constant environment, which has no light sample) and
 // the pixel it lights (its hit's owner). Afterwards value (r, g, b) and whether the slot casts a ray at
 // all.
 struct ShadowBatch : EvaluationBatch {
