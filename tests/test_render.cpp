@@ -983,6 +983,40 @@ TEST(Render, StretchedLutMaterials) {
             }).find("are for lut materials"), std::string::npos);
 }
 
+// A constant environment is lit by the BRDF sample alone, a map by a light sample and a BRDF sample
+// weighted by multiple importance sampling (render/renderer.cpp): two estimators of the same integral.
+// A map whose every pixel is the constant must then give the same sphere, to the noise, for every kind of
+// model: closed-form GGX, tabulated Beckmann, Lambert, a measured table under its fitted proposal, a LUT,
+// and a stretched LUT (shaded one pair at a time).
+TEST(Render, AConstantEnvironmentAndTheSameMapGiveTheSameSphere) {
+  test::TempDir dir;
+  write_gold_lut(dir.file("gold.exr"));
+  write_texture(dir.file("flat.exr"), 32, 16, [](int, int) { return Rgb(0.3, 0.25, 0.2); });
+  const std::string materials[] = {R"({"type": "ggx", "alpha": 0.2, "f0": [0.9, 0.6, 0.3]})", R"({"type": "beckmann", "alpha": 0.4, "f0": [0.8, 0.8, 0.8]})",
+                                   R"({"type": "lambert", "albedo": [0.7, 0.5, 0.3]})", R"({"type": "measured", "file": "builtin:red-plastic"})",
+                                   R"({"type": "lut", "file": "gold.exr"})", R"({"type": "lut", "file": "gold.exr", "stretch": [3, 0.5]})"};
+  double worst = 0.0;
+  for (const std::string& material : materials) {
+    const auto sphere = [&](const std::string& environment) {
+      const RenderedImage image = render(parse_scene_text(R"({"camera": {"position": [0, 0.6, 4], "look_at": [0, 0, 0], "fov": 30,
+        "width": 48, "height": 48}, "render": {"spp": 64, "seed": 5}, "environment": )" + environment + R"(,
+        "materials": {"m": )" + material + R"(}, "objects": [{"type": "sphere", "material": "m"}]})", "s.json", dir.path().string()));
+      double sum = 0.0;
+      int covered = 0;
+      for (std::size_t p = 0; p < image.rgba.size(); p += 4)
+        if (image.rgba[p + 3] > 0.999f) sum += double(image.rgba[p]) + image.rgba[p + 1] + image.rgba[p + 2], ++covered;
+      EXPECT_GT(covered, 600) << material;
+      return sum / covered;
+    };
+    const double by_brdf = sphere(R"({"constant": [0.3, 0.25, 0.2]})"), by_both = sphere(R"({"file": "flat.exr"})");
+    ASSERT_GT(by_both, 0.05) << material;
+    worst = std::max(worst, std::abs(by_brdf / by_both - 1.0));
+    // Each mean is over ~900 pixels of 64 samples: a few 1e-3 of noise; a lost or doubled weight is far more.
+    EXPECT_NEAR(by_brdf / by_both, 1.0, 0.01) << material << ": BRDF samples alone " << by_brdf << ", with light samples " << by_both;
+  }
+  std::printf("[ constant ] worst relative difference of the sphere's mean %.2e\n", worst);
+}
+
 TEST(Render, StretchTextureDrivesTheStretchPerPoint) {
   // A uniform texture (2, 0.5) times a stretch (1.5, 1) is the stretch (3, 0.5) everywhere: the same image,
   // sample for sample. A texture that varies changes the image where it departs from that value.
