@@ -64,10 +64,10 @@ TabulatedMicrofacet::TabulatedMicrofacet(MicrofacetTables tables, VisibleNormalT
   shared->sampling = std::move(sampling);
   for (int j = 0; j < shared->tables.ndf.grid.size(); ++j) shared->cos_nodes.push_back(std::cos(shared->tables.ndf.grid.theta(j)));
   shared->g1.emplace(shared->tables.ndf);
-  if (!shared->sampling.empty() && shared->sampling.resolution != shared->tables.ndf.grid.resolution)
-    throw std::invalid_argument("TabulatedMicrofacet: sampling tables of another resolution than the NDF's");
   if (!shared->sampling.empty()) {
     const int r = shared->sampling.resolution;
+    if (r != shared->tables.ndf.grid.resolution)
+      throw std::invalid_argument("TabulatedMicrofacet: sampling tables of another resolution than the NDF's");
     for (int s = 0; s <= r; ++s) {
       for (int j = 0; j < r; ++j) {
         const double band = shared->cos_nodes[std::size_t(j)] - shared->cos_nodes[std::size_t(j) + 1];

@@ -2,11 +2,12 @@
 //
 //   f(o, i) = f_body(o, i) + F(theta_d) D(h) G2(o, i) / (4 cos(theta_o) cos(theta_i)) + coat(o, i)
 //
-// with f_body Minnaert's body (model/body.h), D and sigma (hence G1 = cos / sigma) splines on the theta grid, F the RGB Fresnel curve and G2
-// the Smith model the fit was made with. sample() picks one of the three parts with probabilities set
-// by their albedos (lobe_weight() and the rest), then draws: for the lobe the distribution of visible
-// normals seen from o, D_o(h) = max(0, o.h) D(h) / sigma(o), reflecting o about h (docs/sampling.md);
-// for the body the cosine; for the coat its GGX visible normals. pdf() is the mixture's.
+// with f_body Minnaert's body (model/body.h), D and sigma (hence G1 = cos / sigma) splines on the theta
+// grid, F the RGB Fresnel curve and G2 the Smith model the fit was made with. sample() picks one of the
+// three parts with probabilities set by their albedos (lobe_weight() and the rest), then draws: for the
+// lobe the distribution of visible normals seen from o, D_o(h) = max(0, o.h) D(h) / sigma(o), reflecting o
+// about h (docs/sampling.md); for the body the cosine; for the coat its GGX visible normals. pdf() is the
+// mixture's.
 #pragma once
 
 #include <cstdint>

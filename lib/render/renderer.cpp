@@ -162,6 +162,11 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
   const double infinity = std::numeric_limits<double>::infinity();
   // Whether the environment gets a light sample per hit (a map), or the BRDF sample alone (constant).
   const bool light_sampled = env && !env->is_constant();
+  // A constant environment's radiance in every direction (the lanes' BRDF samples take it); zero otherwise,
+  // where the lanes' BRDF samples look the map up.
+  const Rgb constant_radiance = env && env->is_constant() ? env->radiance(Vec3(0.0, 0.0, 1.0)) : Rgb(0.0);
+  // The radiance of a ray that hits nothing.
+  const auto background = [&](const Vec3& dir) { return light_sampled ? env->radiance(dir) : constant_radiance; };
   // Per material: whether the stream path shades its hits in lanes.
   std::vector<char> in_lanes;
   for (std::size_t m = 0; m < materials.size(); ++m) in_lanes.push_back(materials[m]->has_lanes() && !stretch_textures[m]);
@@ -181,7 +186,7 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
     planned.alpha = 1.0;
     planned.ray_first = planned.ray_last = 0;
     if (!hit.found()) {
-      planned.radiance = env ? env->radiance(dir) : Rgb(0.0);
+      planned.radiance = background(dir);
       planned.alpha = 0.0;
       return;
     }
@@ -272,10 +277,11 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
     const std::uint64_t sequence = SampleSequence::start(seed, SampleSequence::pixel_key(x, y), s);
     for (int k = 0; k < kSampleNumbers; ++k) u[k] = SampleSequence::number(sequence, k);
   };
-  // A sample added to a pixel's sums (r, g, b, alpha): a radiance that is not finite adds nothing.
-  const auto accumulate = [](double& r, double& g, double& b, double& a, Rgb radiance, double alpha) {
-    if (!std::isfinite(radiance.r) || !std::isfinite(radiance.g) || !std::isfinite(radiance.b)) radiance = Rgb(0.0);
-    r += radiance.r, g += radiance.g, b += radiance.b, a += alpha;
+  // A sample added to a pixel's sums (r, g, b, alpha): a radiance that is not finite adds nothing. No
+  // branch (x - x is 0 for a finite x, NaN otherwise), so the tile's loop over its pixels vectorizes.
+  const auto accumulate = [](double& r, double& g, double& b, double& a, double sr, double sg, double sb, double alpha) {
+    const bool finite = (sr - sr) + (sg - sg) + (sb - sb) == 0.0;
+    r += finite ? sr : 0.0, g += finite ? sg : 0.0, b += finite ? sb : 0.0, a += alpha;
   };
 
   RenderedImage image;
@@ -307,7 +313,7 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
           for (std::size_t q = 0; q < rays.size(); ++q)
             if (!tracer.occluded(rays[q])) planned.radiance += values[q];
           double* acc = pixel_accum(x, y);
-          accumulate(acc[0], acc[1], acc[2], acc[3], planned.radiance, planned.alpha);
+          accumulate(acc[0], acc[1], acc[2], acc[3], planned.radiance.r, planned.radiance.g, planned.radiance.b, planned.alpha);
         }
   };
   // Per material shaded in lanes, a tile's hits for one sample index and their slots.
@@ -341,9 +347,6 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
     std::vector<std::uint32_t> planned_pixels;
   };
   tbb::enumerable_thread_specific<TileSpace> tile_spaces;
-  // A constant environment's radiance in every direction (the lanes' BRDF samples take it); zero otherwise,
-  // where the lanes' BRDF samples look the map up.
-  const Rgb constant_radiance = env && env->is_constant() ? env->radiance(Vec3(0.0, 0.0, 1.0)) : Rgb(0.0);
   // Every pixel of the tile at once, one sample index after the other: camera rays, shading, then shadow
   // rays, as streams (Embree's for triangles; coherent camera rays travel together) and evaluations in
   // batches.
@@ -406,8 +409,8 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
         const Hit& hit = hits[k];
         tile_hits.material[k] = -1.0;
         if (!hit.found()) {  // the environment seen past everything, as place() has it
-          const Rgb background = !env ? Rgb(0.0) : light_sampled ? env->radiance(samples.d(k)) : constant_radiance;
-          for (int c = 0; c < 3; ++c) radiance[c][k] = background[c];
+          const Rgb seen = background(samples.d(k));
+          for (int c = 0; c < 3; ++c) radiance[c][k] = seen[c];
           alpha[k] = 0.0;
           continue;
         }
@@ -487,12 +490,8 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
         if (pk.ray_last > pk.ray_first) add_unblocked(blocked, values, pk.ray_first, pk.ray_last, pk.radiance);
         for (int c = 0; c < 3; ++c) radiance[c][k] = pk.radiance[c];
       }
-      // As accumulate(), in a form the compiler vectorizes: x - x is 0 for a finite x, NaN otherwise.
-      for (std::size_t k = 0; k < n; ++k) {
-        const double r = radiance[0][k], g = radiance[1][k], b = radiance[2][k];
-        const bool finite = (r - r) + (g - g) + (b - b) == 0.0;
-        sum[0][k] += finite ? r : 0.0, sum[1][k] += finite ? g : 0.0, sum[2][k] += finite ? b : 0.0, sum[3][k] += alpha[k];
-      }
+      for (std::size_t k = 0; k < n; ++k)
+        accumulate(sum[0][k], sum[1][k], sum[2][k], sum[3][k], radiance[0][k], radiance[1][k], radiance[2][k], alpha[k]);
     }
     for (std::size_t k = 0; k < n; ++k) {
       double* acc = pixel_accum(int(samples.x[k]), int(samples.y[k]));
