@@ -24,6 +24,7 @@
 #include "lut/lut.h"
 #include "model/analytic.h"
 #include "model/tabulated.h"
+#include "model/visible_slopes.h"
 #include "model/tabulated_anisotropic.h"
 #include "render/renderer.h"
 #include "render/tracer.h"
@@ -339,6 +340,13 @@ void BM_VisibleNormalTables(benchmark::State& state) {
   for (auto _ : state) benchmark::DoNotOptimize(VisibleNormalTables::build(fit.ndf()));
 }
 BENCHMARK(BM_VisibleNormalTables)->ArgName("threads")->Arg(1)->Unit(benchmark::kMillisecond);
+
+void BM_VisibleSlopes(benchmark::State& state) {
+  const auto threads = limit_threads(state);
+  const FitResult fit = Fitter(FitOptions::paper()).fit(gold());
+  for (auto _ : state) benchmark::DoNotOptimize(VisibleSlopes(fit.ndf()));
+}
+BENCHMARK(BM_VisibleSlopes)->ArgName("threads")->Arg(1)->Unit(benchmark::kMillisecond);
 
 void BM_WriteLut(benchmark::State& state) {
   const Fitter fitter(FitOptions::paper());

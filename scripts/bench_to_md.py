@@ -26,6 +26,7 @@ NOTES = {
     "BM_Bake": "bake one MERL file with the default fit: SHA-256, read, fit, sampling tables, EXR, sidecar (hash overlapped with the read)",
     "BM_Sha256File": "SHA-256 of the 35 MB MERL file (OpenSSL; provenance in the LUT, bake cache key)",
     "BM_VisibleNormalTables": "the sampling tables of one material",
+    "BM_VisibleSlopes": "the renderer's visible-slope tables of one material (once per render)",
     "BM_WriteLut": "write one LUT EXR (float32, zip)",
     "BM_BakeBatch": "8 materials baked at once, as `bake --jobs` (the paper's method: the pipeline's overhead)",
 }

@@ -13,6 +13,7 @@
 #include "model/parametric.h"
 #include "model/proposal.h"
 #include "model/tabulated.h"
+#include "model/visible_slopes.h"
 #include "render/camera_batch.h"
 #include "render/ggx_batch.h"
 #include "render/merl_batch.h"
@@ -228,8 +229,8 @@ TEST(GgxLanes, EveryBatchLengthAndDegenerateDirectionStayFiniteAndInBounds) {
 TEST(TabulatedLanes, EveryBatchLengthAndDegenerateDirectionStayFiniteAndInBounds) {
   // As above for a LUT's kernels (render/tabulated_batch.h), whose grid lookups gather: an index past a
   // table shows under the sanitizers. The NDF from a peak a node wide to a flat one, and all zero (no facet
-  // visible: sampling tables uniform, sigma zero). The sampler too, whose search of the running sums runs
-  // until every lane has closed its bracket: numbers at 0 and just below 1, the ends of the guide.
+  // visible: the slopes' rows uniform, sigma zero). The sampler too, whose search of the running sums runs
+  // until every lane has closed its bracket: numbers at 0 and just below 1, on a guide entry.
   const Vec3 degenerate[] = {{0, 0, 1}, {1, 0, 0}, {0, -1, 0}, {0.6, 0, 0.8}, {-0.6, 0, -0.8}, {0, 0, -1}, {1e-300, 0, 1}, {0.9999999, 0, 1e-12}};
   FresnelCurve curve;
   for (auto& v : curve.value) v = Rgb(0.5, 0.6, 0.7);
@@ -239,7 +240,7 @@ TEST(TabulatedLanes, EveryBatchLengthAndDegenerateDirectionStayFiniteAndInBounds
       if (alpha == 0.0) std::fill(ndf.ndf.begin(), ndf.ndf.end(), 0.0), std::fill(ndf.sigma.begin(), ndf.sigma.end(), 0.0);
       const auto lobe = std::make_shared<TabulatedMicrofacet>(
           MicrofacetTables{ndf, Smith::correlated, curve, layered ? Rgb(0.2) : Rgb(0.0), layered ? Coat{0.005, 0.04} : Coat{}, layered ? 3.0 : 1.0});
-      const ShadingModel model(lobe, lobe);
+      const ShadingModel model(lobe, VisibleSlopeProposal::of(*lobe));
       ASSERT_TRUE(model.tabulated_batch_model());
       for (std::size_t n = 0; n <= 40; ++n)
         for (const SimdTarget target : kSimdTargets) {
@@ -252,7 +253,7 @@ TEST(TabulatedLanes, EveryBatchLengthAndDegenerateDirectionStayFiniteAndInBounds
               EXPECT_EQ(e.pdf[k], 0.0);
             }
           }
-          const double ends[] = {0.0, std::nextafter(1.0, 0.0), 0.5, 1e-300, 0.015625};
+          const double ends[] = {0.0, std::nextafter(1.0, 0.0), 0.5, 1e-300, 1.0 / VisibleSlopes::kGuide};
           SampleBatch s;
           for (std::size_t k = 0; k < n; ++k) s.push(glm::normalize(degenerate[k % 8]), ends[k % 5], ends[(k * 3 + 1) % 5], ends[(k + 2) % 5]);
           sample_tabulated_batch(*model.tabulated_batch_model(), s, target);

@@ -1,11 +1,14 @@
 // Piecewise-constant distributions, sampled by inverting their running sums: the one sampler behind the
-// environment map's pixels (2D) and the tabulated model's visible normals (one 1D distribution per view
-// slice). The RGL warp (io/rgl.cpp) is not one of them: the format defines a bilinear density, which
+// environment map's pixels (2D), the tabulated model's visible normals and the renderer's visible slopes
+// (1D rows, model/visible_slopes.h). Inverting keeps a draw continuous in u: two similar lobes draw similar
+// directions from the same numbers, so the noise of their renders largely cancels in a difference (the
+// report's). The RGL warp (io/rgl.cpp) is not one of them: the format defines a bilinear density, which
 // Mitsuba 3 inverts as such, and the parity with it needs that density.
 #pragma once
 
 #include <algorithm>
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 namespace facetfit {
@@ -18,6 +21,19 @@ inline int sample_cdf(const double* cdf, int n, double u, double* t) {
   const double m = cdf[k + 1] - cdf[k];
   *t = m > 0.0 ? std::clamp((u - cdf[k]) / m, 0.0, 1.0) : 0.5;
   return k;
+}
+
+// A guide to the running sums cdf[0..n], appended to `guide`: entry g (0..size) is the last cell k whose
+// sum cdf[k] is <= g / size (n at g = size). The cell a u in [g, g + 1) / size falls in lies between
+// entries g and g + 1, so the SIMD samplers search there rather than over the whole row; size is a power
+// of two, so u size is exact.
+inline void append_cdf_guide(const double* cdf, int n, int size, std::vector<std::int64_t>& guide) {
+  std::int64_t k = 0;
+  for (int g = 0; g <= size; ++g) {
+    const double u = double(g) / size;
+    while (k < n && cdf[k + 1] <= u) ++k;
+    guide.push_back(k);
+  }
 }
 
 // A density over [0, 1]^2 constant on an nx x ny grid of cells, proportional to given weights: rows are

@@ -73,12 +73,6 @@ TabulatedMicrofacet::TabulatedMicrofacet(MicrofacetTables tables, VisibleNormalT
         const double band = shared->cos_nodes[std::size_t(j)] - shared->cos_nodes[std::size_t(j) + 1];
         shared->visible_density.push_back(band > 0.0 ? shared->sampling.mass(s, j) / band : 0.0);
       }
-      std::int64_t node = 0;
-      for (int g = 0; g <= kCdfGuide; ++g) {
-        const double u = double(g) / kCdfGuide;
-        while (node < r && shared->sampling.cdf_at(s, int(node) + 1) <= u) ++node;
-        shared->cdf_guide.push_back(node);
-      }
     }
   }
   shared->parts = ProposalParts(shared->tables.fresnel.value[0], shared->tables.body, shared->tables.coat);

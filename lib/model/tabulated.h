@@ -10,7 +10,6 @@
 // mixture's.
 #pragma once
 
-#include <cstdint>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -83,21 +82,17 @@ class TabulatedMicrofacet final : public Brdf, public Proposal {
   double lobe_weight() const { return shared_->parts.lobe; }
   double body_weight() const { return shared_->parts.body; }
   double coat_weight() const { return shared_->parts.coat_weight(); }
+  const ProposalParts& parts() const { return shared_->parts; }
 
   const MicrofacetTables& tables() const { return shared_->tables; }
   const VisibleNormalTables& sampling() const { return shared_->sampling; }
   const Stretch& stretch() const { return stretch_; }
-  // What SIMD kernels read (render/tabulated_batch.h): cos(theta_j) at the grid's nodes, and G1's table.
+  // cos(theta_j) at the grid's nodes, and G1's table (which the SIMD kernels read, render/tabulated_batch.h).
   const std::vector<double>& cos_nodes() const { return shared_->cos_nodes; }
   const G1Table& g1_table() const { return *shared_->g1; }
   // The visible normals' density per unit cos(theta_h) in interval j of view slice s, mass(s, j) /
-  // (cos_j - cos_{j+1}) (0 for an empty band), at s R + j; empty without sampling tables.
+  // (cos_j - cos_{j+1}) (0 for an empty band), at s R + j, which pdf() reads; empty without sampling tables.
   const std::vector<double>& visible_density() const { return shared_->visible_density; }
-  // A guide to the running sums: at s (kCdfGuide + 1) + g, the last node of slice s whose sum is <= g /
-  // kCdfGuide. The node a u in [g, g + 1) / kCdfGuide draws lies between entries g and g + 1, so a search
-  // starts there instead of over the whole slice. kCdfGuide is a power of two: u kCdfGuide is exact.
-  static constexpr int kCdfGuide = 64;
-  const std::vector<std::int64_t>& cdf_guide() const { return shared_->cdf_guide; }
   bool can_sample() const override { return !shared_->sampling.empty(); }
 
   // The same lobe under another stretch: shares the tables, so it is cheap enough to make per shading
@@ -112,7 +107,6 @@ class TabulatedMicrofacet final : public Brdf, public Proposal {
     std::vector<double> cos_nodes;  // cos(theta_j)
     std::optional<G1Table> g1;      // G1 without an arc cosine and a spline per call
     std::vector<double> visible_density;
-    std::vector<std::int64_t> cdf_guide;
     ProposalParts parts;
   };
   std::shared_ptr<const Shared> shared_;

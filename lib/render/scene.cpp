@@ -19,6 +19,7 @@
 #include "model/builtin.h"
 #include "model/parametric.h"
 #include "model/rotated.h"
+#include "model/visible_slopes.h"
 
 namespace facetfit {
 
@@ -358,17 +359,11 @@ std::shared_ptr<const TabulatedMicrofacet> sampled_lut_model(Lut lut) {
   return std::make_shared<TabulatedMicrofacet>(std::move(lut.tables), std::move(lut.sampling));
 }
 
-// A parametric lobe's proposal, tabulated (model/tabulated.h): the isotropic `ndf` with a flat Fresnel of
-// f0, the body and the coat, so its draws are weighted by f0 and the body.
-std::shared_ptr<const TabulatedMicrofacet> tabulated_proposal(const Ndf& ndf, Smith smith, const Rgb& f0, const Rgb& body = Rgb(0.0),
-                                                              const Coat& coat = {}) {
-  MicrofacetTables tables;
-  tables.smith = smith;
-  tables.ndf = tabulate_ndf(ndf);
-  std::fill(tables.fresnel.value.begin(), tables.fresnel.value.end(), f0);
-  tables.body = body;
-  tables.coat = coat;
-  return std::make_shared<TabulatedMicrofacet>(tables);
+// A parametric lobe's proposal, tabulated: the visible slopes (model/visible_slopes.h) of the isotropic
+// `ndf` on the grid, with the parts of a flat Fresnel of f0, the body and the coat, so its draws are
+// weighted by f0 and the body.
+std::shared_ptr<const Proposal> tabulated_proposal(const Ndf& ndf, const Rgb& f0, const Rgb& body = Rgb(0.0), const Coat& coat = {}) {
+  return std::make_shared<VisibleSlopeProposal>(tabulate_ndf(ndf), ProposalParts(f0, body, coat));
 }
 
 }  // namespace
@@ -384,7 +379,7 @@ std::shared_ptr<const ShadingModel> lut_parametric_model(const Lut& lut, const s
     const auto lobe = std::make_shared<ParametricBrdf>(Ndf{NdfType::ggx, g.alpha.alpha_x, g.alpha.alpha_y}, smith, g.f0, g.f82, g.body);
     return std::make_shared<ShadingModel>(
         std::make_shared<RotatedBrdf>(lobe, g.alpha.angle),
-        tabulated_proposal(Ndf::isotropic(NdfType::ggx, std::sqrt(g.alpha.alpha_x * g.alpha.alpha_y)), smith, g.f0, g.body));
+        tabulated_proposal(Ndf::isotropic(NdfType::ggx, std::sqrt(g.alpha.alpha_x * g.alpha.alpha_y)), g.f0, g.body));
   }
   // The LUT's fit of this family on the whole measurement: its alpha, body and coat, with its own F82-tint
   // (lsq: Schlick) Fresnel or the tabulated curve.
@@ -395,7 +390,7 @@ std::shared_ptr<const ShadingModel> lut_parametric_model(const Lut& lut, const s
   // Tabulated even for GGX: the report compares this render with the measured material's and the LUT's,
   // whose proposals are tabulated too, so the same random numbers give nearly the same directions and
   // most of the noise cancels in their difference (at the report's 32 spp, and at 4 spp in its test).
-  return std::make_shared<ShadingModel>(brdf, tabulated_proposal(ndf, smith, p->f0, p->body, p->coat));
+  return std::make_shared<ShadingModel>(brdf, tabulated_proposal(ndf, p->f0, p->body, p->coat));
 }
 
 std::shared_ptr<const ShadingModel> load_material(const SceneDesc& scene, const MaterialDesc& m) {
@@ -404,9 +399,9 @@ std::shared_ptr<const ShadingModel> load_material(const SceneDesc& scene, const 
     const std::string name = is_builtin(m.file) ? source_name(m.file) : m.file;
     const auto builtin = find_builtin(name);
     if (!builtin) fail(m.file, "analytic materials are built-ins (builtin:NAME)");
-    std::shared_ptr<const TabulatedMicrofacet> proposal;  // tabulated, as lut_parametric_model says why
+    std::shared_ptr<const Proposal> proposal;  // tabulated, as lut_parametric_model says why
     if (const auto* mf = dynamic_cast<const MicrofacetBrdf*>(builtin->brdf.get()))
-      proposal = std::make_shared<TabulatedMicrofacet>(MicrofacetTables{tabulate_ndf(mf->ndf()), mf->smith(), {}, {}, {}});
+      proposal = std::make_shared<VisibleSlopeProposal>(tabulate_ndf(mf->ndf()), ProposalParts{});
     return std::make_shared<ShadingModel>(builtin->brdf, proposal);
   }
   if (m.type == "measured") {
@@ -421,12 +416,14 @@ std::shared_ptr<const ShadingModel> load_material(const SceneDesc& scene, const 
     const bool utia = dynamic_cast<const UtiaBrdf*>(measurement.get()) != nullptr;
     std::shared_ptr<const MerlTable> table = std::dynamic_pointer_cast<const MerlTable>(measurement);
     if (!table && (!(rgl || utia) || m.proposal.empty())) table = std::make_shared<MerlTable>(table_of(*measurement));
-    std::shared_ptr<const TabulatedMicrofacet> proposal;
+    std::shared_ptr<const Proposal> proposal;
     if (!m.proposal.empty()) {
-      proposal = sampled_lut_model(read_lut(resolve(scene, m.proposal)));
+      const Lut lut = read_lut(resolve(scene, m.proposal));
+      const MicrofacetTables& t = lut.tables;
+      proposal = std::make_shared<VisibleSlopeProposal>(t.ndf, ProposalParts(t.fresnel.value[0], t.body, t.coat));
     } else {
       const FitResult fit = Fitter{FitOptions::paper()}.fit(*table);
-      if (fit.ok()) proposal = std::make_shared<TabulatedMicrofacet>(MicrofacetTables{fit.ndf(), fit.smith, fit.fresnel(), {}, {}});
+      if (fit.ok()) proposal = std::make_shared<VisibleSlopeProposal>(fit.ndf(), ProposalParts(fit.fresnel().value[0], Rgb(0.0), Coat{}));
     }
     // RGL files render through their own evaluation (the renderer's o is the viewer's side), not the
     // MERL-layout table: with view slices this is Mitsuba's `measured` (tests/test_mitsuba.cpp).
@@ -446,9 +443,13 @@ std::shared_ptr<const ShadingModel> load_material(const SceneDesc& scene, const 
       const auto lobe = std::make_shared<TabulatedAnisotropic>(std::move(*lut.anisotropic), m.stretch);
       return std::make_shared<ShadingModel>(lobe, lobe);
     }
-    std::shared_ptr<const TabulatedMicrofacet> model = sampled_lut_model(std::move(lut));
-    if (!m.stretch.identity()) model = std::make_shared<TabulatedMicrofacet>(model->stretched(m.stretch));
-    return std::make_shared<ShadingModel>(model, model);
+    if (!m.stretch.identity()) {  // a stretch reshapes the lobe, not the slopes' tables: its own visible normals
+      const auto model = std::make_shared<TabulatedMicrofacet>(sampled_lut_model(std::move(lut))->stretched(m.stretch));
+      return std::make_shared<ShadingModel>(model, model);
+    }
+    // Its own sampling tables too: a stretch_texture stretches it per point (render/renderer.cpp).
+    const auto model = sampled_lut_model(std::move(lut));
+    return std::make_shared<ShadingModel>(model, VisibleSlopeProposal::of(*model));
   }
   // ggx | beckmann | lsq (the LUT's classical baseline: Lambert + GGX + Schlick); nothing else renders as them
   if (m.type != "ggx" && m.type != "beckmann" && m.type != "lsq")
@@ -459,7 +460,7 @@ std::shared_ptr<const ShadingModel> load_material(const SceneDesc& scene, const 
   // Beckmann's tabulated.
   const auto brdf = std::make_shared<ParametricBrdf>(ndf, m.smith, m.f0, m.f82);
   if (ndf.type == NdfType::ggx) return std::make_shared<ShadingModel>(brdf, std::make_shared<GgxProposal>(m.alpha, m.f0, Rgb(0.0), Coat{}));
-  return std::make_shared<ShadingModel>(brdf, tabulated_proposal(ndf, m.smith, m.f0));
+  return std::make_shared<ShadingModel>(brdf, tabulated_proposal(ndf, m.f0));
 }
 
 }  // namespace facetfit

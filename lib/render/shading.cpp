@@ -7,6 +7,7 @@
 #include "model/ndf.h"
 #include "model/parametric.h"
 #include "model/tabulated.h"
+#include "model/visible_slopes.h"
 
 namespace facetfit {
 
@@ -29,12 +30,13 @@ ShadingModel::ShadingModel(std::shared_ptr<const Brdf> brdf, std::shared_ptr<con
     const ProposalParts& parts = ggx->parts();
     m.weights = {lobe_weight_, parts.lobe, parts.body, parts.coat.present() ? parts.coat_weight() : 0.0};
   }
-  // A tabulated proposal: a LUT sampled by itself, or the fitted LUT of a measured table (or the tabulated
-  // NDF of a Beckmann lobe), whose f the lanes do not hold.
-  const auto* tabulated = dynamic_cast<const TabulatedMicrofacet*>(proposal_.get());
-  if (!batch_model_ && tabulated && lobe_weight_ > 0.0) {
-    tabulated_batch_model_ = TabulatedBatchModel::of(*tabulated, lobe_weight_);
-    tabulated_f_ = brdf_.get() == static_cast<const Brdf*>(tabulated);
+  // A tabulated lobe's visible slopes (model/visible_slopes.h): a LUT's own, or those of a measured
+  // table's fitted LUT (or of a Beckmann lobe's tabulated NDF), with f in the lanes where the BRDF is the
+  // LUT itself (a MERL-layout table's f in its own lanes).
+  const auto* slopes = dynamic_cast<const VisibleSlopeProposal*>(proposal_.get());
+  if (!batch_model_ && slopes && lobe_weight_ > 0.0) {
+    tabulated_batch_model_ = TabulatedBatchModel::of(*slopes, dynamic_cast<const TabulatedMicrofacet*>(brdf_.get()), lobe_weight_);
+    tabulated_f_ = tabulated_batch_model_->f;
     if (const auto* table = dynamic_cast<const MerlTable*>(brdf_.get())) merl_batch_model_ = MerlBatchModel::of(*table);
   }
   // The Lambert lanes hold Lambert's law alone, not Minnaert's.

@@ -4,6 +4,9 @@
 // a microfacet proposal (model/proposal.h: the fitted LUT for a measured material, the material itself
 // for a LUT, GGX's in closed form, Beckmann's NDF tabulated on the grid), mixed with cosine sampling so
 // that whatever a single lobe does not explain (diffuse reflection) is still found. pdf() is that mixture.
+// A tabulated lobe proposes through its visible slopes (model/visible_slopes.h: tables, no root to
+// find), which the scene gives as a VisibleSlopeProposal; a stretched one (a roughness texture) through
+// its own visible normals.
 #pragma once
 
 #include <memory>
@@ -41,8 +44,8 @@ class ShadingModel {
   // a lookup of its own, which a light's direction does not need.
   Evaluation eval(const Vec3& o, const Vec3& i, bool with_pdf) const { return with_pdf ? eval(o, i) : Evaluation{f(o, i), 0.0}; }
   // eval() of every pair of the batch: in SIMD lanes for a GGX lobe (render/ggx_batch.h) or a tabulated
-  // proposal (render/tabulated_batch.h: the density, and f where the BRDF is the lobe itself; a MERL-layout
-  // table's f in render/merl_batch.h) unless `simd` is false, one pair at a time otherwise (the reference
+  // lobe's visible slopes (render/tabulated_batch.h: the density, and f where the BRDF is the lobe itself;
+  // a MERL-layout table's f in render/merl_batch.h) unless `simd` is false, one pair at a time otherwise (the reference
   // the lanes are tested against).
   void eval(EvaluationBatch& batch, bool simd = true) const;
   // The lanes' model, where this one runs in them (tests call render/ggx_batch.h with it).
@@ -73,7 +76,8 @@ class ShadingModel {
   const ParametricBrdf* ggx_brdf_ = nullptr;
   const GgxProposal* ggx_proposal_ = nullptr;
   std::optional<GgxBatchModel> batch_model_;  // the same lobe for eval(EvaluationBatch&)
-  // A tabulated proposal's lanes: its draws and density, and f too where the BRDF is the lobe itself.
+  // A tabulated lobe's visible slopes in lanes: their draws and density, and f too where the BRDF is the
+  // lobe itself.
   std::optional<TabulatedBatchModel> tabulated_batch_model_;
   bool tabulated_f_ = false;
   std::optional<MerlBatchModel> merl_batch_model_;  // f of a MERL-layout table under a tabulated proposal

@@ -9,7 +9,7 @@
 #include <hwy/contrib/math/math-inl.h>
 
 #include "model/tabulated.h"
-#include "model/visible_azimuth.h"
+#include "model/visible_slopes.h"
 #include "render/lanes-inl.h"
 #include "render/tabulated_batch.h"
 
@@ -73,127 +73,88 @@ V g1(D d, const TabulatedBatchModel& model, V c) {
   return hn::IfThenElseZero(c > zero, hn::Min(one, cz * ratio));
 }
 
-// 2 integral over phi of max(0, a cos(phi) + b), a, b >= 0 (positive_phi_integral).
-V positive_phi_integral(D d, V a, V b) {
-  const auto whole = a <= b;
-  const V safe_a = hn::IfThenElse(whole, hn::Set(d, 1.0), a);
-  const V ratio = hn::Max(lanes::divide(d, hn::Neg(b), safe_a), hn::Set(d, -1.0));
-  const V part = hn::Set(d, 2.0) * (hn::Sqrt(hn::Max(hn::Zero(d), a * a - b * b)) + b * lanes::acos(d, ratio));
-  return hn::IfThenElse(whole, hn::Set(d, 2.0 * kPi) * b, part);
-}
-
-// AzimuthGuess::operator() (model/visible_azimuth.h) on `values`, its table; lanes where a + b = 0 read
-// any node. s = a / (a + b) by the lanes' division (a few ulp from the one-pair path's): only the start
-// of Newton's steps, not their root.
-V azimuth_guess(D d, const double* values, V a, V b, V u, V phi_max) {
+// The cell k of the running sums cdf[row + 0..n] in which u in [0, 1) falls (the last whose sum is <= u:
+// sample_cdf, so cells without mass are never chosen), by bisection between the entries of the row's
+// guide (append_cdf_guide, at guide_row) around u, and u's fraction in it.
+struct CellDraw {
+  I k;
+  V t;
+};
+HWY_INLINE CellDraw draw_cell(D d, const double* cdf, const std::int64_t* guide, I row, I guide_row, int n, V u) {
   const DI di;
-  constexpr int n = AzimuthGuess::kSize;
-  const V sum = a + b;
-  // s clamped as AzimuthGuess does: lanes the caller discards (a view below the horizon: b < 0) would
-  // otherwise extrapolate far outside [0, phi_max] and hold the vector's Newton loop for ~25 bisections.
-  const V zero = hn::Zero(d), one = hn::Set(d, 1.0);
-  const V s = lanes::divide(d, a, hn::IfThenElse(sum > zero, sum, one));
-  const V x = hn::Min(hn::Max(s, zero), one) * hn::Set(d, double(n));
-  const V y = hn::Min(hn::Max(u, zero), one) * hn::Set(d, double(n));
-  const I i = hn::Min(hn::ConvertTo(di, x), hn::Set(di, n - 1)), j = hn::Min(hn::ConvertTo(di, y), hn::Set(di, n - 1));
-  const V t = x - hn::ConvertTo(d, i), w = y - hn::ConvertTo(d, j);
-  const I next_row = hn::Set(di, AzimuthGuess::kStride), at = i * next_row + j, next = hn::Set(di, 1);
-  const V v00 = hn::GatherIndex(d, values, at), v01 = hn::GatherIndex(d, values, at + next);
-  const V v10 = hn::GatherIndex(d, values, at + next_row), v11 = hn::GatherIndex(d, values, at + next_row + next);
-  const V near = v00 + w * (v01 - v00), far = v10 + w * (v11 - v10);
-  return (near + t * (far - near)) * phi_max;
+  constexpr int entries = VisibleSlopes::kGuide;
+  const I at = guide_row + hn::Min(hn::ConvertTo(di, u * hn::Set(d, double(entries))), hn::Set(di, entries - 1));
+  I k = hn::GatherIndex(di, guide, at), top = hn::GatherIndex(di, guide, at + hn::Set(di, 1));
+  // The sum at cell k is <= u; the last such cell is at most `top`.
+  for (auto open = top > k; !hn::AllFalse(di, open); open = top > k) {
+    const I probe = hn::ShiftRight<1>(k + top + hn::Set(di, 1));
+    const auto take = hn::RebindMask(di, hn::GatherIndex(d, cdf, row + probe) <= u);
+    k = hn::IfThenElse(take, probe, k), top = hn::IfThenElse(take, top, probe - hn::Set(di, 1));
+  }
+  k = hn::Min(k, hn::Set(di, n - 1));
+  const V c0 = hn::GatherIndex(d, cdf, row + k), c1 = hn::GatherIndex(d, cdf, row + k + hn::Set(di, 1));
+  const V zero = hn::Zero(d), one = hn::Set(d, 1.0), mass = c1 - c0;
+  const auto some = mass > zero;
+  const V t = hn::IfThenElse(some, hn::Min(hn::Max(lanes::divide(d, u - c0, hn::IfThenElse(some, mass, one)), zero), one), hn::Set(d, 0.5));
+  return {k, t};
 }
 
-// phi in (-pi, pi] with density proportional to max(0, a cos(phi) + b), a, b >= 0, from u in [0, 1), as
-// (cos phi, sin phi): sample_visible_azimuth of model/visible_azimuth.h, its Newton steps on the CDF
-// a sin(phi) + b phi from the table's guess in every lane until each has stopped (2 steps for most, at
-// most 40).
-lanes::CosSin sample_phi(D d, const double* guess, V a, V b, V u) {
-  const V zero = hn::Zero(d), one = hn::Set(d, 1.0), two = hn::Set(d, 2.0), half = hn::Set(d, 0.5), pi = hn::Set(d, kPi);
-  const auto whole = a <= b;
-  const V ratio = hn::Min(hn::Max(lanes::divide(d, hn::Neg(b), hn::IfThenElse(whole, one, a)), hn::Set(d, -1.0)), one);
-  const V phi_max = hn::IfThenElse(whole, pi, lanes::acos(d, ratio));
-  const auto lower = u < half;
-  const V sign = hn::IfThenElse(lower, hn::Set(d, -1.0), one);
-  u = hn::IfThenElse(lower, two * u, two * u - one);
-  // sin(phi_max) = sqrt(1 - ratio^2) where a > b, 0 where a <= b.
-  const V total = hn::IfThenElseZero(hn::Not(whole), a * hn::Sqrt(hn::Max(zero, one - ratio * ratio))) + b * phi_max;
-  const auto flat = hn::Not(total > zero);
-  const V target = u * total;
-  V lo = zero, hi = phi_max, phi = azimuth_guess(d, guess, a, b, u, phi_max), c = one, s = zero;
-  auto active = hn::Not(flat);
-  for (int it = 0; it < 40 && !hn::AllFalse(d, active); ++it) {
-    const lanes::CosSin at = lanes::cos_sin(d, phi);
-    const V sin_phi = at.s, cos_phi = at.c;
-    const V f = a * sin_phi + b * phi - target;
-    const auto beyond = f > zero;
-    hi = hn::IfThenElse(beyond, phi, hi), lo = hn::IfThenElse(beyond, lo, phi);
-    const V df = a * cos_phi + b, mid = half * (lo + hi);
-    V next = hn::IfThenElse(df > zero, phi - lanes::divide(d, f, hn::IfThenElse(df > zero, df, one)), mid);
-    next = hn::IfThenElse(hn::And(next >= lo, next <= hi), next, mid);
-    const V step = next - phi;
-    // Stopped: the rotation by the last step to first order.
-    const auto stops = hn::And(active, hn::Abs(step) < hn::Set(d, 1e-7));
-    c = hn::IfThenElse(stops, cos_phi - sin_phi * step, c), s = hn::IfThenElse(stops, sin_phi + cos_phi * step, s);
-    active = hn::AndNot(stops, active);
-    phi = hn::IfThenElse(active, next, phi);
-  }
-  if (!hn::AllFalse(d, active)) {
-    const lanes::CosSin at = lanes::cos_sin(d, phi);
-    c = hn::IfThenElse(active, at.c, c), s = hn::IfThenElse(active, at.s, s);
-  }
-  if (!hn::AllFalse(d, flat)) {  // no density: uniform
-    const V uniform = u * pi;
-    const lanes::CosSin at = lanes::cos_sin(d, uniform);
-    c = hn::IfThenElse(flat, at.c, c), s = hn::IfThenElse(flat, at.s, s);
-  }
-  return {c, sign * s};
+// The view slice s below o and the weight t of s + 1 (view_slice, model/visible_slopes.h); lanes whose o
+// is below the horizon (discarded) read slice 0, inside the tables.
+struct SliceLanes {
+  I s;
+  V t;
+};
+HWY_INLINE SliceLanes view_slice(D d, V oz, V scale) {
+  const DI di;
+  const V one = hn::Set(d, 1.0);
+  const V cos_o = hn::Min(hn::Max(oz, hn::Zero(d)), one), sin_o = hn::Sqrt(hn::Max(hn::Zero(d), one - cos_o * cos_o));
+  const V x = lanes::divide(d, cos_o, cos_o + scale * sin_o) * hn::Set(d, double(VisibleSlopes::kSlices - 1));
+  const I s = hn::Min(hn::ConvertTo(di, x), hn::Set(di, VisibleSlopes::kSlices - 2));
+  return {s, x - hn::ConvertTo(d, s)};
 }
 
-// o reflected about a normal drawn from the lobe's visible normals seen from o: i
-// (TabulatedMicrofacet::lobe_direction, unstretched), to be refused where i.z <= 0.
+// The cosine and sine of o's azimuth (o.xy / |o.xy|; 1 and 0 straight above).
+HWY_INLINE lanes::CosSin view_azimuth(D d, V ox, V oy) {
+  const V o_xy = hn::Sqrt(ox * ox + oy * oy), zero = hn::Zero(d), one = hn::Set(d, 1.0);
+  const auto turned = o_xy > zero;
+  const V per_xy = hn::IfThenElseZero(turned, lanes::reciprocal(d, hn::IfThenElse(turned, o_xy, one)));
+  return {hn::IfThenElse(turned, ox * per_xy, one), oy * per_xy};
+}
+
+// o reflected about a normal drawn from the lobe's visible slopes (VisibleSlopes::sample), to be refused
+// where i.z <= 0.
 lanes::Direction lobe_direction(D d, const TabulatedBatchModel& model, V ox, V oy, V oz, V u1, V u2) {
   const DI di;
-  const V zero = hn::Zero(d), one = hn::Set(d, 1.0);
-  const int r = model.resolution;
+  constexpr int cells = VisibleSlopes::kCells, side = VisibleSlopes::kSideCells;
+  const V zero = hn::Zero(d), one = hn::Set(d, 1.0), half = hn::Set(d, 0.5), scale = hn::Set(d, model.scale);
+  const V edge = hn::Set(d, VisibleSlopes::kEdge);
   // One of the two view slices around o with the weights of the mixture, reusing u1.
-  const GridPosition view = locate(d, oz, r);
+  const SliceLanes view = view_slice(d, oz, scale);
   const V keep = one - view.t;
   const auto first = u1 < keep;
   V u = lanes::divide(d, hn::IfThenElse(first, u1, u1 - keep), hn::IfThenElse(first, keep, hn::IfThenElse(view.t > zero, view.t, one)));
   u = hn::Min(hn::Max(u, zero), hn::Set(d, 1.0 - 1e-16));
-  const I slice = hn::IfThenElse(hn::RebindMask(di, first), view.j, view.j + hn::Set(di, 1));
-  // The interval of theta_h: the last node of the slice's running sums <= u (sample_cdf: zero-mass
-  // intervals are never chosen), by bisection between the guide's entries around u.
-  const I row = slice * hn::Set(di, r + 1), last = hn::Set(di, r);
-  constexpr int guide = TabulatedMicrofacet::kCdfGuide;
-  const I at = slice * hn::Set(di, guide + 1) + hn::Min(hn::ConvertTo(di, u * hn::Set(d, double(guide))), hn::Set(di, guide - 1));
-  I k = hn::GatherIndex(di, model.cdf_guide, at), top = hn::GatherIndex(di, model.cdf_guide, at + hn::Set(di, 1));
-  // The running sum at node k is <= u; the last such node is at most `top`.
-  for (auto open = top > k; !hn::AllFalse(di, open); open = top > k) {
-    const I probe = hn::ShiftRight<1>(k + top + hn::Set(di, 1));
-    const auto take = hn::RebindMask(di, hn::GatherIndex(d, model.cdf, row + probe) <= u);
-    k = hn::IfThenElse(take, probe, k), top = hn::IfThenElse(take, top, probe - hn::Set(di, 1));
-  }
-  k = hn::Min(k, last - hn::Set(di, 1));
-  const V c0 = hn::GatherIndex(d, model.cdf, row + k), c1 = hn::GatherIndex(d, model.cdf, row + k + hn::Set(di, 1));
-  const V mass = c1 - c0;
-  const auto some = mass > zero;
-  const V frac = hn::IfThenElse(some, hn::Min(hn::Max(lanes::divide(d, u - c0, hn::IfThenElse(some, mass, one)), zero), one), hn::Set(d, 0.5));
-  // Uniform in cos(theta_h) within the interval.
-  const V n0 = hn::GatherIndex(d, model.cos_nodes, k), n1 = hn::GatherIndex(d, model.cos_nodes, k + hn::Set(di, 1));
-  const V cos_h = n0 - frac * (n0 - n1);
-  const V sin_h = hn::Sqrt(hn::Max(zero, one - cos_h * cos_h)), sin_o = hn::Sqrt(hn::Max(zero, one - oz * oz));
-  // phi relative to o's azimuth, then turned to it by o.xy / |o.xy|.
-  const lanes::CosSin phi = sample_phi(d, model.azimuth_guess, sin_o * sin_h, oz * cos_h, u2);
-  V hx = sin_h * phi.c, hy = sin_h * phi.s;
-  const V o_xy = hn::Sqrt(ox * ox + oy * oy);
-  const auto turned = hn::And(sin_o > zero, o_xy > zero);
-  const V per_xy = lanes::reciprocal(d, hn::IfThenElse(turned, o_xy, one)), turn_c = ox * per_xy, turn_s = oy * per_xy;
-  const V tx = turn_c * hx - turn_s * hy, ty = turn_s * hx + turn_c * hy;
-  hx = hn::IfThenElse(turned, tx, hx), hy = hn::IfThenElse(turned, ty, hy);
-  const V two_o_h = hn::Set(d, 2.0) * (ox * hx + oy * hy + oz * cos_h);
-  return {two_o_h * hx - ox, two_o_h * hy - oy, two_o_h * cos_h - oz};
+  const I slice = hn::IfThenElse(hn::RebindMask(di, first), view.s, view.s + hn::Set(di, 1));
+  const CellDraw cx = draw_cell(d, model.view_cdf, model.view_guide, slice * hn::Set(di, cells + 1),
+                                slice * hn::Set(di, VisibleSlopes::kGuide + 1), cells, u);
+  const V v = hn::Min(hn::Max(hn::Set(d, -1.0) + (hn::ConvertTo(d, cx.k) + cx.t) * hn::Set(d, 2.0 / cells), hn::Neg(edge)), edge);
+  const V x = lanes::divide(d, scale * v, one - hn::Abs(v));
+  // y~'s sign from u2's first half, its size from the rest.
+  const auto lower = u2 < half;
+  const V sign = hn::IfThenElse(lower, hn::Set(d, -1.0), one);
+  u2 = hn::IfThenElse(lower, hn::Set(d, 2.0) * u2, hn::Set(d, 2.0) * u2 - one);
+  const CellDraw cy = draw_cell(d, model.side_cdf, model.side_guide, cx.k * hn::Set(di, side + 1),
+                                cx.k * hn::Set(di, VisibleSlopes::kGuide + 1), side, u2);
+  const V w = hn::Min((hn::ConvertTo(d, cy.k) + cy.t) * hn::Set(d, 1.0 / side), edge);
+  const V y = sign * lanes::divide(d, scale * w, one - w);
+  const V inv = lanes::reciprocal(d, hn::Sqrt(one + x * x + y * y));
+  // From o's azimuth frame to the local one.
+  const lanes::CosSin turn = view_azimuth(d, ox, oy);
+  const V vx = hn::Neg(x) * inv, vy = hn::Neg(y) * inv;
+  const V hx = turn.c * vx - turn.s * vy, hy = turn.s * vx + turn.c * vy, hz = inv;
+  const V two_o_h = hn::Set(d, 2.0) * (ox * hx + oy * hy + oz * hz);
+  return {two_o_h * hx - ox, two_o_h * hy - oy, two_o_h * hz - oz};
 }
 
 }  // namespace
@@ -209,7 +170,8 @@ void EvalTabulatedBatch(const TabulatedBatchModel& model, EvaluationBatch& batch
   const D d;
   const DI di;
   const std::size_t n = batch.padded_size();
-  const V zero = hn::Zero(d), one = hn::Set(d, 1.0), four = hn::Set(d, 4.0);
+  const V zero = hn::Zero(d), one = hn::Set(d, 1.0), four = hn::Set(d, 4.0), scale = hn::Set(d, model.scale);
+  constexpr int cells = VisibleSlopes::kCells, side = VisibleSlopes::kSideCells;
   const int resolution = model.resolution;
   const V body[3] = {hn::Set(d, model.body.r * kInvPi), hn::Set(d, model.body.g * kInvPi), hn::Set(d, model.body.b * kInvPi)};
   const bool minnaert = model.body_exponent != 1.0;
@@ -225,8 +187,6 @@ void EvalTabulatedBatch(const TabulatedBatchModel& model, EvaluationBatch& batch
     const V inv_len = lanes::inverse_sqrt(d, hx * hx + hy * hy + hz * hz);
     hx = hx * inv_len, hy = hy * inv_len, hz = hz * inv_len;
     const auto h_up = hz > zero;
-    // theta_h once, for D and for the normal's place on the grid.
-    const GridPosition normal = locate(d, hn::IfThenElse(h_up, hz, one), resolution);
     const V four_cos = four * iz * oz;
     const V cos_d = hn::Min(hn::Max(ix * hx + iy * hy + iz * hz, zero), one);
     const V o_dot_h = ox * hx + oy * hy + oz * hz;
@@ -237,7 +197,8 @@ void EvalTabulatedBatch(const TabulatedBatchModel& model, EvaluationBatch& batch
       coat_f = terms.f, coat_pdf = terms.pdf;
     }
     if (with_f) {
-      const V dh = hn::IfThenElseZero(h_up, hn::Max(zero, spline(d, model.ndf, normal, model.resolution)));
+      const GridPosition normal = locate(d, hn::IfThenElse(h_up, hz, one), resolution);
+      const V dh = hn::IfThenElseZero(h_up, hn::Max(zero, spline(d, model.ndf, normal, resolution)));
       const V g1_i = g1(d, model, iz), g1_o = g1(d, model, oz);
       V g2;
       switch (model.smith) {
@@ -259,25 +220,28 @@ void EvalTabulatedBatch(const TabulatedBatchModel& model, EvaluationBatch& batch
       for (int c = 0; c < 3; ++c) hn::StoreU(hn::IfThenElseZero(formed, body[c] * factor + fresnel[c] * specular + coat_f), d, out[c] + k);
     }
 
-    // The lobe's visible normals (TabulatedMicrofacet::measured_visible_normal_pdf): the density per
-    // cos(theta_h) of the normal's interval, mixed linearly between the two view slices around o, spread
-    // over phi as max(0, o.h); reflected about h, d(omega_i) = 4 (o.h) d(omega_h).
+    // The lobe's visible slopes (VisibleSlopes::pdf): h in o's azimuth frame, its cell, the cell's share
+    // mixed between the two view slices around o, per steradian of h; reflected about h, d(omega_i) =
+    // 4 (o.h) d(omega_h).
     // A light's slots take f alone (shading_batch.h): where no lane of the vector asks, no density.
     if (hn::AllFalse(d, hn::LoadU(d, batch.with_pdf.data() + k) != zero)) {
       hn::StoreU(zero, d, batch.pdf.data() + k);
       continue;
     }
-    const GridPosition view = locate(d, oz, resolution);
-    const I at = view.j * hn::Set(di, resolution) + normal.j;
-    const V per_cos_lo = hn::GatherIndex(d, model.visible_density, at);
-    const V per_cos_hi = hn::GatherIndex(d, model.visible_density, at + hn::Set(di, resolution));
-    const V per_cos = (one - view.t) * per_cos_lo + view.t * per_cos_hi;
-    const V sin_o = hn::Sqrt(hn::Max(zero, one - oz * oz)), sin_h = hn::Sqrt(hn::Max(zero, one - hz * hz));
-    const V phi_total = positive_phi_integral(d, sin_o * sin_h, oz * hz);
-    const auto visible = hn::And(hn::And(o_faces_h, h_up), hn::And(per_cos > zero, phi_total > zero));
-    const V safe_total = hn::IfThenElse(visible, phi_total, one);
-    // per_cos (o.h) / total / (4 o.h): o.h cancels.
-    const V lobe_pdf = hn::IfThenElseZero(visible, lanes::divide(d, per_cos, four * safe_total));
+    const lanes::CosSin turn = view_azimuth(d, ox, oy);
+    const auto visible = hn::And(o_faces_h, h_up);
+    const V vx = turn.c * hx + turn.s * hy, vy = turn.c * hy - turn.s * hx;
+    const V a = hn::IfThenElse(visible, scale * hz + hn::Abs(vx), one), b = hn::IfThenElse(visible, scale * hz + hn::Abs(vy), one);
+    const V v = hn::Neg(lanes::divide(d, vx, a)), w = lanes::divide(d, hn::Abs(vy), b);
+    const I i = hn::Min(hn::Max(hn::ConvertTo(di, (v + one) * hn::Set(d, 0.5 * cells)), hn::Zero(di)), hn::Set(di, cells - 1));
+    const I j = hn::Min(hn::Max(hn::ConvertTo(di, w * hn::Set(d, double(side))), hn::Zero(di)), hn::Set(di, side - 1));
+    const SliceLanes view = view_slice(d, oz, scale);
+    const I at = view.s * hn::Set(di, cells) + i;
+    const V mixed = (one - view.t) * hn::GatherIndex(d, model.view_mass, at) + view.t * hn::GatherIndex(d, model.view_mass, at + hn::Set(di, cells));
+    const V cell = mixed * hn::GatherIndex(d, model.side_mass, i * hn::Set(di, side) + j);
+    const V ab = a * b;
+    const V per_h = lanes::divide(d, cell * hn::Set(d, 0.25 * cells * side) * (hn::Set(d, model.scale * model.scale) * hz), ab * ab);
+    const V lobe_pdf = hn::IfThenElseZero(visible, lanes::divide(d, per_h, four * o_dot_h));
     hn::StoreU(hn::IfThenElseZero(above, lanes::mixture_density(d, model.weights, coat, lobe_pdf, coat_pdf, iz)), d, batch.pdf.data() + k);
   }
 }
@@ -292,26 +256,32 @@ HWY_AFTER_NAMESPACE();
 
 namespace facetfit {
 
-std::optional<TabulatedBatchModel> TabulatedBatchModel::of(const TabulatedMicrofacet& lobe, double lobe_weight) {
-  if (!lobe.stretch().identity() || !lobe.can_sample()) return std::nullopt;
-  const MicrofacetTables& tables = lobe.tables();
-  if (tables.fresnel.value.size() != std::size_t(FresnelCurve::kSize)) return std::nullopt;
+TabulatedBatchModel TabulatedBatchModel::of(const VisibleSlopeProposal& proposal, const TabulatedMicrofacet* lobe, double lobe_weight) {
   TabulatedBatchModel m;
+  const VisibleSlopes& slopes = proposal.slopes();
+  m.scale = slopes.scale();
+  m.view_cdf = slopes.view_cdf().data();
+  m.view_mass = slopes.view_mass().data();
+  m.view_guide = slopes.view_guide().data();
+  m.side_cdf = slopes.side_cdf().data();
+  m.side_mass = slopes.side_mass().data();
+  m.side_guide = slopes.side_guide().data();
+  const ProposalParts& parts = proposal.parts();
+  m.coat = parts.coat;
+  m.weights = {lobe_weight, parts.lobe, parts.body, parts.coat.present() ? parts.coat_weight() : 0.0};
+  if (!lobe || !lobe->stretch().identity()) return m;
+  const MicrofacetTables& tables = lobe->tables();
+  if (tables.fresnel.value.size() != std::size_t(FresnelCurve::kSize) || tables.coat.alpha != parts.coat.alpha || tables.coat.f0 != parts.coat.f0)
+    return m;
+  m.f = true;
   m.resolution = tables.ndf.grid.resolution;
   m.ndf = tables.ndf.ndf.data();
-  m.cos_nodes = lobe.cos_nodes().data();
-  m.cdf = lobe.sampling().cdf.data();
-  m.visible_density = lobe.visible_density().data();
-  m.cdf_guide = lobe.cdf_guide().data();
-  m.g1_ratios = lobe.g1_table().ratios();
-  m.g1_size = lobe.g1_table().size();
+  m.g1_ratios = lobe->g1_table().ratios();
+  m.g1_size = lobe->g1_table().size();
   m.smith = tables.smith;
   m.curve = tables.fresnel.value.data();
   m.body = tables.body;
   m.body_exponent = tables.body_exponent;
-  m.azimuth_guess = AzimuthGuess::table().values();
-  m.coat = tables.coat;
-  m.weights = {lobe_weight, lobe.lobe_weight(), lobe.body_weight(), tables.coat.present() ? lobe.coat_weight() : 0.0};
   return m;
 }
 
