@@ -83,19 +83,28 @@ struct CellDraw {
 HWY_INLINE CellDraw draw_cell(D d, const double* cdf, const std::int64_t* guide, I row, I guide_row, int n, V u) {
   const DI di;
   constexpr int entries = VisibleSlopes::kGuide;
-  const I at = guide_row + hn::Min(hn::ConvertTo(di, u * hn::Set(d, double(entries))), hn::Set(di, entries - 1));
-  I k = hn::GatherIndex(di, guide, at), top = hn::GatherIndex(di, guide, at + hn::Set(di, 1));
-  // The sum at cell k is <= u; the last such cell is at most `top`.
-  for (auto open = top > k; !hn::AllFalse(di, open); open = top > k) {
-    const I probe = hn::ShiftRight<1>(k + top + hn::Set(di, 1));
-    const auto take = hn::RebindMask(di, hn::GatherIndex(d, cdf, row + probe) <= u);
-    k = hn::IfThenElse(take, probe, k), top = hn::IfThenElse(take, top, probe - hn::Set(di, 1));
+  const I one_i = hn::Set(di, 1), last = hn::Set(di, n - 1), end = hn::Set(di, n);
+  I k = hn::GatherIndex(di, guide, guide_row + hn::Min(hn::ConvertTo(di, u * hn::Set(d, double(entries))), hn::Set(di, entries - 1)));
+  // The sum at cell k is <= u. Most draws end within two cells of it: the next three sums at once, then
+  // steps one cell at a time for lanes that go further (a guide entry over several cells of little mass).
+  const V c0 = hn::GatherIndex(d, cdf, row + k), c1 = hn::GatherIndex(d, cdf, row + hn::Min(k + one_i, end));
+  const V c2 = hn::GatherIndex(d, cdf, row + hn::Min(k + hn::Set(di, 2), end)), c3 = hn::GatherIndex(d, cdf, row + hn::Min(k + hn::Set(di, 3), end));
+  const auto a1 = hn::And(hn::RebindMask(d, k < last), c1 <= u);
+  const auto a2 = hn::And(a1, hn::And(hn::RebindMask(d, k + one_i < last), c2 <= u));
+  const auto a3 = hn::And(a2, hn::And(hn::RebindMask(d, k + hn::Set(di, 2) < last), c3 <= u));
+  V lo = hn::IfThenElse(a2, c2, hn::IfThenElse(a1, c1, c0)), hi = hn::IfThenElse(a2, c3, hn::IfThenElse(a1, c2, c1));
+  k = k + hn::IfThenElseZero(hn::RebindMask(di, a1), one_i) + hn::IfThenElseZero(hn::RebindMask(di, a2), one_i);
+  if (HWY_UNLIKELY(!hn::AllFalse(d, a3))) {
+    auto more = hn::RebindMask(di, a3);
+    do {
+      k = hn::IfThenElse(more, k + one_i, k);
+      more = hn::And(more, hn::And(k < last, hn::RebindMask(di, hn::GatherIndex(d, cdf, row + hn::Min(k + one_i, end)) <= u)));
+    } while (!hn::AllFalse(di, more));
+    lo = hn::GatherIndex(d, cdf, row + k), hi = hn::GatherIndex(d, cdf, row + k + one_i);
   }
-  k = hn::Min(k, hn::Set(di, n - 1));
-  const V c0 = hn::GatherIndex(d, cdf, row + k), c1 = hn::GatherIndex(d, cdf, row + k + hn::Set(di, 1));
-  const V zero = hn::Zero(d), one = hn::Set(d, 1.0), mass = c1 - c0;
+  const V zero = hn::Zero(d), one = hn::Set(d, 1.0), mass = hi - lo;
   const auto some = mass > zero;
-  const V t = hn::IfThenElse(some, hn::Min(hn::Max(lanes::divide(d, u - c0, hn::IfThenElse(some, mass, one)), zero), one), hn::Set(d, 0.5));
+  const V t = hn::IfThenElse(some, hn::Min(hn::Max(lanes::divide(d, u - lo, hn::IfThenElse(some, mass, one)), zero), one), hn::Set(d, 0.5));
   return {k, t};
 }
 
