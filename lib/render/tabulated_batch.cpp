@@ -74,8 +74,8 @@ V g1(D d, const TabulatedBatchModel& model, V c) {
 }
 
 // The cell k of the running sums cdf[row + 0..n] in which u in [0, 1) falls (the last whose sum is <= u:
-// sample_cdf, so cells without mass are never chosen), by bisection between the entries of the row's
-// guide (append_cdf_guide, at guide_row) around u, and u's fraction in it.
+// sample_cdf, so cells without mass are never chosen), stepping on from the cell the row's guide gives
+// for u (append_cdf_guide, at guide_row), and u's fraction in it.
 struct CellDraw {
   I k;
   V t;
