@@ -242,27 +242,32 @@ TEST(TabulatedLanes, EveryBatchLengthAndDegenerateDirectionStayFiniteAndInBounds
           MicrofacetTables{ndf, Smith::correlated, curve, layered ? Rgb(0.2) : Rgb(0.0), layered ? Coat{0.005, 0.04} : Coat{}, layered ? 3.0 : 1.0});
       const ShadingModel model(lobe, VisibleSlopeProposal::of(*lobe));
       ASSERT_TRUE(model.tabulated_batch_model());
+      // And the proposal alone (a measured table's: no f in the lanes), whose f's tables are null.
+      const auto slopes = VisibleSlopeProposal::of(*lobe);  // the lanes' model points into its tables
+      const TabulatedBatchModel proposal_only = TabulatedBatchModel::of(*slopes, nullptr, 0.85);
+      ASSERT_FALSE(proposal_only.f);
       for (std::size_t n = 0; n <= 40; ++n)
-        for (const SimdTarget target : kSimdTargets) {
-          EvaluationBatch e;
-          for (std::size_t k = 0; k < n; ++k) e.push(glm::normalize(degenerate[k % 8]), glm::normalize(degenerate[(k * 3 + 1) % 8]));
-          eval_tabulated_batch(*model.tabulated_batch_model(), e, target);
-          for (std::size_t k = 0; k < n; ++k) {
-            for (const double v : {e.r[k], e.g[k], e.b[k], e.pdf[k]}) ASSERT_TRUE(std::isfinite(v)) << "alpha " << alpha << " pair " << k;
-            if (!(e.oz[k] > 0.0 && e.iz[k] > 0.0)) {
-              EXPECT_EQ(e.pdf[k], 0.0);
+        for (const SimdTarget target : kSimdTargets)
+          for (const TabulatedBatchModel* batch_model : {&*model.tabulated_batch_model(), &proposal_only}) {
+            EvaluationBatch e;
+            for (std::size_t k = 0; k < n; ++k) e.push(glm::normalize(degenerate[k % 8]), glm::normalize(degenerate[(k * 3 + 1) % 8]));
+            eval_tabulated_batch(*batch_model, e, target);
+            for (std::size_t k = 0; k < n; ++k) {
+              for (const double v : {e.r[k], e.g[k], e.b[k], e.pdf[k]}) ASSERT_TRUE(std::isfinite(v)) << "alpha " << alpha << " pair " << k;
+              if (!(e.oz[k] > 0.0 && e.iz[k] > 0.0)) {
+                EXPECT_EQ(e.pdf[k], 0.0);
+              }
             }
+            const double ends[] = {0.0, std::nextafter(1.0, 0.0), 0.5, 1e-300, 1.0 / VisibleSlopes::kGuide};
+            SampleBatch s;
+            for (std::size_t k = 0; k < n; ++k) s.push(glm::normalize(degenerate[k % 8]), ends[k % 5], ends[(k * 3 + 1) % 5], ends[(k + 2) % 5]);
+            sample_tabulated_batch(*batch_model, s, target);
+            for (std::size_t k = 0; k < n; ++k)
+              if (s.found[k] != 0.0) {
+                EXPECT_GT(s.oz[k], 0.0);
+                for (const double v : {s.ix[k], s.iy[k], s.iz[k]}) ASSERT_TRUE(std::isfinite(v)) << "alpha " << alpha << " sample " << k;
+              }
           }
-          const double ends[] = {0.0, std::nextafter(1.0, 0.0), 0.5, 1e-300, 1.0 / VisibleSlopes::kGuide};
-          SampleBatch s;
-          for (std::size_t k = 0; k < n; ++k) s.push(glm::normalize(degenerate[k % 8]), ends[k % 5], ends[(k * 3 + 1) % 5], ends[(k + 2) % 5]);
-          sample_tabulated_batch(*model.tabulated_batch_model(), s, target);
-          for (std::size_t k = 0; k < n; ++k)
-            if (s.found[k] != 0.0) {
-              EXPECT_GT(s.oz[k], 0.0);
-              for (const double v : {s.ix[k], s.iy[k], s.iz[k]}) ASSERT_TRUE(std::isfinite(v)) << "alpha " << alpha << " sample " << k;
-            }
-        }
     }
 }
 

@@ -47,7 +47,7 @@ VisibleSlopes::VisibleSlopes(const TabulatedNdf& ndf) {
       const double u = (j + gx[q]) / r, theta = ThetaGrid::theta_of_u(u), s = std::sin(theta);
       moment += 4.0 * s * s * ndf.D(theta) * gw[q] / r * kPi * u;
     }
-  scale_ = std::isfinite(moment) && moment > 1e-4 ? std::min(moment, 100.0) : (moment > 0.0 ? 1e-4 : 1.0);
+  scale_ = std::isfinite(moment) && moment > 0.0 ? clamp(moment, 1e-4, 100.0) : 1.0;
 
   // P22 over the cells of v >= 0 (those of v < 0 mirror them) at 3 x 3 Gauss points: each point's
   // weight is P22 dx~/dv dy~/dw times the cell's area in (v, w).
@@ -92,6 +92,7 @@ VisibleSlopes::VisibleSlopes(const TabulatedNdf& ndf) {
 }
 
 Vec3 VisibleSlopes::sample(const Vec3& o, double u1, double u2) const {
+  if (!(o.z > 0.0)) return {0.0, 0.0, 1.0};  // no view slice (callers draw for o above the horizon)
   // One of the two view slices around o with the weights of the mixture, reusing u1.
   const ViewSlice view = view_slice(o, scale_);
   int s = view.s;

@@ -84,7 +84,8 @@ HWY_INLINE CellDraw draw_cell(D d, const double* cdf, const std::int64_t* guide,
   const DI di;
   constexpr int entries = VisibleSlopes::kGuide;
   const I one_i = hn::Set(di, 1), last = hn::Set(di, n - 1), end = hn::Set(di, n);
-  I k = hn::GatherIndex(di, guide, guide_row + hn::Min(hn::ConvertTo(di, u * hn::Set(d, double(entries))), hn::Set(di, entries - 1)));
+  const I g = hn::Min(hn::Max(hn::ConvertTo(di, u * hn::Set(d, double(entries))), hn::Zero(di)), hn::Set(di, entries - 1));
+  I k = hn::GatherIndex(di, guide, guide_row + g);
   // The sum at cell k is <= u. Most draws end within two cells of it: the next three sums at once, then
   // steps one cell at a time for lanes that go further (a guide entry over several cells of little mass).
   const V c0 = hn::GatherIndex(d, cdf, row + k), c1 = hn::GatherIndex(d, cdf, row + hn::Min(k + one_i, end));
@@ -119,7 +120,7 @@ HWY_INLINE SliceLanes view_slice(D d, V oz, V scale) {
   const V one = hn::Set(d, 1.0);
   const V cos_o = hn::Min(hn::Max(oz, hn::Zero(d)), one), sin_o = hn::Sqrt(hn::Max(hn::Zero(d), one - cos_o * cos_o));
   const V x = lanes::divide(d, cos_o, cos_o + scale * sin_o) * hn::Set(d, double(VisibleSlopes::kSlices - 1));
-  const I s = hn::Min(hn::ConvertTo(di, x), hn::Set(di, VisibleSlopes::kSlices - 2));
+  const I s = hn::Min(hn::Max(hn::ConvertTo(di, x), hn::Zero(di)), hn::Set(di, VisibleSlopes::kSlices - 2));
   return {s, x - hn::ConvertTo(d, s)};
 }
 
@@ -176,6 +177,7 @@ void SampleTabulatedBatch(const TabulatedBatchModel& model, SampleBatch& batch) 
 }
 
 void EvalTabulatedBatch(const TabulatedBatchModel& model, EvaluationBatch& batch, bool with_f) {
+  with_f = with_f && model.f;  // f's tables are null otherwise
   const D d;
   const DI di;
   const std::size_t n = batch.padded_size();

@@ -53,8 +53,9 @@ struct TabulatedBatchModel {
 
 // Fills the batch's r, g, b and pdf for its padded_size() pairs; zero where o or i is below the horizon,
 // and pdf zero for a vector of pairs none of which asks for it (EvaluationBatch::with_pdf).
-// `target`: which SIMD code runs (render/simd_targets.h; the tests run each). Without `with_f`, pdf alone: the
-// density of a proposal whose BRDF the lanes do not hold (a measured table's, sampled by its fitted LUT).
+// `target`: which SIMD code runs (render/simd_targets.h; the tests run each). Without `with_f` (or the
+// model's `f`), pdf alone: the density of a proposal whose BRDF the lanes do not hold (a measured table's,
+// sampled by its fitted LUT).
 void eval_tabulated_batch(const TabulatedBatchModel& model, EvaluationBatch& batch, SimdTarget target = SimdTarget::best, bool with_f = true);
 // Fills the batch's i and found for its padded_size() entries (ShadingModel::sample_direction).
 void sample_tabulated_batch(const TabulatedBatchModel& model, SampleBatch& batch, SimdTarget target = SimdTarget::best);
