@@ -40,6 +40,13 @@ struct TurnedFrame {
     f.c = cosine, f.s = sine;
     return f;
   }
+  // The frame whose x axis is w's azimuth, (w.x, w.y) / |w.xy| (the identity straight up): a view's own.
+  static TurnedFrame of_azimuth(const Vec3& w) {
+    const double r = std::sqrt(w.x * w.x + w.y * w.y);
+    if (!(r > 0.0)) return TurnedFrame();
+    const double per = 1.0 / r;
+    return of(w.x * per, w.y * per);
+  }
   Vec3 to_frame(const Vec3& v) const { return {c * v.x + s * v.y, -s * v.x + c * v.y, v.z}; }    // by -angle
   Vec3 from_frame(const Vec3& v) const { return {c * v.x - s * v.y, s * v.x + c * v.y, v.z}; }  // by +angle
 };

@@ -23,6 +23,20 @@ inline int sample_cdf(const double* cdf, int n, double u, double* t) {
   return k;
 }
 
+// Which of two distributions mixed with weights 1 - t and t a u in [0, 1) draws (0 or 1), u rescaled to
+// [0, 1) within that one's share: the draw from it needs no number of its own.
+inline int pick_of_two(double t, double* u) {
+  int which = 0;
+  if (*u < 1.0 - t) {
+    *u /= 1.0 - t;
+  } else {
+    *u = (*u - (1.0 - t)) / t;
+    which = 1;
+  }
+  *u = std::clamp(*u, 0.0, 1.0 - 1e-16);
+  return which;
+}
+
 // A guide to the running sums cdf[0..n], appended to `guide`: entry g (0..size) is the last cell k whose
 // sum cdf[k] is <= g / size (n at g = size). The cell a u in [g, g + 1) / size falls in lies between
 // entries g and g + 1, so the SIMD samplers search there rather than over the whole row; size is a power

@@ -22,6 +22,9 @@ inline Vec3 spherical_direction(double theta, double phi) {
   return {s * std::cos(phi), s * std::sin(phi), std::cos(theta)};
 }
 
+// o reflected about the unit normal h, 2 (o.h) h - o: a microfacet's light direction for the view o.
+inline Vec3 reflect_about(const Vec3& o, const Vec3& h) { return 2.0 * glm::dot(o, h) * h - o; }
+
 // Rec.709 / sRGB relative luminance.
 inline double luminance(const Rgb& c) { return 0.2126 * c.r + 0.7152 * c.g + 0.0722 * c.b; }
 

@@ -24,7 +24,7 @@ inline std::optional<Vec3> ggx_visible_direction(const Vec3& o, double alpha, do
   const double p2 = (1.0 - s) * std::sqrt(std::max(0.0, 1.0 - p1 * p1)) + s * r * std::sin(phi);
   const Vec3 n = p1 * t1 + p2 * t2 + std::sqrt(std::max(0.0, 1.0 - p1 * p1 - p2 * p2)) * v;
   const Vec3 h = glm::normalize(Vec3(alpha * n.x, alpha * n.y, std::max(0.0, n.z)));
-  const Vec3 i = 2.0 * glm::dot(o, h) * h - o;
+  const Vec3 i = reflect_about(o, h);
   if (i.z <= 0.0) return std::nullopt;
   return i;
 }

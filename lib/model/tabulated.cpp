@@ -75,7 +75,7 @@ TabulatedMicrofacet::TabulatedMicrofacet(MicrofacetTables tables, VisibleNormalT
       }
     }
   }
-  shared->parts = ProposalParts(shared->tables.fresnel.value[0], shared->tables.body, shared->tables.coat);
+  shared->parts = shared->tables.proposal_parts();
   shared_ = std::move(shared);
 }
 
@@ -187,7 +187,7 @@ std::optional<Vec3> TabulatedMicrofacet::lobe_direction(const Vec3& o, double u1
     const Vec3 m = measured_visible_normal(stretch_.direction(stretch_.to_frame(o)), u1, u2);
     h = stretch_.from_frame(stretch_.stretched_normal(m));
   }
-  const Vec3 i = 2.0 * glm::dot(o, h) * h - o;
+  const Vec3 i = reflect_about(o, h);
   if (i.z <= 0.0) return std::nullopt;
   return i;
 }
@@ -197,14 +197,7 @@ Vec3 TabulatedMicrofacet::measured_visible_normal(const Vec3& o, double u1, doub
   const int r = grid.resolution;
   // Pick one of the two view slices around o with the weights of the mixture, reusing u1.
   const GridPosition view = locate(grid, o.z);
-  int slice = view.j;
-  if (u1 < 1.0 - view.t) {
-    u1 /= 1.0 - view.t;
-  } else {
-    u1 = (u1 - (1.0 - view.t)) / view.t;
-    slice = view.j + 1;
-  }
-  u1 = clamp(u1, 0.0, 1.0 - 1e-16);
+  const int slice = view.j + pick_of_two(view.t, &u1);
   // The interval of theta_h: the last node whose CDF is <= u1 (zero-mass intervals are never chosen).
   const double* cdf = shared_->sampling.cdf.data() + std::size_t(slice) * (r + 1);
   double frac;
@@ -215,9 +208,8 @@ Vec3 TabulatedMicrofacet::measured_visible_normal(const Vec3& o, double u1, doub
   // phi relative to o's azimuth, then turned to it (no arc tangent: its cosine and sine are o.xy / |o.xy|).
   const auto [cos_phi, sin_phi] = sample_visible_azimuth(sin_o * sin_h, o.z * cos_h, u2);
   const Vec3 h(sin_h * cos_phi, sin_h * sin_phi, cos_h);
-  const double o_xy = std::sqrt(o.x * o.x + o.y * o.y);
-  if (!(sin_o > 0.0 && o_xy > 0.0)) return h;
-  return TurnedFrame::of(o.x / o_xy, o.y / o_xy).from_frame(h);
+  if (!(sin_o > 0.0)) return h;
+  return TurnedFrame::of_azimuth(o).from_frame(h);
 }
 
 }  // namespace facetfit

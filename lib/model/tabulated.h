@@ -33,6 +33,9 @@ struct MicrofacetTables {
   Rgb body{0.0};  // the body's albedo at normal incidence (model/body.h)
   Coat coat;      // optional clear coat over it
   double body_exponent = 1.0;  // Minnaert's k (model/body.h): 1 is Lambert
+
+  // The parts a proposal of this lobe draws from, weighted by F(0), the body and the coat (model/proposal.h).
+  ProposalParts proposal_parts() const { return ProposalParts(fresnel.value[0], body, coat); }
 };
 
 // Tables for sampling visible normals. For each view slice s (theta_o at grid node s) and each u interval
@@ -82,12 +85,11 @@ class TabulatedMicrofacet final : public Brdf, public Proposal {
   double lobe_weight() const { return shared_->parts.lobe; }
   double body_weight() const { return shared_->parts.body; }
   double coat_weight() const { return shared_->parts.coat_weight(); }
-  const ProposalParts& parts() const { return shared_->parts; }
 
   const MicrofacetTables& tables() const { return shared_->tables; }
   const VisibleNormalTables& sampling() const { return shared_->sampling; }
   const Stretch& stretch() const { return stretch_; }
-  // cos(theta_j) at the grid's nodes, and G1's table (which the SIMD kernels read, render/tabulated_batch.h).
+  // cos(theta_j) at the grid's nodes; G1's table, which the SIMD kernels read (render/tabulated_batch.h).
   const std::vector<double>& cos_nodes() const { return shared_->cos_nodes; }
   const G1Table& g1_table() const { return *shared_->g1; }
   // The visible normals' density per unit cos(theta_h) in interval j of view slice s, mass(s, j) /

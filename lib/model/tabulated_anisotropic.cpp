@@ -195,7 +195,7 @@ std::optional<Vec3> TabulatedAnisotropic::sample_direction(const Vec3& o, double
     const Vec3 m = measured_visible_normal(measured_direction(o), u1, u2);
     h = stretch_.from_frame(stretch_.stretched_normal(stretch_.to_frame(m)));
   }
-  const Vec3 i = 2.0 * glm::dot(o, h) * h - o;
+  const Vec3 i = reflect_about(o, h);
   if (i.z <= 0.0) return std::nullopt;
   return i;
 }

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/frame.h"
 #include "core/piecewise_constant.h"
 #include "core/quadrature_rules.h"
 
@@ -95,14 +96,7 @@ Vec3 VisibleSlopes::sample(const Vec3& o, double u1, double u2) const {
   if (!(o.z > 0.0)) return {0.0, 0.0, 1.0};  // no view slice (callers draw for o above the horizon)
   // One of the two view slices around o with the weights of the mixture, reusing u1.
   const ViewSlice view = view_slice(o, scale_);
-  int s = view.s;
-  if (u1 < 1.0 - view.t) {
-    u1 /= 1.0 - view.t;
-  } else {
-    u1 = (u1 - (1.0 - view.t)) / view.t;
-    s += 1;
-  }
-  u1 = clamp(u1, 0.0, 1.0 - 1e-16);
+  const int s = view.s + pick_of_two(view.t, &u1);
   double tx, ty;
   const int i = sample_cdf(view_cdf_.data() + std::size_t(s) * (kCells + 1), kCells, u1, &tx);
   const double v = clamp(-1.0 + 2.0 * (i + tx) / kCells, -kEdge, kEdge);
@@ -114,21 +108,17 @@ Vec3 VisibleSlopes::sample(const Vec3& o, double u1, double u2) const {
   const double w = std::min((j + ty) / kSide, kEdge);
   const double y = sign * (scale_ * w / (1.0 - w));
   const double inv = 1.0 / std::sqrt(1.0 + x * x + y * y);
-  // From o's azimuth frame (its cosine and sine are o.xy / |o.xy|) to the local one.
-  const double o_xy = std::sqrt(o.x * o.x + o.y * o.y), per_xy = o_xy > 0.0 ? 1.0 / o_xy : 0.0;
-  const double c = o_xy > 0.0 ? o.x * per_xy : 1.0, sn = o.y * per_xy;
-  const double hx = -x * inv, hy = -y * inv;
-  return {c * hx - sn * hy, sn * hx + c * hy, inv};
+  // From o's azimuth frame to the local one.
+  return TurnedFrame::of_azimuth(o).from_frame(Vec3(-x * inv, -y * inv, inv));
 }
 
 double VisibleSlopes::pdf(const Vec3& o, const Vec3& h) const {
   if (o.z <= 0.0 || h.z <= 0.0 || glm::dot(o, h) <= 0.0) return 0.0;
-  const double o_xy = std::sqrt(o.x * o.x + o.y * o.y), per_xy = o_xy > 0.0 ? 1.0 / o_xy : 0.0;
-  const double c = o_xy > 0.0 ? o.x * per_xy : 1.0, sn = o.y * per_xy;
   // h in o's azimuth frame; with A = c cos(theta_h) + |h_x| (and B for y), v = x~ / (c + |x~|) = -h_x / A,
   // w = |h_y| / B, and dv/dx~ dw/dy~ / cos^3(theta_h) = c^2 cos(theta_h) / (A B)^2: no slope, so no
   // overflow, at a grazing h.
-  const double hx = c * h.x + sn * h.y, hy = c * h.y - sn * h.x;
+  const Vec3 seen = TurnedFrame::of_azimuth(o).to_frame(h);
+  const double hx = seen.x, hy = seen.y;
   const double a = scale_ * h.z + std::abs(hx), b = scale_ * h.z + std::abs(hy);
   const double v = -hx / a, w = std::abs(hy) / b;
   const int i = std::clamp(int((v + 1.0) * (0.5 * kCells)), 0, kCells - 1), j = std::min(int(w * kSide), kSide - 1);
@@ -143,7 +133,7 @@ std::optional<Vec3> VisibleSlopeProposal::sample_direction(const Vec3& o, double
   if (o.z <= 0.0) return std::nullopt;
   return parts_.sample(o, u1, u2, [&](double a, double b) -> std::optional<Vec3> {
     const Vec3 h = slopes_.sample(o, a, b);
-    const Vec3 i = 2.0 * glm::dot(o, h) * h - o;
+    const Vec3 i = reflect_about(o, h);
     if (i.z <= 0.0) return std::nullopt;
     return i;
   });

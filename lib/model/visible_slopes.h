@@ -92,9 +92,11 @@ inline ViewSlice view_slice(const Vec3& o, double scale) {
 class VisibleSlopeProposal final : public Proposal {
  public:
   VisibleSlopeProposal(const TabulatedNdf& ndf, const ProposalParts& parts) : slopes_(ndf), parts_(parts) {}
+  // The proposal of a lobe with these tables: its NDF, with its parts.
+  explicit VisibleSlopeProposal(const MicrofacetTables& tables) : VisibleSlopeProposal(tables.ndf, tables.proposal_parts()) {}
   // The proposal of `lobe` (unstretched: a stretch reshapes the lobe, not these tables).
   static std::shared_ptr<const VisibleSlopeProposal> of(const TabulatedMicrofacet& lobe) {
-    return std::make_shared<VisibleSlopeProposal>(lobe.tables().ndf, lobe.parts());
+    return std::make_shared<VisibleSlopeProposal>(lobe.tables());
   }
 
   std::optional<Vec3> sample_direction(const Vec3& o, double u1, double u2) const override;

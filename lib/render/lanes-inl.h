@@ -196,6 +196,12 @@ struct Direction {
   V x, y, z;
 };
 
+// o reflected about the unit normal h, 2 (o.h) h - o (reflect_about, core/vec.h).
+inline Direction reflect(D d, V ox, V oy, V oz, V hx, V hy, V hz) {
+  const V two_o_h = hn::Set(d, 2.0) * (ox * hx + oy * hy + oz * hz);
+  return {two_o_h * hx - ox, two_o_h * hy - oy, two_o_h * hz - oz};
+}
+
 // Visible normals of GGX (model/ggx_visible.h, Heitz 2018) for o above the horizon, with u1, u2 in [0, 1)
 // and (cos, sin) of phi = 2 pi u2: i, to be refused where i.z <= 0.
 inline Direction ggx_visible_direction(D d, V ox, V oy, V oz, V alpha, V u1, V cos_phi, V sin_phi) {
@@ -218,8 +224,7 @@ inline Direction ggx_visible_direction(D d, V ox, V oy, V oz, V alpha, V u1, V c
   V hx = alpha * nx, hy = alpha * ny, hz = hn::Max(zero, nz);
   const V inv_h = inverse_sqrt(d, hx * hx + hy * hy + hz * hz);
   hx = hx * inv_h, hy = hy * inv_h, hz = hz * inv_h;
-  const V two_o_h = hn::Set(d, 2.0) * (ox * hx + oy * hy + oz * hz);
-  return {two_o_h * hx - ox, two_o_h * hy - oy, two_o_h * hz - oz};
+  return reflect(d, ox, oy, oz, hx, hy, hz);
 }
 
 // The density of i for a shading model that draws with `weights` (ShadingModel::pdf), from the lobe's and

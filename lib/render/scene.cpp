@@ -418,12 +418,10 @@ std::shared_ptr<const ShadingModel> load_material(const SceneDesc& scene, const 
     if (!table && (!(rgl || utia) || m.proposal.empty())) table = std::make_shared<MerlTable>(table_of(*measurement));
     std::shared_ptr<const Proposal> proposal;
     if (!m.proposal.empty()) {
-      const Lut lut = read_lut(resolve(scene, m.proposal));
-      const MicrofacetTables& t = lut.tables;
-      proposal = std::make_shared<VisibleSlopeProposal>(t.ndf, ProposalParts(t.fresnel.value[0], t.body, t.coat));
+      proposal = std::make_shared<VisibleSlopeProposal>(read_lut(resolve(scene, m.proposal)).tables);
     } else {
       const FitResult fit = Fitter{FitOptions::paper()}.fit(*table);
-      if (fit.ok()) proposal = std::make_shared<VisibleSlopeProposal>(fit.ndf(), ProposalParts(fit.fresnel().value[0], Rgb(0.0), Coat{}));
+      if (fit.ok()) proposal = std::make_shared<VisibleSlopeProposal>(MicrofacetTables{fit.ndf(), fit.smith, fit.fresnel(), {}, {}});
     }
     // RGL files render through their own evaluation (the renderer's o is the viewer's side), not the
     // MERL-layout table: with view slices this is Mitsuba's `measured` (tests/test_mitsuba.cpp).

@@ -36,7 +36,6 @@ ShadingModel::ShadingModel(std::shared_ptr<const Brdf> brdf, std::shared_ptr<con
   const auto* slopes = dynamic_cast<const VisibleSlopeProposal*>(proposal_.get());
   if (!batch_model_ && slopes && lobe_weight_ > 0.0) {
     tabulated_batch_model_ = TabulatedBatchModel::of(*slopes, dynamic_cast<const TabulatedMicrofacet*>(brdf_.get()), lobe_weight_);
-    tabulated_f_ = tabulated_batch_model_->f;
     if (const auto* table = dynamic_cast<const MerlTable*>(brdf_.get())) merl_batch_model_ = MerlBatchModel::of(*table);
   }
   // The Lambert lanes hold Lambert's law alone, not Minnaert's.
@@ -72,8 +71,8 @@ void ShadingModel::eval(EvaluationBatch& batch, bool simd) const {
   if (simd && batch_model_) return eval_ggx_batch(*batch_model_, batch);
   if (simd && lambert_albedo_) return eval_lambert_batch(*lambert_albedo_, batch);
   if (simd && tabulated_batch_model_) {
-    eval_tabulated_batch(*tabulated_batch_model_, batch, SimdTarget::best, tabulated_f_);
-    if (tabulated_f_) return;
+    eval_tabulated_batch(*tabulated_batch_model_, batch, SimdTarget::best, tabulated_batch_model_->f);
+    if (tabulated_batch_model_->f) return;
     if (merl_batch_model_) return eval_merl_batch(*merl_batch_model_, batch);
     for (std::size_t k = 0; k < batch.size(); ++k) {
       const Rgb v = f(batch.o(k), batch.i(k));

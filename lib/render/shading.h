@@ -79,7 +79,6 @@ class ShadingModel {
   // A tabulated lobe's visible slopes in lanes: their draws and density, and f too where the BRDF is the
   // lobe itself.
   std::optional<TabulatedBatchModel> tabulated_batch_model_;
-  bool tabulated_f_ = false;
   std::optional<MerlBatchModel> merl_batch_model_;  // f of a MERL-layout table under a tabulated proposal
   std::optional<Rgb> lambert_albedo_;  // a Lambertian surface sampled by the cosine alone (render/lambert_batch.h)
 };

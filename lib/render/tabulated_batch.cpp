@@ -163,8 +163,7 @@ lanes::Direction lobe_direction(D d, const TabulatedBatchModel& model, V ox, V o
   const lanes::CosSin turn = view_azimuth(d, ox, oy);
   const V vx = hn::Neg(x) * inv, vy = hn::Neg(y) * inv;
   const V hx = turn.c * vx - turn.s * vy, hy = turn.s * vx + turn.c * vy, hz = inv;
-  const V two_o_h = hn::Set(d, 2.0) * (ox * hx + oy * hy + oz * hz);
-  return {two_o_h * hx - ox, two_o_h * hy - oy, two_o_h * hz - oz};
+  return lanes::reflect(d, ox, oy, oz, hx, hy, hz);
 }
 
 }  // namespace
