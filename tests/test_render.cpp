@@ -74,6 +74,11 @@ Vec3 lane_test_direction(std::mt19937_64& rng, double grazing, bool underflow = 
   return glm::normalize(Vec3(std::cos(phi), std::sin(phi), heights[kind]));
 }
 
+// x rounded to single precision, the lanes' of the tabulated lobe (render/tabulated_batch.h): their
+// inputs as they see them.
+double single(double x) { return double(float(x)); }
+Vec3 single(const Vec3& v) { return Vec3(single(v.x), single(v.y), single(v.z)); }
+
 // A sphere of `m` filling most of a small image, under a uniform environment of radiance 1.
 SceneDesc furnace(const MaterialDesc& m, int spp = 64) {
   SceneDesc s = default_scene(m);
@@ -643,17 +648,21 @@ TEST(Shading, TabulatedInSimdLanesEqualsOnePairAtATime) {
   // draw (the slice, the cells' bisections from the guides, the slopes' frame); pairs that include grazing
   // and below-horizon directions, batches of every length modulo the lane count, every SIMD target the CPU
   // has, against ShadingModel's one pair at a time.
+  // The lanes compute in single precision: both paths take the same inputs, rounded to single (the
+  // directions and numbers as the lanes see them; a direction within 1e-160 of the normal is the normal,
+  // a cos(theta) of 1e-170 is the horizon).
   const FresnelCurve curve = coloured_curve();
   std::mt19937_64 rng(11);
   std::uniform_real_distribution<double> u(0.0, 1.0);
   const auto direction = [&] { return lane_test_direction(rng, 0.05, true); };
-  // Relative to the value (or to 1e-3 of the batch's largest), 1e-10 rather than the GGX kernel's 1e-12:
-  // theta_h = acos(h.z) turns the last bit of h.z (which the lanes may round otherwise: fused multiply-adds)
-  // into 1e-16 / theta_h of theta_h, which a peak a node wide (alpha 0.005: d ln D / d theta_h up to ~400)
-  // turns into up to 3e-11 of D.
-  // A drawn direction within 1e-10 (worst seen 9e-13): the lanes' divisions and square roots are a few
-  // ulp from the one-pair path's, and nothing iterates.
-  int cases = 0, compared = 0, found = 0;
+  // f and the density relative to the value (or to 1e-3 of the batch's largest) within 2e-4 (worst seen
+  // 4.9e-5): single precision's 6e-8, through the spline's, the tables' and the Fresnel curve's lookups
+  // (theta_h from 1 - h.z = sin^2 / (1 + h.z), not from h.z: render/lanes-inl.h, acos).
+  // A drawn direction within 1e-3 (most within 1e-5; worst seen 2.2e-4 for alpha 0.005, where the cells'
+  // slopes x = c v / (1 - |v|) stretch v's rounding), except where a number falls within rounding of a
+  // boundary between view slices or cells, which the two paths may then put on either side: at most 1 in
+  // 1,000 draws (seen: 1 in 21,600). A direction found by one path and not the other only on the horizon.
+  int cases = 0, compared = 0, found = 0, flips = 0;
   double worst = 0.0, sample_worst = 0.0;
   for (const auto& [type, alpha] : {std::pair{NdfType::ggx, 0.005}, {NdfType::ggx, 0.3}, {NdfType::ggx, 1.5}, {NdfType::beckmann, 0.3}})
     for (const Smith smith : {Smith::masking, Smith::correlated, Smith::separable})
@@ -673,8 +682,9 @@ TEST(Shading, TabulatedInSimdLanesEqualsOnePairAtATime) {
           for (std::size_t k = 0; k < n; ++k) {
             Vec3 o = direction(), i = direction();
             if (k % 3 == 0) i = glm::normalize(Vec3(-o.x, -o.y, o.z) + 0.02 * direction());  // near the peak
+            o = single(o), i = single(i);
             lanes.push(o, i), reference.push(o, i);
-            const double u1 = u(rng), u2 = u(rng), u3 = u(rng);
+            const double u1 = single(u(rng)), u2 = single(u(rng)), u3 = single(u(rng));
             drawn.push(o, u1, u2, u3), one_by_one.push(o, u1, u2, u3);
           }
           eval_tabulated_batch(*model.tabulated_batch_model(), lanes, target), model.eval(reference, false);
@@ -689,13 +699,20 @@ TEST(Shading, TabulatedInSimdLanesEqualsOnePairAtATime) {
             ASSERT_EQ(f_only.b[k], lanes.b[k]) << where << " pair " << k;
           }
           for (std::size_t k = 0; k < n; ++k) {
-            ASSERT_EQ(drawn.found[k], one_by_one.found[k]) << where << " sample " << k;
+            if (drawn.found[k] != one_by_one.found[k]) {
+              const double z = drawn.found[k] ? drawn.iz[k] : one_by_one.iz[k];
+              ASSERT_LT(std::abs(z), 1e-5) << where << " sample " << k << ": found by one path only, i.z " << z;
+              ++flips;
+              continue;
+            }
             if (!one_by_one.found[k]) continue;
             ++found;
             const Vec3 a = drawn.i(k), b = one_by_one.i(k);
+            if (glm::length(a - b) > 1e-3) {
+              ++flips;
+              continue;
+            }
             sample_worst = std::max(sample_worst, glm::length(a - b));
-            ASSERT_LE(glm::length(a - b), 1e-10) << where << " sample " << k << ": " << a.x << " " << a.y << " " << a.z << " against "
-                                                << b.x << " " << b.y << " " << b.z;
           }
           double largest[4] = {};
           for (std::size_t k = 0; k < n; ++k)
@@ -708,16 +725,18 @@ TEST(Shading, TabulatedInSimdLanesEqualsOnePairAtATime) {
               const double a = values[c][0], b = values[c][1];
               ASSERT_TRUE(std::isfinite(a)) << where << " pair " << k << " value " << c << " o.z " << lanes.oz[k] << " i.z " << lanes.iz[k] << " against " << b;
               const double scale = std::max(std::abs(b), 1e-3 * largest[c]);
-              ASSERT_LE(std::abs(a - b), 1e-10 * scale) << where << " pair " << k << " value " << c << ": " << a << " against " << b;
+              ASSERT_LE(std::abs(a - b), 2e-4 * scale) << where << " pair " << k << " value " << c << ": " << a << " against " << b;
               if (scale > 0.0) worst = std::max(worst, std::abs(a - b) / scale);
               compared += b != 0.0;
             }
           }
           ++cases;
         }
-  std::printf("[ lanes ] worst relative difference of f and pdf %.2e, of a drawn direction %.2e\n", worst, sample_worst);
+  std::printf("[ lanes ] worst relative difference of f and pdf %.2e, of a drawn direction %.2e; %d draws on either side of a boundary\n",
+              worst, sample_worst, flips);
   EXPECT_EQ(cases, 72);  // every case on each of the three SIMD targets
   EXPECT_GT(compared, 20000);  // about half the pairs are above the horizon, four values each
+  EXPECT_LE(flips, found / 1000);
   EXPECT_GT(found, 5000);
 }
 
@@ -741,21 +760,23 @@ TEST(Shading, TabulatedProposalInSimdLanesEqualsOnePairAtATime) {
     EvaluationBatch lanes, reference;
     SampleBatch drawn, one_by_one;
     for (std::size_t k = 0; k < 403; ++k) {
-      const Vec3 o = direction(), i = direction();
+      // In single precision, as the lanes see them (Shading.TabulatedInSimdLanesEqualsOnePairAtATime).
+      const Vec3 o = single(direction()), i = single(direction());
       lanes.push(o, i), reference.push(o, i);
-      const double u1 = u(rng), u2 = u(rng), u3 = u(rng);
+      const double u1 = single(u(rng)), u2 = single(u(rng)), u3 = single(u(rng));
       drawn.push(o, u1, u2, u3), one_by_one.push(o, u1, u2, u3);
     }
     model.eval(lanes, true), model.eval(reference, false);
     model.sample_directions(drawn, true), model.sample_directions(one_by_one, false);
     for (std::size_t k = 0; k < lanes.size(); ++k) {
-      // f is the BRDF's, one pair at a time either way.
+      // f is the BRDF's, one pair at a time either way; the density and the draw to single precision's
+      // rounding, as in that test (no draw here fell on a boundary).
       EXPECT_EQ(lanes.f(k), reference.f(k)) << k;
-      EXPECT_NEAR(lanes.pdf[k], reference.pdf[k], 1e-10 * std::max(1.0, reference.pdf[k])) << k;
+      EXPECT_NEAR(lanes.pdf[k], reference.pdf[k], 2e-4 * std::max(1.0, reference.pdf[k])) << k;
       ASSERT_EQ(drawn.found[k], one_by_one.found[k]) << k;
       if (!one_by_one.found[k]) continue;
       ++found;
-      EXPECT_LE(glm::length(drawn.i(k) - one_by_one.i(k)), 1e-10) << k;
+      EXPECT_LE(glm::length(drawn.i(k) - one_by_one.i(k)), 1e-3) << k;
     }
   }
   EXPECT_GT(found, 300);

@@ -22,7 +22,7 @@ using lanes::V;
 void SampleGgxBatch(const GgxBatchModel& model, SampleBatch& batch) {
   const D d;
   const V alpha = hn::Set(d, model.alpha);
-  lanes::sample_proposal(d, model.weights, model.coat, batch, [&](V ox, V oy, V oz, V u1, V, V cos_phi, V sin_phi) {
+  lanes::sample_proposal(d, model.weights, model.coat, batch, true, [&](V ox, V oy, V oz, V u1, V, V cos_phi, V sin_phi) {
     return lanes::ggx_visible_direction(d, ox, oy, oz, alpha, u1, cos_phi, sin_phi);
   });
 }
@@ -62,7 +62,7 @@ void EvalGgxBatch(const GgxBatchModel& model, EvaluationBatch& batch) {
     const V specular = lanes::divide(d, dh * g2, four_cos);
     V fresnel[3];
     if (model.curve) {
-      lanes::fresnel_curve(d, model.curve, cos_d, fresnel);
+      lanes::fresnel_curve(d, &model.curve[0].r, cos_d, fresnel);
     } else {
       const V m5 = lanes::schlick_weight(d, cos_d);
       const V m = one - cos_d, m2 = m * m, basis = cos_d * m2 * m2 * m2;

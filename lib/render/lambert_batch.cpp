@@ -36,7 +36,7 @@ void SampleLambertBatch(SampleBatch& batch) {
   const D d;
   // Cosine sampling alone: no proposal, every draw past its weight of zero (ShadingModel::sample_direction).
   const ProposalWeights cosine_only{0.0, 1.0, 0.0, 0.0};
-  lanes::sample_proposal(d, cosine_only, Coat{}, batch, [&](V, V, V, V, V, V, V) {
+  lanes::sample_proposal(d, cosine_only, Coat{}, batch, false, [&](V, V, V, V, V, V, V) {
     const V zero = hn::Zero(d);
     return lanes::Direction{zero, zero, zero};
   });

@@ -26,6 +26,46 @@ namespace hn = hwy::HWY_NAMESPACE;
 using D = hn::ScalableTag<double>;
 using V = hn::Vec<D>;
 using DI = hn::RebindToSigned<D>;
+// Single precision: twice a double vector's lanes (one on the scalar baseline). The tabulated lobe's
+// kernels run in it (render/tabulated_batch.cpp); every helper below takes either.
+using DF = hn::ScalableTag<float>;
+using VF = hn::Vec<DF>;
+
+template <class DT>
+constexpr bool kSingle = sizeof(hn::TFromD<DT>) == 4;
+
+// A column's (double) lanes from p in DT's precision: hn::Lanes(dt) entries.
+template <class DT>
+HWY_INLINE hn::Vec<DT> load(DT dt, const double* p) {
+  if constexpr (!kSingle<DT>) {
+    return hn::LoadU(dt, p);
+  } else {
+    const D d;
+#if HWY_TARGET == HWY_SCALAR
+    return hn::DemoteTo(dt, hn::LoadU(d, p));
+#else
+    const hn::Half<DT> dh;
+    return hn::Combine(dt, hn::DemoteTo(dh, hn::LoadU(d, p + hn::Lanes(d))), hn::DemoteTo(dh, hn::LoadU(d, p)));
+#endif
+  }
+}
+
+// v's lanes into a column of doubles at p.
+template <class DT>
+HWY_INLINE void store(DT dt, hn::Vec<DT> v, double* p) {
+  if constexpr (!kSingle<DT>) {
+    hn::StoreU(v, dt, p);
+  } else {
+    const D d;
+#if HWY_TARGET == HWY_SCALAR
+    hn::StoreU(hn::PromoteTo(d, v), d, p);
+#else
+    const hn::Half<DT> dh;
+    hn::StoreU(hn::PromoteTo(d, hn::LowerHalf(dh, v)), d, p);
+    hn::StoreU(hn::PromoteTo(d, hn::UpperHalf(dh, v)), d, p + hn::Lanes(d));
+#endif
+  }
+}
 
 // 1 / x, as the division gives it to a few ulp. AVX-512 has a 14-bit estimate that two Newton steps,
 // y += y (1 - x y), make 56 bits in about half the division's time (vdivpd on 8 doubles issues once per
@@ -90,23 +130,47 @@ inline V sqrt(D d, V x) {
 #endif
 }
 
-// acos(c), c in [-1, 1], as Highway's Acos (asin's polynomial on [0, 1/2] at |c| or at sqrt((1 - |c|) / 2))
-// with sqrt above for the square root. The polynomial is Highway's internal AsinImpl (hwy 1.0.3, Debian
-// bookworm's): the lanes tests compare the result with std::acos's to 1e-10 on every target.
-inline V acos(D d, V c) {
-  const V a = hn::Abs(c), half = hn::Set(d, 0.5), half_pi = hn::Set(d, 0.5 * kPi);
-  const auto near_zero = a < half;
-  const V yy = hn::IfThenElse(near_zero, a * a, hn::NegMulAdd(a, half, half));
-  const V y = hn::IfThenElse(near_zero, a, sqrt(d, yy));
-  hn::impl::AsinImpl<double> poly;
-  const V asin_y = hn::MulAdd(poly.AsinPoly(d, yy, y), y * yy, y);
-  const V z = hn::IfThenElse(near_zero, half_pi - hn::CopySign(asin_y, c), asin_y + asin_y);
-  return hn::IfThenElse(hn::Or(near_zero, c >= hn::Zero(d)), z, hn::Set(d, kPi) - z);
+// The same in single precision: the division and the square root themselves (AVX2's and AVX-512's
+// single-precision estimates would each need a Newton step to reach it).
+inline VF reciprocal(DF d, VF x) { return hn::Set(d, 1.0f) / x; }
+inline VF divide(DF, VF a, VF b) { return a / b; }
+inline VF inverse_sqrt(DF d, VF x) { return hn::Set(d, 1.0f) / hn::Sqrt(x); }
+inline VF sqrt(DF, VF x) { return hn::Sqrt(x); }
+
+// x in DT's precision (a double constant rounded to single where DT is).
+template <class DT>
+HWY_INLINE hn::Vec<DT> set(DT d, double x) {
+  return hn::Set(d, static_cast<hn::TFromD<DT>>(x));
 }
 
-struct CosSin {
-  V c, s;
+// acos(c), c in [-1, 1], as Highway's Acos (asin's polynomial on [0, 1/2] at |c| or at sqrt((1 - |c|) / 2))
+// with sqrt above for the square root. The polynomial is Highway's internal AsinImpl (hwy 1.0.3, Debian
+// bookworm's): the lanes tests compare the result with std::acos's to 1e-10 on every target (double).
+// `one_minus_c`, where given, is 1 - c for c >= 1/2 from the caller's own terms: single precision rounds
+// c = cos(theta) near 1 to steps of 6e-8, which leaves a theta of 0.005 with 0.5% of error; 1 - c =
+// sin^2 / (1 + c) keeps it to the sine's rounding.
+template <class DT, class VT = hn::Vec<DT>>
+HWY_INLINE VT acos(DT d, VT c, VT one_minus_c) {
+  const VT a = hn::Abs(c), half = set(d, 0.5), half_pi = set(d, 0.5 * kPi);
+  const auto near_zero = a < half;
+  const VT yy = hn::IfThenElse(near_zero, a * a, half * one_minus_c);
+  const VT y = hn::IfThenElse(near_zero, a, sqrt(d, yy));
+  hn::impl::AsinImpl<hn::TFromD<DT>> poly;
+  const VT asin_y = hn::MulAdd(poly.AsinPoly(d, yy, y), y * yy, y);
+  const VT z = hn::IfThenElse(near_zero, half_pi - hn::CopySign(asin_y, c), asin_y + asin_y);
+  return hn::IfThenElse(hn::Or(near_zero, c >= hn::Zero(d)), z, set(d, kPi) - z);
+}
+template <class DT, class VT = hn::Vec<DT>>
+HWY_INLINE VT acos(DT d, VT c) {
+  const VT one = set(d, 1.0);
+  return acos(d, c, one - hn::Abs(c));
+}
+
+template <class VT>
+struct CosSinOf {
+  VT c, s;
 };
+using CosSin = CosSinOf<V>;
 
 // (-1)^k / n! for n = 2k and 2k + 1, k = 0..10: the coefficients of cos_sin's series.
 constexpr std::array<double, 22> kCosSinSeries = [] {
@@ -124,53 +188,59 @@ constexpr std::array<double, 22> kCosSinSeries = [] {
 // pi/2 (1e-18, 2e-17) are below double rounding; Estrin's scheme, half Horner's dependent chain. Accurate
 // to double rounding of 1 (absolute, as a direction's components need; sin(0) is 6e-17). Highway's Sin and
 // Cos reduce any argument, each on its own.
-inline CosSin cos_sin(D d, V phi) {
-  const V x = hn::Abs(phi) - hn::Set(d, 0.5 * kPi), x2 = x * x;
-  const auto c = [&](std::size_t n) { return hn::Set(d, kCosSinSeries[n]); };
-  const V cos_x = hn::impl::Estrin(x2, c(0), c(2), c(4), c(6), c(8), c(10), c(12), c(14), c(16), c(18), c(20));
-  const V sin_x = hn::impl::Estrin(x2, c(1), c(3), c(5), c(7), c(9), c(11), c(13), c(15), c(17), c(19), c(21));
+template <class DT, class VT = hn::Vec<DT>>
+HWY_INLINE CosSinOf<VT> cos_sin(DT d, VT phi) {
+  const VT x = hn::Abs(phi) - set(d, 0.5 * kPi), x2 = x * x;
+  const auto c = [&](std::size_t n) { return set(d, kCosSinSeries[n]); };
+  const VT cos_x = hn::impl::Estrin(x2, c(0), c(2), c(4), c(6), c(8), c(10), c(12), c(14), c(16), c(18), c(20));
+  const VT sin_x = hn::impl::Estrin(x2, c(1), c(3), c(5), c(7), c(9), c(11), c(13), c(15), c(17), c(19), c(21));
   return {hn::Neg(sin_x * x), hn::CopySign(cos_x, phi)};
 }
 
 // cos and sin of 2 pi u, u in [0, 1): the angle taken in [-pi, pi) (u - 1 is exact for u >= 1/2).
-inline CosSin cos_sin_turn(D d, V u) {
-  const V one = hn::Set(d, 1.0);
-  return cos_sin(d, hn::Set(d, 2.0 * kPi) * hn::IfThenElse(u >= hn::Set(d, 0.5), u - one, u));
+template <class DT, class VT = hn::Vec<DT>>
+HWY_INLINE CosSinOf<VT> cos_sin_turn(DT d, VT u) {
+  const VT one = set(d, 1.0);
+  return cos_sin(d, set(d, 2.0 * kPi) * hn::IfThenElse(u >= set(d, 0.5), u - one, u));
 }
 
 // Smith's Lambda of GGX for w above the horizon: (sqrt(1 + alpha^2 tan^2) - 1) / 2, with
 // alpha^2 sin^2 = wx^2 ax^2 + wy^2 ay^2; zero where that is (as for a denormal normal).
-inline V ggx_lambda(D d, V wx, V wy, V wz, V ax2, V ay2) {
-  const V a2t2 = divide(d, wx * wx * ax2 + wy * wy * ay2, wz * wz);
-  const V one = hn::Set(d, 1.0), half = hn::Set(d, 0.5);
+template <class DT, class VT = hn::Vec<DT>>
+HWY_INLINE VT ggx_lambda(DT d, VT wx, VT wy, VT wz, VT ax2, VT ay2) {
+  const VT a2t2 = divide(d, wx * wx * ax2 + wy * wy * ay2, wz * wz);
+  const VT one = set(d, 1.0), half = set(d, 0.5);
   return hn::IfThenElseZero(a2t2 > hn::Zero(d), half * (hn::Sqrt(one + a2t2) - one));
 }
 
 // D(h) of GGX for h above the horizon: ax^3 ay^3 / (pi e^2), e = hx^2 ay^2 + hy^2 ax^2 + hz^2 ax^2 ay^2.
-inline V ggx_ndf(D d, V hx, V hy, V hz, V ax2, V ay2, V numerator_over_pi) {
-  const V e = hx * hx * ay2 + hy * hy * ax2 + hz * hz * ax2 * ay2;
+template <class DT, class VT = hn::Vec<DT>>
+HWY_INLINE VT ggx_ndf(DT d, VT hx, VT hy, VT hz, VT ax2, VT ay2, VT numerator_over_pi) {
+  const VT e = hx * hx * ay2 + hy * hy * ax2 + hz * hz * ax2 * ay2;
   return divide(d, numerator_over_pi, e * e);
 }
 
 // (1 - mu)^5 of Schlick's approximation, mu clamped to [0, 1] as fresnel_schlick does.
-inline V schlick_weight(D d, V cos_d) {
-  const V m = hn::Min(hn::Max(hn::Set(d, 1.0) - cos_d, hn::Zero(d)), hn::Set(d, 1.0));
+template <class DT, class VT = hn::Vec<DT>>
+HWY_INLINE VT schlick_weight(DT d, VT cos_d) {
+  const VT m = hn::Min(hn::Max(set(d, 1.0) - cos_d, hn::Zero(d)), set(d, 1.0));
   return (m * m) * (m * m) * m;
 }
 
 // The tabulated Fresnel curve at cos(theta_d) in [0, 1]: linear between its entries, one per degree of
-// theta_d (FresnelCurve::eval).
-inline void fresnel_curve(D d, const Rgb* curve, V cos_d, V out[3]) {
+// theta_d (FresnelCurve::eval); `curve` holds its r, g, b entry by entry, in DT's precision.
+template <class DT, class VT = hn::Vec<DT>>
+HWY_INLINE void fresnel_curve(DT d, const hn::TFromD<DT>* curve, VT cos_d, VT out[3]) {
   constexpr int size = FresnelCurve::kSize;
-  const DI di;
-  const V zero = hn::Zero(d), one = hn::Set(d, 1.0);
-  const V x = hn::Min(hn::Max(lanes::acos(d, cos_d) * hn::Set(d, size / (0.5 * kPi)), zero), hn::Set(d, size - 1.0));
-  const auto j = hn::Min(hn::ConvertTo(di, x), hn::Set(di, std::int64_t{size - 2}));
-  const V t = x - hn::ConvertTo(d, j);
-  const auto j3 = j + j + j;  // three doubles per entry
-  const double* base = &curve[0].r;
+  const hn::RebindToSigned<DT> di;
+  using Index = hn::TFromD<decltype(di)>;
+  const VT zero = hn::Zero(d), one = set(d, 1.0);
+  const VT x = hn::Min(hn::Max(lanes::acos(d, cos_d) * set(d, size / (0.5 * kPi)), zero), set(d, size - 1.0));
+  const auto j = hn::Min(hn::ConvertTo(di, x), hn::Set(di, Index{size - 2}));
+  const VT t = x - hn::ConvertTo(d, j);
+  const auto j3 = j + j + j;  // three values per entry
   for (int c = 0; c < 3; ++c) {
-    const V lo = hn::GatherIndex(d, base + c, j3), hi = hn::GatherIndex(d, base + 3 + c, j3);
+    const VT lo = hn::GatherIndex(d, curve + c, j3), hi = hn::GatherIndex(d, curve + 3 + c, j3);
     out[c] = lo * (one - t) + hi * t;
   }
 }
@@ -178,100 +248,115 @@ inline void fresnel_curve(D d, const Rgb* curve, V cos_d, V out[3]) {
 // A clear coat's f (the same in R, G and B) and its visible normals' density of i (model/coat.h), from the
 // half vector h, cos(theta_d), 4 cos(theta_i) cos(theta_o) and whether o faces h; the caller masks the
 // pairs below the horizon.
-struct CoatTerms {
-  V f, pdf;
+template <class VT>
+struct CoatTermsOf {
+  VT f, pdf;
 };
-inline CoatTerms coat_terms(D d, const Coat& coat, V ox, V oy, V oz, V ix, V iy, V iz, V hx, V hy, V hz, V cos_d, V four_cos,
-                            hn::Mask<D> o_faces_h) {
+using CoatTerms = CoatTermsOf<V>;
+template <class DT, class VT = hn::Vec<DT>>
+HWY_INLINE CoatTermsOf<VT> coat_terms(DT d, const Coat& coat, VT ox, VT oy, VT oz, VT ix, VT iy, VT iz, VT hx, VT hy, VT hz, VT cos_d,
+                                      VT four_cos, hn::Mask<DT> o_faces_h) {
   const double a = coat.alpha;
-  const V a2 = hn::Set(d, a * a), numerator = hn::Set(d, a * a * a * a * a * a / kPi), one = hn::Set(d, 1.0);
-  const V dc = ggx_ndf(d, hx, hy, hz, a2, a2, numerator);
-  const V lc_o = ggx_lambda(d, ox, oy, oz, a2, a2), lc_i = ggx_lambda(d, ix, iy, iz, a2, a2);
-  const V f0 = hn::Set(d, coat.f0);
-  const V fc = f0 + (one - f0) * schlick_weight(d, cos_d);
-  return {fc * dc * (one / (one + lc_i + lc_o)) / four_cos, hn::IfThenElseZero(o_faces_h, (one / (one + lc_o)) * dc / (hn::Set(d, 4.0) * oz))};
+  const VT a2 = set(d, a * a), numerator = set(d, a * a * a * a * a * a / kPi), one = set(d, 1.0);
+  const VT dc = ggx_ndf(d, hx, hy, hz, a2, a2, numerator);
+  const VT lc_o = ggx_lambda(d, ox, oy, oz, a2, a2), lc_i = ggx_lambda(d, ix, iy, iz, a2, a2);
+  const VT f0 = set(d, coat.f0);
+  const VT fc = f0 + (one - f0) * schlick_weight(d, cos_d);
+  return {fc * dc * (one / (one + lc_i + lc_o)) / four_cos, hn::IfThenElseZero(o_faces_h, (one / (one + lc_o)) * dc / (set(d, 4.0) * oz))};
 }
 
-struct Direction {
-  V x, y, z;
+template <class VT>
+struct DirectionOf {
+  VT x, y, z;
 };
+using Direction = DirectionOf<V>;
 
 // o reflected about the unit normal h, 2 (o.h) h - o (reflect_about, core/vec.h).
-inline Direction reflect(D d, V ox, V oy, V oz, V hx, V hy, V hz) {
-  const V two_o_h = hn::Set(d, 2.0) * (ox * hx + oy * hy + oz * hz);
+template <class DT, class VT = hn::Vec<DT>>
+HWY_INLINE DirectionOf<VT> reflect(DT d, VT ox, VT oy, VT oz, VT hx, VT hy, VT hz) {
+  const VT two_o_h = set(d, 2.0) * (ox * hx + oy * hy + oz * hz);
   return {two_o_h * hx - ox, two_o_h * hy - oy, two_o_h * hz - oz};
 }
 
 // Visible normals of GGX (model/ggx_visible.h, Heitz 2018) for o above the horizon, with u1, u2 in [0, 1)
 // and (cos, sin) of phi = 2 pi u2: i, to be refused where i.z <= 0.
-inline Direction ggx_visible_direction(D d, V ox, V oy, V oz, V alpha, V u1, V cos_phi, V sin_phi) {
-  const V zero = hn::Zero(d), one = hn::Set(d, 1.0), half = hn::Set(d, 0.5);
+template <class DT, class VT = hn::Vec<DT>>
+HWY_INLINE DirectionOf<VT> ggx_visible_direction(DT d, VT ox, VT oy, VT oz, VT alpha, VT u1, VT cos_phi, VT sin_phi) {
+  const VT zero = hn::Zero(d), one = set(d, 1.0), half = set(d, 0.5);
   // to the unit-roughness frame
-  V vx = alpha * ox, vy = alpha * oy, vz = oz;
-  const V inv_v = inverse_sqrt(d, vx * vx + vy * vy + vz * vz);
+  VT vx = alpha * ox, vy = alpha * oy, vz = oz;
+  const VT inv_v = inverse_sqrt(d, vx * vx + vy * vy + vz * vz);
   vx = vx * inv_v, vy = vy * inv_v, vz = vz * inv_v;
-  const V len2 = vx * vx + vy * vy;
+  const VT len2 = vx * vx + vy * vy;
   const auto tilted = len2 > zero;
-  const V inv_len = inverse_sqrt(d, hn::IfThenElse(tilted, len2, one));
-  const V t1x = hn::IfThenElse(tilted, hn::Neg(vy) * inv_len, one), t1y = hn::IfThenElseZero(tilted, vx * inv_len);
+  const VT inv_len = inverse_sqrt(d, hn::IfThenElse(tilted, len2, one));
+  const VT t1x = hn::IfThenElse(tilted, hn::Neg(vy) * inv_len, one), t1y = hn::IfThenElseZero(tilted, vx * inv_len);
   // t2 = v x t1, t1.z = 0 (written out as glm::cross does)
-  const V t2x = vy * zero - t1y * vz, t2y = vz * t1x - zero * vx, t2z = vx * t1y - t1x * vy;
-  const V r = hn::Sqrt(u1);
-  const V p1 = r * cos_phi, s = half * (one + vz);
-  const V p2 = (one - s) * hn::Sqrt(hn::Max(zero, one - p1 * p1)) + s * r * sin_phi;
-  const V w = hn::Sqrt(hn::Max(zero, one - p1 * p1 - p2 * p2));
-  const V nx = p1 * t1x + p2 * t2x + w * vx, ny = p1 * t1y + p2 * t2y + w * vy, nz = p1 * zero + p2 * t2z + w * vz;
-  V hx = alpha * nx, hy = alpha * ny, hz = hn::Max(zero, nz);
-  const V inv_h = inverse_sqrt(d, hx * hx + hy * hy + hz * hz);
+  const VT t2x = vy * zero - t1y * vz, t2y = vz * t1x - zero * vx, t2z = vx * t1y - t1x * vy;
+  const VT r = hn::Sqrt(u1);
+  const VT p1 = r * cos_phi, s = half * (one + vz);
+  const VT p2 = (one - s) * hn::Sqrt(hn::Max(zero, one - p1 * p1)) + s * r * sin_phi;
+  const VT w = hn::Sqrt(hn::Max(zero, one - p1 * p1 - p2 * p2));
+  const VT nx = p1 * t1x + p2 * t2x + w * vx, ny = p1 * t1y + p2 * t2y + w * vy, nz = p1 * zero + p2 * t2z + w * vz;
+  VT hx = alpha * nx, hy = alpha * ny, hz = hn::Max(zero, nz);
+  const VT inv_h = inverse_sqrt(d, hx * hx + hy * hy + hz * hz);
   hx = hx * inv_h, hy = hy * inv_h, hz = hz * inv_h;
   return reflect(d, ox, oy, oz, hx, hy, hz);
 }
 
 // The density of i for a shading model that draws with `weights` (ShadingModel::pdf), from the lobe's and
 // the coat's densities (the body's is the cosine's).
-inline V mixture_density(D d, const ProposalWeights& weights, bool coat, V lobe_pdf, V coat_pdf, V iz) {
-  const V inv_pi = hn::Set(d, kInvPi);
-  V parts = hn::Set(d, weights.part_lobe) * lobe_pdf + hn::Set(d, weights.part_body) * iz * inv_pi;
-  if (coat) parts = parts + hn::Set(d, weights.part_coat) * coat_pdf;
-  return hn::Set(d, weights.lobe_weight) * parts + hn::Set(d, 1.0 - weights.lobe_weight) * (iz * inv_pi);
+template <class DT, class VT = hn::Vec<DT>>
+HWY_INLINE VT mixture_density(DT d, const ProposalWeights& weights, bool coat, VT lobe_pdf, VT coat_pdf, VT iz) {
+  const VT inv_pi = set(d, kInvPi);
+  VT parts = set(d, weights.part_lobe) * lobe_pdf + set(d, weights.part_body) * iz * inv_pi;
+  if (coat) parts = parts + set(d, weights.part_coat) * coat_pdf;
+  return set(d, weights.lobe_weight) * parts + set(d, 1.0 - weights.lobe_weight) * (iz * inv_pi);
 }
+
+// The largest number below 1 in DT's precision: where a number drawn in [0, 1) is clamped.
+template <class DT>
+constexpr double kBelowOne = kSingle<DT> ? 1.0 - 0x1.0p-24 : 1.0 - 1e-16;
 
 // Fills the batch's i and found for its padded_size() entries, drawn with `weights`
 // (ShadingModel::sample_direction). `lobe(ox, oy, oz, u1, u2, cos_phi, sin_phi)` draws the lobe's
 // direction (to be refused where i.z <= 0) with u1 rescaled to the lobe's part and (cos, sin) of
-// phi = 2 pi u2; it runs on every lane, the lanes that pick another part discard it.
-template <class Lobe>
-void sample_proposal(D d, const ProposalWeights& weights, const Coat& coat, SampleBatch& batch, const Lobe& lobe) {
+// phi = 2 pi u2 (where `lobe_turns`; zeros otherwise: the series costs as much as a tabulated lobe's
+// cell draw, and only GGX lobes, the body and the coat read it); it runs on every lane, the lanes that
+// pick another part discard it.
+template <class DT, class Lobe>
+void sample_proposal(DT d, const ProposalWeights& weights, const Coat& coat, SampleBatch& batch, bool lobe_turns, const Lobe& lobe) {
+  using VT = hn::Vec<DT>;
   const std::size_t n = batch.padded_size();
-  const V zero = hn::Zero(d), one = hn::Set(d, 1.0), two = hn::Set(d, 2.0);
-  const V quarter_pi = hn::Set(d, 0.25 * kPi), half_pi = hn::Set(d, 0.5 * kPi);
-  const V coat_alpha = hn::Set(d, coat.alpha), lobe_weight = hn::Set(d, weights.lobe_weight);
-  const V part_lobe = hn::Set(d, weights.part_lobe), part_body = hn::Set(d, weights.part_body);
+  const VT zero = hn::Zero(d), one = set(d, 1.0), two = set(d, 2.0);
+  const VT quarter_pi = set(d, 0.25 * kPi), half_pi = set(d, 0.5 * kPi);
+  const VT coat_alpha = set(d, coat.alpha), lobe_weight = set(d, weights.lobe_weight);
+  const VT part_lobe = set(d, weights.part_lobe), part_body = set(d, weights.part_body);
   // Their reciprocals once (a part the model lacks gives infinity; no lane that picks it reads the result).
-  const V per_lobe = hn::Set(d, 1.0 / weights.part_lobe), per_body = hn::Set(d, 1.0 / weights.part_body);
-  const V per_coat = hn::Set(d, 1.0 / weights.part_coat);
-  const bool with_coat = coat.present(), body = weights.part_body > 0.0;
+  const VT per_lobe = set(d, 1.0 / weights.part_lobe), per_body = set(d, 1.0 / weights.part_body);
+  const VT per_coat = set(d, 1.0 / weights.part_coat);
+  const bool with_coat = coat.present(), body = weights.part_body > 0.0, turns = lobe_turns || with_coat || body;
   for (std::size_t k = 0; k < n; k += hn::Lanes(d)) {
-    const V ox = hn::LoadU(d, batch.ox.data() + k), oy = hn::LoadU(d, batch.oy.data() + k), oz = hn::LoadU(d, batch.oz.data() + k);
-    const V u1 = hn::LoadU(d, batch.u1.data() + k), u2 = hn::LoadU(d, batch.u2.data() + k), u3 = hn::LoadU(d, batch.u3.data() + k);
-    const CosSin turn = cos_sin_turn(d, u2);
-    const V cos_phi = turn.c, sin_phi = turn.s;
+    const VT ox = load(d, batch.ox.data() + k), oy = load(d, batch.oy.data() + k), oz = load(d, batch.oz.data() + k);
+    const VT u1 = load(d, batch.u1.data() + k), u2 = load(d, batch.u2.data() + k), u3 = load(d, batch.u3.data() + k);
+    const CosSinOf<VT> turn = turns ? cos_sin_turn(d, u2) : CosSinOf<VT>{zero, zero};
+    const VT cos_phi = turn.c, sin_phi = turn.s;
     // The proposal (u3 < lobe_weight): u1 picks its part and is rescaled within it (ProposalParts::sample).
     const auto in_lobe = u1 < part_lobe;
-    Direction i = lobe(ox, oy, oz, u1 * per_lobe, u2, cos_phi, sin_phi);
-    const V rest = u1 - part_lobe;
+    DirectionOf<VT> i = lobe(ox, oy, oz, u1 * per_lobe, u2, cos_phi, sin_phi);
+    const VT rest = u1 - part_lobe;
     auto refused = hn::Not(in_lobe);  // parts past the lobe that this model lacks
     if (body) {
       const auto in_body = hn::AndNot(in_lobe, rest < part_body);
-      const V r = hn::Sqrt(rest * per_body);
+      const VT r = hn::Sqrt(rest * per_body);
       i.x = hn::IfThenElse(in_body, r * cos_phi, i.x), i.y = hn::IfThenElse(in_body, r * sin_phi, i.y);
       i.z = hn::IfThenElse(in_body, hn::Sqrt(hn::Max(zero, one - r * r)), i.z);
       refused = hn::AndNot(in_body, refused);
     }
     if (with_coat) {
       const auto in_coat = hn::AndNot(in_lobe, rest >= part_body);
-      const V u = hn::Min(hn::Max((rest - part_body) * per_coat, zero), hn::Set(d, 1.0 - 1e-16));
-      const Direction c = ggx_visible_direction(d, ox, oy, oz, coat_alpha, u, cos_phi, sin_phi);
+      const VT u = hn::Min(hn::Max((rest - part_body) * per_coat, zero), set(d, kBelowOne<DT>));
+      const DirectionOf<VT> c = ggx_visible_direction(d, ox, oy, oz, coat_alpha, u, cos_phi, sin_phi);
       i.x = hn::IfThenElse(in_coat, c.x, i.x), i.y = hn::IfThenElse(in_coat, c.y, i.y), i.z = hn::IfThenElse(in_coat, c.z, i.z);
       refused = hn::AndNot(in_coat, refused);
     }
@@ -279,23 +364,23 @@ void sample_proposal(D d, const ProposalWeights& weights, const Coat& coat, Samp
     // Skipped where no lane draws it (with 8 lanes, a quarter of the vectors).
     const auto cosine = u3 >= lobe_weight;
     if (!hn::AllFalse(d, cosine)) {
-      const V a = two * u1 - one, b = two * u2 - one;
+      const VT a = two * u1 - one, b = two * u2 - one;
       const auto a_wins = hn::Abs(a) > hn::Abs(b), centre = hn::And(a == zero, b == zero);
-      const V r = hn::IfThenElseZero(hn::Not(centre), hn::IfThenElse(a_wins, a, b));
+      const VT r = hn::IfThenElseZero(hn::Not(centre), hn::IfThenElse(a_wins, a, b));
       // b / a where |a| wins, else a / b; guarded, for the lanes that use neither.
-      const V num = hn::IfThenElse(a_wins, b, a), den = hn::IfThenElse(a_wins, a, b);
-      const V ratio = divide(d, num, hn::IfThenElse(den == zero, one, den));
-      const V disc_phi = hn::IfThenElseZero(hn::Not(centre), hn::IfThenElse(a_wins, quarter_pi * ratio, half_pi - quarter_pi * ratio));
-      const CosSin disc = cos_sin(d, disc_phi);
-      const V x = r * disc.c, y = r * disc.s;
+      const VT num = hn::IfThenElse(a_wins, b, a), den = hn::IfThenElse(a_wins, a, b);
+      const VT ratio = divide(d, num, hn::IfThenElse(den == zero, one, den));
+      const VT disc_phi = hn::IfThenElseZero(hn::Not(centre), hn::IfThenElse(a_wins, quarter_pi * ratio, half_pi - quarter_pi * ratio));
+      const CosSinOf<VT> disc = cos_sin(d, disc_phi);
+      const VT x = r * disc.c, y = r * disc.s;
       i.x = hn::IfThenElse(cosine, x, i.x), i.y = hn::IfThenElse(cosine, y, i.y);
       i.z = hn::IfThenElse(cosine, hn::Sqrt(hn::Max(zero, one - x * x - y * y)), i.z);
       refused = hn::AndNot(cosine, refused);
     }
     // The proposal's parts refuse i below the horizon; the cosine's i.z >= 0 stands.
     const auto found = hn::AndNot(refused, hn::And(oz > zero, hn::Or(cosine, i.z > zero)));
-    hn::StoreU(i.x, d, batch.ix.data() + k), hn::StoreU(i.y, d, batch.iy.data() + k), hn::StoreU(i.z, d, batch.iz.data() + k);
-    hn::StoreU(hn::IfThenElseZero(found, one), d, batch.found.data() + k);
+    store(d, i.x, batch.ix.data() + k), store(d, i.y, batch.iy.data() + k), store(d, i.z, batch.iz.data() + k);
+    store(d, hn::IfThenElseZero(found, one), batch.found.data() + k);
   }
 }
 

@@ -17,7 +17,8 @@ namespace facetfit {
 // values or those of an earlier use).
 class Columns {
  public:
-  // Lanes of the widest SIMD target (AVX-512: 8 doubles) times two.
+  // Lanes of the widest SIMD target times two (AVX-512: 8 doubles; the single-precision kernels read 16
+  // entries at once).
   static constexpr std::size_t kPadding = 16;
 
   std::size_t size() const { return size_; }

@@ -1,13 +1,16 @@
 // The tabulated microfacet model (a LUT: model/tabulated.h) over a batch, in SIMD lanes, as
 // render/ggx_batch.h does for GGX: ShadingModel's sample_direction and eval (f(o, i) and the sampling
 // density) with the lobe as BRDF and its visible slopes as proposal (model/visible_slopes.h), or the
-// proposal alone (its draws and density), every term theirs in the same order, so the two agree to
-// rounding (tests/test_render.cpp). The arc cosines of f's grid lookups are render/lanes-inl.h's
-// (Highway's polynomial); the proposal needs none.
+// proposal alone (its draws and density), every term theirs in the same order, in single precision: the
+// two agree to its rounding (tests/test_render.cpp), but for a draw whose number falls within rounding of
+// a boundary between cells. The arc cosines of f's grid lookups are render/lanes-inl.h's (Highway's
+// polynomial); the proposal needs none.
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <optional>
+#include <vector>
 
 #include "core/vec.h"
 #include "model/coat.h"
@@ -20,30 +23,36 @@ namespace facetfit {
 class TabulatedMicrofacet;
 class VisibleSlopeProposal;
 
+// The lanes work in single precision, as a renderer's SIMD kernels commonly do: twice a double vector's
+// lanes for the same instructions (the tabulated lobe's draws and evaluations took 58% of the LUT
+// sphere's render in double, docs/render-speed.md). Their tables are the model's, rounded to float.
 struct TabulatedBatchModel {
   // f's tables, set where `f` (the BRDF is the lobe itself, unstretched): the theta grid
   // (model/theta_grid.h) and D at its resolution + 1 nodes, G1 / cos(theta) at cos(theta) = (m / g1_size)^2,
-  // m = 0..g1_size (model/tabulated_ndf.h, G1Table), the Fresnel curve's 90 entries, the body.
+  // m = 0..g1_size (model/tabulated_ndf.h, G1Table), the Fresnel curve's 90 entries (r, g, b each), the body.
   bool f = false;
   int resolution = 0;
-  const double* ndf = nullptr;
-  const double* g1_ratios = nullptr;
+  const float* ndf = nullptr;
+  const float* g1_ratios = nullptr;
   int g1_size = 0;
   Smith smith = Smith::correlated;
-  const Rgb* curve = nullptr;
+  const float* curve = nullptr;
   Rgb body{0.0};
   double body_exponent = 1.0;  // Minnaert's k (model/body.h)
   // The proposal's: its visible normals' tables (model/visible_slopes.h, VisibleSlopes), and the coat
   // (its f too where `f`).
   double scale = 1.0;
-  const double* view_cdf = nullptr;
-  const double* view_mass = nullptr;
-  const std::int64_t* view_guide = nullptr;
-  const double* side_cdf = nullptr;
-  const double* side_mass = nullptr;
-  const std::int64_t* side_guide = nullptr;
+  const float* view_cdf = nullptr;
+  const float* view_mass = nullptr;
+  const std::int32_t* view_guide = nullptr;
+  const float* side_cdf = nullptr;
+  const float* side_mass = nullptr;
+  const std::int32_t* side_guide = nullptr;
   Coat coat;
   ProposalWeights weights;
+  // What the pointers above point into (shared by copies).
+  std::shared_ptr<const std::vector<float>> values;
+  std::shared_ptr<const std::vector<std::int32_t>> guides;
 
   // The lanes' model of `proposal` taken with weight lobe_weight, with f where `lobe` is the BRDF and
   // the lanes hold it (unstretched, the curve's 90 entries, the proposal's coat): the caller passes
