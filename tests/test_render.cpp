@@ -490,7 +490,7 @@ TEST(Wavefront, HitsAndSlotsEqualTheOneHitPath) {
 }
 
 TEST(Camera, SamplesInSimdLanesEqualOneAtATime) {
-  // The numbers exactly (integer arithmetic, and 53 bits to a double), the directions to rounding; pixels
+  // The numbers exactly (integer arithmetic, and 52 bits to a double), the directions to rounding; pixels
   // of a wide image (large keys), seeds that set the high bits, sample indices past 2^24 (shifted by 40),
   // batches of every length modulo the lane count; every target (the best one: AVX-512's whole 64-bit
   // multiplications where the CPU has it; AVX2's from 32-bit halves; the baseline).
@@ -513,6 +513,12 @@ TEST(Camera, SamplesInSimdLanesEqualOneAtATime) {
           batch.push(pixels.back().first, pixels.back().second);
         }
         camera_sample_batch(camera, seed, s, batch, target);
+        // Only the numbers a constant environment reads (the camera's and the BRDF sample's), into a batch
+        // whose columns hold something else: those, the same; the rest, not written.
+        CameraSampleBatch some = batch;
+        for (auto& column : some.u) std::fill(column.begin(), column.end(), -1.0);
+        const unsigned read = sample_numbers_read(true, false);
+        camera_sample_batch(camera, seed, s, some, target, read);
         for (std::size_t k = 0; k < n; ++k) {
           const auto [x, y] = pixels[k];
           const std::uint64_t start = SampleSequence::start(seed, SampleSequence::pixel_key(x, y), s);
@@ -520,6 +526,7 @@ TEST(Camera, SamplesInSimdLanesEqualOneAtATime) {
           for (int j = 0; j < kSampleNumbers; ++j) {
             u[j] = SampleSequence::number(start, j);
             ASSERT_EQ(batch.u[j][k], u[j]) << "number " << j << " of pixel (" << x << ", " << y << ")";
+            ASSERT_EQ(some.u[j][k], read >> j & 1u ? u[j] : -1.0) << "number " << j << " of pixel (" << x << ", " << y << ")";
             ASSERT_TRUE(u[j] >= 0.0 && u[j] < 1.0);
           }
           const Vec3 want = camera.direction(x, y, u[0], u[1]), got = batch.d(k);

@@ -20,7 +20,6 @@ namespace {
 
 using D = hn::ScalableTag<double>;
 using DU = hn::RebindToUnsigned<D>;
-using DI = hn::RebindToSigned<D>;
 using VU = hn::Vec<DU>;
 
 // The low 64 bits of a x c: AVX2 multiplies 32 x 32 bits, so from the halves (the high halves' product
@@ -43,22 +42,23 @@ VU mul(VU a, std::uint64_t c) {
 
 }  // namespace
 
-void DrawCameraSamples(const PinholeCamera& camera, std::uint64_t seed, int s, CameraSampleBatch& batch) {
+void DrawCameraSamples(const PinholeCamera& camera, std::uint64_t seed, int s, CameraSampleBatch& batch, unsigned numbers) {
   const D d;
   const DU du;
-  const DI di;
   const std::uint64_t seed_part = SampleSequence::start(seed, 0, s);
-  const auto scale = hn::Set(d, 0x1.0p-53), one = hn::Set(d, 1.0);
+  const auto one = hn::Set(d, 1.0);
+  const VU one_bits = hn::Set(du, SampleSequence::kOne);
   const auto to_sx = hn::Set(d, camera.to_sx), to_sy = hn::Set(d, camera.to_sy);
   const auto tan_half = hn::Set(d, camera.tan_half), aspect = hn::Set(d, camera.aspect);
   for (std::size_t k = 0; k < batch.padded_size(); k += hn::Lanes(d)) {
     const VU start = hn::Xor(hn::Set(du, seed_part), hn::LoadU(du, batch.key.data() + k));
     for (int j = 0; j < kSampleNumbers; ++j) {
+      if (!(numbers >> j & 1u)) continue;
       VU z = start + hn::Set(du, std::uint64_t(j + 1) * SampleSequence::kStep);
       z = mul(hn::Xor(z, hn::ShiftRight<30>(z)), SampleSequence::kMix1);
       z = mul(hn::Xor(z, hn::ShiftRight<27>(z)), SampleSequence::kMix2);
       z = hn::Xor(z, hn::ShiftRight<31>(z));
-      hn::StoreU(hn::ConvertTo(d, hn::BitCast(di, hn::ShiftRight<11>(z))) * scale, d, batch.u[j].data() + k);
+      hn::StoreU(hn::BitCast(d, hn::Or(hn::ShiftRight<12>(z), one_bits)) - one, d, batch.u[j].data() + k);
     }
     const auto sx = ((hn::LoadU(d, batch.x.data() + k) + hn::LoadU(d, batch.u[0].data() + k)) * to_sx - one) * tan_half * aspect;
     const auto sy = (one - (hn::LoadU(d, batch.y.data() + k) + hn::LoadU(d, batch.u[1].data() + k)) * to_sy) * tan_half;
@@ -81,8 +81,9 @@ HWY_AFTER_NAMESPACE();
 #include "render/simd_dispatch.h"
 namespace facetfit {
 
-void camera_sample_batch(const PinholeCamera& camera, std::uint64_t seed, int s, CameraSampleBatch& batch, SimdTarget target) {
-  FACETFIT_DISPATCH(target, DrawCameraSamples, camera, seed, s, batch);
+void camera_sample_batch(const PinholeCamera& camera, std::uint64_t seed, int s, CameraSampleBatch& batch, SimdTarget target, unsigned numbers) {
+  numbers |= 3u;  // the camera ray's
+  FACETFIT_DISPATCH(target, DrawCameraSamples, camera, seed, s, batch, numbers);
 }
 
 }  // namespace facetfit

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <cstring>
 #include <vector>
 
 #include "render/shading_batch.h"
@@ -26,14 +27,20 @@ struct SampleSequence {
   static std::uint64_t start(std::uint64_t seed, std::uint64_t pixel_key, int s) {
     return seed * 0x100000001B3ull ^ pixel_key ^ std::uint64_t(s) << 40;
   }
-  // Number j of the sequence from `start`: its (j + 1)-th state, mixed; a double in [0, 1) from 53 bits.
+  // Number j of the sequence from `start`: its (j + 1)-th state, mixed; a double in [0, 1) from its top 52
+  // bits, as the mantissa of a number in [1, 2) less 1 (exact; the lanes form it with an or, where AVX2
+  // has no conversion of 64-bit integers).
   static double number(std::uint64_t start, int j) {
     std::uint64_t z = start + std::uint64_t(j + 1) * kStep;
     z = (z ^ (z >> 30)) * kMix1;
     z = (z ^ (z >> 27)) * kMix2;
     z ^= z >> 31;
-    return double(z >> 11) * 0x1.0p-53;
+    const std::uint64_t bits = z >> 12 | kOne;
+    double x;
+    std::memcpy(&x, &bits, sizeof x);
+    return x - 1.0;
   }
+  static constexpr std::uint64_t kOne = 0x3FF0000000000000ull;  // 1.0's bits
 };
 
 // A pinhole camera: image point (x + u0, y + u1), in pixels from the top left, to a unit direction.
@@ -68,9 +75,18 @@ struct CameraSampleBatch : Columns {
   Vec3 d(std::size_t k) const { return {dx[k], dy[k], dz[k]}; }
 };
 
-// Fills u and d for the batch's padded_size() entries: SampleSequence::number j of each pixel's sample s,
-// and PinholeCamera::direction with its first two. `target`: which SIMD code runs (render/simd_targets.h;
-// the tests run each).
-void camera_sample_batch(const PinholeCamera& camera, std::uint64_t seed, int s, CameraSampleBatch& batch, SimdTarget target = SimdTarget::best);
+// Which of a sample's numbers a scene reads (bit j for number j): the jitter always, the environment's
+// light sample (2, 3) under a map, the BRDF sample (4 to 6) with an environment.
+constexpr unsigned kAllSampleNumbers = (1u << kSampleNumbers) - 1;
+inline unsigned sample_numbers_read(bool environment, bool light_sampled) {
+  return 3u | (light_sampled ? 12u : 0u) | (environment ? 112u : 0u);
+}
+
+// Fills u and d for the batch's padded_size() entries: SampleSequence::number j of each pixel's sample s
+// for each j in `numbers` (the others are not written: a third of a constant environment's draws are
+// never read), and PinholeCamera::direction with the first two. `target`: which SIMD code runs
+// (render/simd_targets.h; the tests run each).
+void camera_sample_batch(const PinholeCamera& camera, std::uint64_t seed, int s, CameraSampleBatch& batch, SimdTarget target = SimdTarget::best,
+                         unsigned numbers = kAllSampleNumbers);
 
 }  // namespace facetfit

@@ -167,6 +167,7 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
   const Rgb constant_radiance = env && env->is_constant() ? env->radiance(Vec3(0.0, 0.0, 1.0)) : Rgb(0.0);
   // The radiance of a ray that hits nothing.
   const auto background = [&](const Vec3& dir) { return light_sampled ? env->radiance(dir) : constant_radiance; };
+  const unsigned numbers_read = sample_numbers_read(env.has_value(), light_sampled);
   // Per material: whether the stream path shades its hits in lanes.
   std::vector<char> in_lanes;
   for (std::size_t m = 0; m < materials.size(); ++m) in_lanes.push_back(materials[m]->has_lanes() && !stretch_textures[m]);
@@ -395,7 +396,7 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
     tile_hits.resize_to(n);
     tile_hits.light_sampled = light_sampled;
     for (int s = first; s < last; ++s) {
-      camera_sample_batch(camera, seed, s, samples);
+      camera_sample_batch(camera, seed, s, samples, SimdTarget::best, numbers_read);
       std::copy_n(samples.dx.begin(), padded, cameras.dx.begin()), std::copy_n(samples.dy.begin(), padded, cameras.dy.begin());
       std::copy_n(samples.dz.begin(), padded, cameras.dz.begin());
       tracer.intersect(cameras, hits, true);
