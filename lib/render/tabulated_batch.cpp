@@ -59,10 +59,10 @@ V spline(DF d, const float* values, const GridPosition& p, int resolution) {
   w1 = hn::IfThenElse(past, w1 - w3, w1);
   w3 = hn::IfThenElseZero(hn::Not(past), w3);
   const I i3 = hn::Min(p.j + hn::Set(di, 2), hn::Set(di, resolution));
-  V v = w0 * hn::GatherIndex(d, values, i0);
-  v = v + w1 * hn::GatherIndex(d, values, p.j);
-  v = v + w2 * hn::GatherIndex(d, values, p.j + one);
-  return v + w3 * hn::GatherIndex(d, values, i3);
+  V v = w0 * lanes::gather(d, values, i0);
+  v = v + w1 * lanes::gather(d, values, p.j);
+  v = v + w2 * lanes::gather(d, values, p.j + one);
+  return v + w3 * lanes::gather(d, values, i3);
 }
 
 // G1 of the table (G1Table::operator()) at c = cos(theta) > 0; lanes at or below the horizon read 0.
@@ -73,7 +73,7 @@ V g1(DF d, const TabulatedBatchModel& model, V c) {
   const V x = hn::Sqrt(cz) * scale;
   const I m = hn::Min(hn::ConvertTo(di, x), hn::Set(di, model.g1_size - 1));
   const V t = x - hn::ConvertTo(d, m);
-  const V lo = hn::GatherIndex(d, model.g1_ratios, m), hi = hn::GatherIndex(d, model.g1_ratios, m + hn::Set(di, 1));
+  const V lo = lanes::gather(d, model.g1_ratios, m), hi = lanes::gather(d, model.g1_ratios, m + hn::Set(di, 1));
   const V ratio = hn::IfThenElse(x >= scale, hn::Set(d, model.g1_ratios[model.g1_size]), lo + t * (hi - lo));
   return hn::IfThenElseZero(c > zero, hn::Min(one, cz * ratio));
 }
@@ -90,11 +90,11 @@ HWY_INLINE CellDraw draw_cell(DF d, const float* cdf, const std::int32_t* guide,
   constexpr int entries = VisibleSlopes::kGuide;
   const I one_i = hn::Set(di, 1), last = hn::Set(di, n - 1), end = hn::Set(di, n);
   const I g = hn::Min(hn::Max(hn::ConvertTo(di, u * set(d, double(entries))), hn::Zero(di)), hn::Set(di, entries - 1));
-  I k = hn::GatherIndex(di, guide, guide_row + g);
+  I k = lanes::gather(di, guide, guide_row + g);
   // The sum at cell k is <= u. Most draws end within two cells of it: the next three sums at once, then
   // steps one cell at a time for lanes that go further (a guide entry over several cells of little mass).
-  const V c0 = hn::GatherIndex(d, cdf, row + k), c1 = hn::GatherIndex(d, cdf, row + hn::Min(k + one_i, end));
-  const V c2 = hn::GatherIndex(d, cdf, row + hn::Min(k + hn::Set(di, 2), end)), c3 = hn::GatherIndex(d, cdf, row + hn::Min(k + hn::Set(di, 3), end));
+  const V c0 = lanes::gather(d, cdf, row + k), c1 = lanes::gather(d, cdf, row + hn::Min(k + one_i, end));
+  const V c2 = lanes::gather(d, cdf, row + hn::Min(k + hn::Set(di, 2), end)), c3 = lanes::gather(d, cdf, row + hn::Min(k + hn::Set(di, 3), end));
   const auto a1 = hn::And(hn::RebindMask(d, k < last), c1 <= u);
   const auto a2 = hn::And(a1, hn::And(hn::RebindMask(d, k + one_i < last), c2 <= u));
   const auto a3 = hn::And(a2, hn::And(hn::RebindMask(d, k + hn::Set(di, 2) < last), c3 <= u));
@@ -104,9 +104,9 @@ HWY_INLINE CellDraw draw_cell(DF d, const float* cdf, const std::int32_t* guide,
     auto more = hn::RebindMask(di, a3);
     do {
       k = hn::IfThenElse(more, k + one_i, k);
-      more = hn::And(more, hn::And(k < last, hn::RebindMask(di, hn::GatherIndex(d, cdf, row + hn::Min(k + one_i, end)) <= u)));
+      more = hn::And(more, hn::And(k < last, hn::RebindMask(di, lanes::gather(d, cdf, row + hn::Min(k + one_i, end)) <= u)));
     } while (!hn::AllFalse(di, more));
-    lo = hn::GatherIndex(d, cdf, row + k), hi = hn::GatherIndex(d, cdf, row + k + one_i);
+    lo = lanes::gather(d, cdf, row + k), hi = lanes::gather(d, cdf, row + k + one_i);
   }
   const V zero = hn::Zero(d), one = set(d, 1.0), mass = hi - lo;
   const auto some = mass > zero;
@@ -259,8 +259,8 @@ void EvalTabulatedBatch(const TabulatedBatchModel& model, EvaluationBatch& batch
     const I j = hn::Min(hn::Max(hn::ConvertTo(di, w * set(d, double(side))), hn::Zero(di)), hn::Set(di, side - 1));
     const SliceLanes view = view_slice(d, oz, scale);
     const I at = view.s * hn::Set(di, cells) + i;
-    const V mixed = (one - view.t) * hn::GatherIndex(d, model.view_mass, at) + view.t * hn::GatherIndex(d, model.view_mass, at + hn::Set(di, cells));
-    const V cell = mixed * hn::GatherIndex(d, model.side_mass, i * hn::Set(di, side) + j);
+    const V mixed = (one - view.t) * lanes::gather(d, model.view_mass, at) + view.t * lanes::gather(d, model.view_mass, at + hn::Set(di, cells));
+    const V cell = mixed * lanes::gather(d, model.side_mass, i * hn::Set(di, side) + j);
     const V ab = a * b;
     const V per_h = lanes::divide(d, cell * set(d, 0.25 * cells * side) * (set(d, model.scale * model.scale) * hz), ab * ab);
     const V lobe_pdf = hn::IfThenElseZero(visible, lanes::divide(d, per_h, four * o_dot_h));
