@@ -154,6 +154,33 @@ HWY_INLINE hn::Vec<DT> gather(DT d, const T* base, hn::Vec<hn::RebindToSigned<DT
   return hn::GatherIndex(d, base, index);
 }
 
+// base[index + c], c = 0..3, in each lane: four neighbouring entries of a table at once. AVX2's eight
+// single-precision lanes load each lane's four together and transpose them (two 4 x 4 transposes),
+// where four gathers would load 32 floats one by one; elsewhere four gathers. Reads up to base[index + 3]
+// whether or not the caller uses it: the table needs three entries of room past the last index.
+template <class DT>
+struct Neighbours {
+  hn::Vec<DT> v[4];
+};
+template <class DT>
+HWY_INLINE Neighbours<DT> gather4(DT d, const float* base, hn::Vec<hn::RebindToSigned<DT>> index) {
+  const hn::RebindToSigned<DT> di;
+#if HWY_TARGET == HWY_AVX2
+  if constexpr (hn::MaxLanes(DT()) == 8) {
+    alignas(32) std::int32_t at[8];
+    hn::Store(index, di, at);
+    __m128 r0 = _mm_loadu_ps(base + at[0]), r1 = _mm_loadu_ps(base + at[1]), r2 = _mm_loadu_ps(base + at[2]), r3 = _mm_loadu_ps(base + at[3]);
+    __m128 r4 = _mm_loadu_ps(base + at[4]), r5 = _mm_loadu_ps(base + at[5]), r6 = _mm_loadu_ps(base + at[6]), r7 = _mm_loadu_ps(base + at[7]);
+    _MM_TRANSPOSE4_PS(r0, r1, r2, r3);
+    _MM_TRANSPOSE4_PS(r4, r5, r6, r7);
+    using VT = hn::Vec<DT>;
+    return {{VT{_mm256_set_m128(r4, r0)}, VT{_mm256_set_m128(r5, r1)}, VT{_mm256_set_m128(r6, r2)}, VT{_mm256_set_m128(r7, r3)}}};
+  }
+#endif
+  return {{gather(d, base, index), gather(d, base, index + hn::Set(di, 1)), gather(d, base, index + hn::Set(di, 2)),
+           gather(d, base, index + hn::Set(di, 3))}};
+}
+
 // x in DT's precision (a double constant rounded to single where DT is).
 template <class DT>
 HWY_INLINE hn::Vec<DT> set(DT d, double x) {
@@ -256,9 +283,15 @@ HWY_INLINE void fresnel_curve(DT d, const hn::TFromD<DT>* curve, VT cos_d, VT ou
   const auto j = hn::Min(hn::ConvertTo(di, x), hn::Set(di, Index{size - 2}));
   const VT t = x - hn::ConvertTo(d, j);
   const auto j3 = j + j + j;  // three values per entry
-  for (int c = 0; c < 3; ++c) {
-    const VT lo = gather(d, curve + c, j3), hi = gather(d, curve + 3 + c, j3);
-    out[c] = lo * (one - t) + hi * t;
+  if constexpr (kSingle<DT>) {
+    // Entries j and j + 1, r g b r and r g b r (the curve has room past its end: TabulatedBatchModel).
+    const Neighbours<DT> lo = gather4(d, curve, j3), hi = gather4(d, curve + 3, j3);
+    for (int c = 0; c < 3; ++c) out[c] = lo.v[c] * (one - t) + hi.v[c] * t;
+  } else {
+    for (int c = 0; c < 3; ++c) {
+      const VT lo = gather(d, curve + c, j3), hi = gather(d, curve + 3 + c, j3);
+      out[c] = lo * (one - t) + hi * t;
+    }
   }
 }
 

@@ -43,26 +43,25 @@ HWY_INLINE GridPosition locate(DF d, V c, V one_minus_c, int resolution) {
   return {j, x - hn::ConvertTo(d, j)};
 }
 
-// The Catmull-Rom spline through `values` at p (ThetaGrid::interpolate): node j - 1 mirrored to node 1
-// at j = 0, the ghost past the last node folded into the weights of the last two.
-V spline(DF d, const float* values, const GridPosition& p, int resolution) {
+// The Catmull-Rom spline through D's nodes at p (ThetaGrid::interpolate): node j - 1 mirrored to node 1
+// at j = 0, the ghost past the last node folded into the weights of the last two. `quads` holds interval
+// j's four nodes (j - 1 or 1, j, j + 1, j + 2 or the last) together (TabulatedBatchModel::ndf).
+V spline(DF d, const float* quads, const GridPosition& p, int resolution) {
   const DI di;
   const V t = p.t, t2 = t * t, t3 = t2 * t, half = set(d, 0.5);
   const V w0 = half * (hn::Neg(t) + set(d, 2.0) * t2 - t3);
   V w1 = half * (set(d, 2.0) - set(d, 5.0) * t2 + set(d, 3.0) * t3);
   V w2 = half * (t + set(d, 4.0) * t2 - set(d, 3.0) * t3);
   V w3 = half * (t3 - t2);
-  const I one = hn::Set(di, 1);
-  const I i0 = hn::IfThenElse(p.j == hn::Zero(di), one, p.j - one);
   const auto past = hn::RebindMask(d, p.j + hn::Set(di, 2) > hn::Set(di, resolution));
   w2 = hn::IfThenElse(past, w2 + set(d, 2.0) * w3, w2);
   w1 = hn::IfThenElse(past, w1 - w3, w1);
   w3 = hn::IfThenElseZero(hn::Not(past), w3);
-  const I i3 = hn::Min(p.j + hn::Set(di, 2), hn::Set(di, resolution));
-  V v = w0 * lanes::gather(d, values, i0);
-  v = v + w1 * lanes::gather(d, values, p.j);
-  v = v + w2 * lanes::gather(d, values, p.j + one);
-  return v + w3 * lanes::gather(d, values, i3);
+  const lanes::Neighbours<DF> node = lanes::gather4(d, quads, p.j * hn::Set(di, 4));
+  V v = w0 * node.v[0];
+  v = v + w1 * node.v[1];
+  v = v + w2 * node.v[2];
+  return v + w3 * node.v[3];
 }
 
 // G1 of the table (G1Table::operator()) at c = cos(theta) > 0; lanes at or below the horizon read 0.
@@ -73,7 +72,8 @@ V g1(DF d, const TabulatedBatchModel& model, V c) {
   const V x = hn::Sqrt(cz) * scale;
   const I m = hn::Min(hn::ConvertTo(di, x), hn::Set(di, model.g1_size - 1));
   const V t = x - hn::ConvertTo(d, m);
-  const V lo = lanes::gather(d, model.g1_ratios, m), hi = lanes::gather(d, model.g1_ratios, m + hn::Set(di, 1));
+  const lanes::Neighbours<DF> node = lanes::gather4(d, model.g1_ratios, m);
+  const V lo = node.v[0], hi = node.v[1];
   const V ratio = hn::IfThenElse(x >= scale, hn::Set(d, model.g1_ratios[model.g1_size]), lo + t * (hi - lo));
   return hn::IfThenElseZero(c > zero, hn::Min(one, cz * ratio));
 }
@@ -93,8 +93,10 @@ HWY_INLINE CellDraw draw_cell(DF d, const float* cdf, const std::int32_t* guide,
   I k = lanes::gather(di, guide, guide_row + g);
   // The sum at cell k is <= u. Most draws end within two cells of it: the next three sums at once, then
   // steps one cell at a time for lanes that go further (a guide entry over several cells of little mass).
-  const V c0 = lanes::gather(d, cdf, row + k), c1 = lanes::gather(d, cdf, row + hn::Min(k + one_i, end));
-  const V c2 = lanes::gather(d, cdf, row + hn::Min(k + hn::Set(di, 2), end)), c3 = lanes::gather(d, cdf, row + hn::Min(k + hn::Set(di, 3), end));
+  // Where a lane reads a sum past the row's last (cdf[row + n]), the masks below do not use it; the
+  // tables have room past their end (TabulatedBatchModel).
+  const lanes::Neighbours<DF> sums = lanes::gather4(d, cdf, row + k);
+  const V c0 = sums.v[0], c1 = sums.v[1], c2 = sums.v[2], c3 = sums.v[3];
   const auto a1 = hn::And(hn::RebindMask(d, k < last), c1 <= u);
   const auto a2 = hn::And(a1, hn::And(hn::RebindMask(d, k + one_i < last), c2 <= u));
   const auto a3 = hn::And(a2, hn::And(hn::RebindMask(d, k + hn::Set(di, 2) < last), c3 <= u));
@@ -307,12 +309,19 @@ TabulatedBatchModel TabulatedBatchModel::of(const VisibleSlopeProposal& proposal
   const std::size_t view_guide = put_guide(slopes.view_guide()), side_guide = put_guide(slopes.side_guide());
   std::size_t ndf = 0, g1_ratios = 0, curve = 0;
   if (tables) {
-    ndf = put(tables->ndf.ndf);
+    // Interval j's four nodes of the spline together (spline()).
+    const std::vector<double>& nodes = tables->ndf.ndf;
+    const int resolution = tables->ndf.grid.resolution;
+    std::vector<double> quads;
+    for (int j = 0; j < resolution; ++j)
+      for (const int at : {j == 0 ? 1 : j - 1, j, j + 1, std::min(j + 2, resolution)}) quads.push_back(nodes[std::size_t(at)]);
+    ndf = put(quads);
     g1_ratios = put(std::vector<double>(lobe->g1_table().ratios(), lobe->g1_table().ratios() + lobe->g1_table().size() + 1));
     std::vector<double> rgb;
     for (const Rgb& e : tables->fresnel.value) rgb.insert(rgb.end(), {e.r, e.g, e.b});
     curve = put(rgb);
   }
+  values->resize(values->size() + 4, 0.0f);  // room past the last table for the lanes' reads of four neighbours (lanes::gather4)
   m.view_cdf = values->data() + view_cdf, m.view_mass = values->data() + view_mass;
   m.side_cdf = values->data() + side_cdf, m.side_mass = values->data() + side_mass;
   m.view_guide = guides->data() + view_guide, m.side_guide = guides->data() + side_guide;

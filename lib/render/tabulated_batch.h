@@ -28,8 +28,10 @@ class VisibleSlopeProposal;
 // sphere's render in double, docs/render-speed.md). Their tables are the model's, rounded to float.
 struct TabulatedBatchModel {
   // f's tables, set where `f` (the BRDF is the lobe itself, unstretched): the theta grid
-  // (model/theta_grid.h) and D at its resolution + 1 nodes, G1 / cos(theta) at cos(theta) = (m / g1_size)^2,
-  // m = 0..g1_size (model/tabulated_ndf.h, G1Table), the Fresnel curve's 90 entries (r, g, b each), the body.
+  // (model/theta_grid.h) and D at its resolution + 1 nodes, the four a grid interval's spline reads
+  // together per interval; G1 / cos(theta) at cos(theta) = (m / g1_size)^2, m = 0..g1_size
+  // (model/tabulated_ndf.h, G1Table); the Fresnel curve's 90 entries (r, g, b each); the body. Every table
+  // has room for three more entries past its end (the lanes read four neighbours at once).
   bool f = false;
   int resolution = 0;
   const float* ndf = nullptr;
