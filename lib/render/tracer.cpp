@@ -182,13 +182,16 @@ void Tracer::occluded(const std::vector<Ray>& rays, std::vector<char>& blocked) 
 
 void Tracer::intersect(const RayBatch& rays, std::vector<Hit>& hits, bool coherent) const {
   const std::size_t n = rays.size();
-  hits.assign(n, Hit{});
+  hits.resize(n);
   if (!spheres_.empty()) {
     std::vector<double> t;
     std::vector<int> sphere;
     nearest_spheres(sphere_set_, rays, t, sphere);
+    // Every hit written once (the fill before the spheres' took 1.3% of a LUT sphere's render: perf).
     for (std::size_t k = 0; k < n; ++k)
-      if (sphere[k] >= 0) hits[k].t = t[k], hits[k].object = spheres_[std::size_t(sphere[k])].object;
+      hits[k] = sphere[k] >= 0 ? Hit{t[k], spheres_[std::size_t(sphere[k])].object, Vec3(0.0)} : Hit{};
+  } else {
+    std::fill(hits.begin(), hits.end(), Hit{});
   }
   if (!triangles_ || n == 0) return;
   std::vector<RTCRayHit> rh(n);
