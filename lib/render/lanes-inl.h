@@ -25,7 +25,6 @@ namespace hn = hwy::HWY_NAMESPACE;
 
 using D = hn::ScalableTag<double>;
 using V = hn::Vec<D>;
-using DI = hn::RebindToSigned<D>;
 // Single precision: twice a double vector's lanes (one on the scalar baseline). The tabulated lobe's
 // kernels run in it (render/tabulated_batch.cpp); every helper below takes either.
 using DF = hn::ScalableTag<float>;
