@@ -47,18 +47,21 @@ void DrawCameraSamples(const PinholeCamera& camera, std::uint64_t seed, int s, C
   const DU du;
   const std::uint64_t seed_part = SampleSequence::start(seed, 0, s);
   const auto one = hn::Set(d, 1.0);
-  const VU one_bits = hn::Set(du, SampleSequence::kOne);
+  const VU one_bits = hn::Set(du, SampleSequence::kOne), half_mantissa = hn::Set(du, SampleSequence::kHalfMantissa);
   const auto to_sx = hn::Set(d, camera.to_sx), to_sy = hn::Set(d, camera.to_sy);
   const auto tan_half = hn::Set(d, camera.tan_half), aspect = hn::Set(d, camera.aspect);
   for (std::size_t k = 0; k < batch.padded_size(); k += hn::Lanes(d)) {
     const VU start = hn::Xor(hn::Set(du, seed_part), hn::LoadU(du, batch.key.data() + k));
-    for (int j = 0; j < kSampleNumbers; ++j) {
-      if (!(numbers >> j & 1u)) continue;
-      VU z = start + hn::Set(du, std::uint64_t(j + 1) * SampleSequence::kStep);
+    for (int pair = 0; 2 * pair < kSampleNumbers; ++pair) {
+      const int j = 2 * pair;
+      const bool even = numbers >> j & 1u, odd = j + 1 < kSampleNumbers && (numbers >> (j + 1) & 1u);
+      if (!even && !odd) continue;
+      VU z = start + hn::Set(du, std::uint64_t(pair + 1) * SampleSequence::kStep);
       z = mul(hn::Xor(z, hn::ShiftRight<30>(z)), SampleSequence::kMix1);
       z = mul(hn::Xor(z, hn::ShiftRight<27>(z)), SampleSequence::kMix2);
       z = hn::Xor(z, hn::ShiftRight<31>(z));
-      hn::StoreU(hn::BitCast(d, hn::Or(hn::ShiftRight<12>(z), one_bits)) - one, d, batch.u[j].data() + k);
+      if (even) hn::StoreU(hn::BitCast(d, hn::Or(hn::And(hn::ShiftRight<12>(z), half_mantissa), one_bits)) - one, d, batch.u[j].data() + k);
+      if (odd) hn::StoreU(hn::BitCast(d, hn::Or(hn::ShiftRight<12>(hn::ShiftLeft<32>(z)), one_bits)) - one, d, batch.u[j + 1].data() + k);
     }
     const auto sx = ((hn::LoadU(d, batch.x.data() + k) + hn::LoadU(d, batch.u[0].data() + k)) * to_sx - one) * tan_half * aspect;
     const auto sy = (one - (hn::LoadU(d, batch.y.data() + k) + hn::LoadU(d, batch.u[1].data() + k)) * to_sy) * tan_half;
