@@ -351,8 +351,10 @@ TEST(Wavefront, HitsAndSlotsEqualTheOneHitPath) {
     for (std::size_t k = 0; k < n; ++k) {
       const Vec3 d = glm::normalize(Vec3(u(rng) - 0.5, u(rng) - 0.5, -4.0));
       tile.dx[k] = d.x, tile.dy[k] = d.y, tile.dz[k] = d.z;
-      tile.t[k] = 3.0 + u(rng), tile.material[k] = double(k % 3 == 2 ? 1 : 0), tile.sphere[k] = k % 2 ? 1.0 : 0.0;
+      tile.t[k] = 3.0 + u(rng), tile.material[k] = double(k % 3 == 2 ? 1 : 0);
       const Vec3 g = k % 2 ? Vec3(u(rng), u(rng), -u(rng)) : unit();  // a centre, or a triangle's normal
+      // A sphere through the hit: its radius the centre's distance from it.
+      tile.inv_radius[k] = k % 2 ? 1.0 / glm::length(camera + tile.t[k] * d - g) : 0.0;
       tile.gx[k] = g.x, tile.gy[k] = g.y, tile.gz[k] = g.z;
       const Vec3 l = unit();
       tile.lx[k] = l.x, tile.ly[k] = l.y, tile.lz[k] = l.z, tile.light_pdf[k] = k % 5 ? 0.1 : 0.0;
@@ -380,7 +382,8 @@ TEST(Wavefront, HitsAndSlotsEqualTheOneHitPath) {
           EXPECT_EQ(hits.owner[row], double(k)) << where;
           const Vec3 dir(tile.dx[k], tile.dy[k], tile.dz[k]);
           const Vec3 p = camera + tile.t[k] * dir;
-          Vec3 nrm = tile.sphere[k] != 0.0 ? glm::normalize(p - Vec3(tile.gx[k], tile.gy[k], tile.gz[k])) : glm::normalize(Vec3(tile.gx[k], tile.gy[k], tile.gz[k]));
+          Vec3 nrm = tile.inv_radius[k] != 0.0 ? (p - Vec3(tile.gx[k], tile.gy[k], tile.gz[k])) * tile.inv_radius[k]
+                                               : glm::normalize(Vec3(tile.gx[k], tile.gy[k], tile.gz[k]));
           if (glm::dot(nrm, dir) > 0.0) nrm = -nrm;
           const Frame frame = with_tangent ? Frame(nrm, tangent) : Frame(nrm);
           const Vec3 o = frame.to_local(-dir), origin = p + eps * nrm;

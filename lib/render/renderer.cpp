@@ -193,7 +193,8 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
     }
     const ObjectDesc& object = desc.objects[std::size_t(hit.object)];
     const Vec3 p = cam.position + hit.t * dir;
-    Vec3 n = object.kind == ObjectDesc::Kind::sphere ? glm::normalize(p - object.center) : glm::normalize(hit.ng);
+    // On a sphere p lies at its radius: (p - centre) / radius is the unit normal, as the lanes have it.
+    Vec3 n = object.kind == ObjectDesc::Kind::sphere ? (p - object.center) * (1.0 / object.radius) : glm::normalize(hit.ng);
     if (glm::dot(n, dir) > 0.0) n = -n;  // shade the side the camera sees
     const std::optional<Vec3>& tangent = tangents[std::size_t(object_material[std::size_t(hit.object)])];
     planned.frame = tangent ? Frame(n, *tangent) : Frame(n);
@@ -431,7 +432,7 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
         const ObjectDesc& object = desc.objects[std::size_t(hit.object)];
         const bool sphere = object.kind == ObjectDesc::Kind::sphere;
         const Vec3 g = sphere ? object.center : hit.ng;
-        tile_hits.sphere[k] = sphere ? 1.0 : 0.0, tile_hits.gx[k] = g.x, tile_hits.gy[k] = g.y, tile_hits.gz[k] = g.z;
+        tile_hits.inv_radius[k] = sphere ? 1.0 / object.radius : 0.0, tile_hits.gx[k] = g.x, tile_hits.gy[k] = g.y, tile_hits.gz[k] = g.z;
         if (light_sampled) {
           const Environment::Sample ls = env->sample(samples.u[2][k], samples.u[3][k]);
           tile_hits.lx[k] = ls.d.x, tile_hits.ly[k] = ls.d.y, tile_hits.lz[k] = ls.d.z, tile_hits.light_pdf[k] = ls.pdf;

@@ -83,17 +83,21 @@ constexpr CompressTable kCompress = [] {
   }
   return t;
 }();
+// Where every lane stays (most vectors inside an object), a plain store: Zen's cross-lane permutation costs
+// three operations a column.
 struct ToFront {
   decltype(hn::SetTableIndices(D(), static_cast<const std::int64_t*>(nullptr))) index;
   std::size_t at;
+  bool whole;
   HWY_INLINE void operator()(D d, V v, std::vector<double>& column) const {
-    hn::StoreU(hn::TableLookupLanes(v, index), d, column.data() + at);
+    hn::StoreU(whole ? v : hn::TableLookupLanes(v, index), d, column.data() + at);
   }
 };
 HWY_INLINE ToFront to_front(D d, M m, std::size_t at) {
   std::uint8_t bits[8] = {};
   hn::StoreMaskBits(d, m, bits);
-  return {hn::SetTableIndices(d, kCompress.index[bits[0] & 15]), at};
+  const int lanes = bits[0] & 15;
+  return {hn::SetTableIndices(d, kCompress.index[lanes]), at, lanes == (1 << hn::Lanes(d)) - 1};
 }
 #endif
 
@@ -142,8 +146,13 @@ void PlaceHits(const TileHits& tile, const Vec3& camera, double eps, double mate
     const Vec3V dir{load(d, tile.dx, k), load(d, tile.dy, k), load(d, tile.dz, k)};
     const Vec3V p{hn::Set(d, camera.x) + t * dir.x, hn::Set(d, camera.y) + t * dir.y, hn::Set(d, camera.z) + t * dir.z};
     const Vec3V g{load(d, tile.gx, k), load(d, tile.gy, k), load(d, tile.gz, k)};
-    const M sphere = load(d, tile.sphere, k) != zero;
-    Vec3V nrm = normalize(d, {hn::IfThenElse(sphere, p.x - g.x, g.x), hn::IfThenElse(sphere, p.y - g.y, g.y), hn::IfThenElse(sphere, p.z - g.z, g.z)});
+    const V inv_radius = load(d, tile.inv_radius, k);
+    Vec3V nrm{(p.x - g.x) * inv_radius, (p.y - g.y) * inv_radius, (p.z - g.z) * inv_radius};
+    const M triangle = hn::And(mine, inv_radius == zero);
+    if (!hn::AllFalse(d, triangle)) {
+      const Vec3V ng = normalize(d, g);
+      nrm = {hn::IfThenElse(triangle, ng.x, nrm.x), hn::IfThenElse(triangle, ng.y, nrm.y), hn::IfThenElse(triangle, ng.z, nrm.z)};
+    }
     // Shade the side the camera sees.
     const M back = dot(nrm, dir) > zero;
     nrm = {hn::IfThenElse(back, hn::Neg(nrm.x), nrm.x), hn::IfThenElse(back, hn::Neg(nrm.y), nrm.y), hn::IfThenElse(back, hn::Neg(nrm.z), nrm.z)};

@@ -19,10 +19,11 @@
 namespace facetfit {
 
 // A tile's camera rays for one sample index, per pixel, in columns: the hit (t, infinity for none; the
-// material's index, -1 for none; a sphere's centre or a triangle's normal in g), the ray's direction, the
+// material's index, -1 for none; a sphere's centre and the reciprocal of its radius, or a triangle's normal
+// and 0, in g and inv_radius), the ray's direction, the
 // environment's light sample (world direction, density, radiance) and the BRDF sample's numbers.
 struct TileHits : Columns {
-  std::vector<double> t, material, sphere, gx, gy, gz;
+  std::vector<double> t, material, inv_radius, gx, gy, gz;
   std::vector<double> dx, dy, dz;
   std::vector<double> lx, ly, lz, light_pdf, light_r, light_g, light_b;
   std::vector<double> u1, u2, u3;
@@ -32,7 +33,7 @@ struct TileHits : Columns {
   // n pixels, whose columns the caller writes in place.
   void resize_to(std::size_t n) {
     ensure(n, [this](std::size_t m) {
-      resize({&t, &material, &sphere, &gx, &gy, &dx, &dy, &lx, &ly, &light_r, &light_g, &light_b}, m, 0.0);
+      resize({&t, &material, &inv_radius, &gx, &gy, &dx, &dy, &lx, &ly, &light_r, &light_g, &light_b}, m, 0.0);
       resize({&gz, &dz, &lz, &light_pdf}, m, 1.0);
       resize({&u1, &u2, &u3}, m, 0.5);
     });
