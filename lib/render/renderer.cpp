@@ -104,8 +104,16 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
   }
 
   const Tracer tracer = referenced_by("a mesh object", [&] { return Tracer(desc); });
-  std::vector<int> object_material;  // per object
-  for (const ObjectDesc& o : desc.objects) object_material.push_back(material_index.at(o.material));
+  // Per object: its material, and what the lanes read of it per hit (a sphere's centre and the reciprocal
+  // of its radius; 0 for a mesh), so that the tile loop does not reach into the scene's description.
+  std::vector<int> object_material;
+  std::vector<double> object_inv_radius;
+  std::vector<Vec3> object_center;
+  for (const ObjectDesc& o : desc.objects) {
+    object_material.push_back(material_index.at(o.material));
+    const bool sphere = o.kind == ObjectDesc::Kind::sphere;
+    object_inv_radius.push_back(sphere ? 1.0 / o.radius : 0.0), object_center.push_back(sphere ? o.center : Vec3(0.0));
+  }
 
   const CameraDesc& cam = desc.camera;
   const int width = cam.width, height = cam.height;
@@ -191,10 +199,10 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
       planned.alpha = 0.0;
       return;
     }
-    const ObjectDesc& object = desc.objects[std::size_t(hit.object)];
     const Vec3 p = cam.position + hit.t * dir;
     // On a sphere p lies at its radius: (p - centre) / radius is the unit normal, as the lanes have it.
-    Vec3 n = object.kind == ObjectDesc::Kind::sphere ? (p - object.center) * (1.0 / object.radius) : glm::normalize(hit.ng);
+    const double inv_radius = object_inv_radius[std::size_t(hit.object)];
+    Vec3 n = inv_radius != 0.0 ? (p - object_center[std::size_t(hit.object)]) * inv_radius : glm::normalize(hit.ng);
     if (glm::dot(n, dir) > 0.0) n = -n;  // shade the side the camera sees
     const std::optional<Vec3>& tangent = tangents[std::size_t(object_material[std::size_t(hit.object)])];
     planned.frame = tangent ? Frame(n, *tangent) : Frame(n);
@@ -416,7 +424,7 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
           alpha[k] = 0.0;
           continue;
         }
-        const std::size_t material = std::size_t(object_material[std::size_t(hit.object)]);
+        const std::size_t object = std::size_t(hit.object), material = std::size_t(object_material[object]);
         if (!in_lanes[material]) {
           Planned& pk = planned[k];
           place(hit, samples.d(k), pk);
@@ -429,10 +437,9 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
         alpha[k] = 1.0;
         present[material] = 1;
         tile_hits.material[k] = double(material), tile_hits.t[k] = hit.t;
-        const ObjectDesc& object = desc.objects[std::size_t(hit.object)];
-        const bool sphere = object.kind == ObjectDesc::Kind::sphere;
-        const Vec3 g = sphere ? object.center : hit.ng;
-        tile_hits.inv_radius[k] = sphere ? 1.0 / object.radius : 0.0, tile_hits.gx[k] = g.x, tile_hits.gy[k] = g.y, tile_hits.gz[k] = g.z;
+        const double inv_radius = object_inv_radius[object];
+        const Vec3 g = inv_radius != 0.0 ? object_center[object] : hit.ng;
+        tile_hits.inv_radius[k] = inv_radius, tile_hits.gx[k] = g.x, tile_hits.gy[k] = g.y, tile_hits.gz[k] = g.z;
         if (light_sampled) {
           const Environment::Sample ls = env->sample(samples.u[2][k], samples.u[3][k]);
           tile_hits.lx[k] = ls.d.x, tile_hits.ly[k] = ls.d.y, tile_hits.lz[k] = ls.d.z, tile_hits.light_pdf[k] = ls.pdf;

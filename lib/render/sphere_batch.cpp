@@ -52,6 +52,8 @@ HWY_INLINE V intersect(D d, V cx, V cy, V cz, V radius, const RayV& r, V tfar) {
   const V nx = fx + s * r.dx, ny = fy + s * r.dy, nz = fz + s * r.dz;
   const V chord2 = r2 - (nx * nx + ny * ny + nz * nz);
   const auto meets = hn::AndNot(away, chord2 >= zero);
+  // Camera rays past a sphere's outline miss it together: no square root, no second division.
+  if (hn::AllFalse(d, meets)) return inf;
   const V q = b + hn::CopySign(hn::Sqrt(hn::IfThenElseZero(meets, a * chord2)), b);
   const V t0 = q * inv_a, t1 = hn::IfThenElse(q != zero, lanes::divide(d, c, hn::IfThenElse(q != zero, q, hn::Set(d, 1.0))), t0);
   const auto swap = t0 > t1;
