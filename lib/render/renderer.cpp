@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <limits>
 
 #include "core/error.h"
@@ -287,8 +288,9 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
     const std::uint64_t sequence = SampleSequence::start(seed, SampleSequence::pixel_key(x, y), s);
     for (int k = 0; k < kSampleNumbers; ++k) u[k] = SampleSequence::number(sequence, k);
   };
-  // A sample added to a pixel's sums (r, g, b, alpha): a radiance that is not finite adds nothing. No
-  // branch (x - x is 0 for a finite x, NaN otherwise), so the tile's loop over its pixels vectorizes.
+  // A sample added to a pixel's sums (r, g, b, alpha): a radiance that is not finite adds nothing (x - x
+  // is 0 for a finite x, NaN otherwise). The stream path adds a tile's in lanes (add_samples: GCC left
+  // this loop scalar, with a branch).
   const auto accumulate = [](double& r, double& g, double& b, double& a, double sr, double sg, double sb, double alpha) {
     const bool finite = (sr - sr) + (sg - sg) + (sb - sb) == 0.0;
     r += finite ? sr : 0.0, g += finite ? sg : 0.0, b += finite ? sb : 0.0, a += alpha;
@@ -483,11 +485,20 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
         if (w.hits.size() == 0) continue;
         const ShadowBatch& b = w.shadows;
         const double* value[3] = {b.value_r.data(), b.value_g.data(), b.value_b.data()};
+        // The value's bits and-ed with all ones or none: GCC made the choice a branch, mispredicted at the
+        // edges of shadows and of the lit side.
         const auto add = [&](std::size_t begin, std::size_t end) {
           for (std::size_t e = begin; e < end; ++e) {
-            const bool lights = b.casts[e] != 0.0 && !w.blocked[e];
+            const std::uint64_t keep = std::uint64_t(0) - std::uint64_t((b.casts[e] != 0.0) & (w.blocked[e] == 0));
             const std::size_t k = std::size_t(b.owner[e]);
-            for (int c = 0; c < 3; ++c) radiance[c][k] += lights ? value[c][e] : 0.0;
+            for (int c = 0; c < 3; ++c) {
+              std::uint64_t bits;
+              std::memcpy(&bits, &value[c][e], sizeof bits);
+              bits &= keep;
+              double v;
+              std::memcpy(&v, &bits, sizeof v);
+              radiance[c][k] += v;
+            }
           }
         };
         add(0, w.ranges.lights_begin);
@@ -499,8 +510,7 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
         if (pk.ray_last > pk.ray_first) add_unblocked(blocked, values, pk.ray_first, pk.ray_last, pk.radiance);
         for (int c = 0; c < 3; ++c) radiance[c][k] = pk.radiance[c];
       }
-      for (std::size_t k = 0; k < n; ++k)
-        accumulate(sum[0][k], sum[1][k], sum[2][k], sum[3][k], radiance[0][k], radiance[1][k], radiance[2][k], alpha[k]);
+      add_samples(radiance, alpha, sum, n);
     }
     for (std::size_t k = 0; k < n; ++k) {
       double* acc = pixel_accum(int(samples.x[k]), int(samples.y[k]));

@@ -310,6 +310,26 @@ void ShadowValues(ShadowBatch& batch, const SlotRanges& ranges) {
   }
 }
 
+void AddSamples(const double* const radiance[3], const double* alpha, double* const sum[4], std::size_t n) {
+  const D d;
+  const std::size_t lanes = hn::Lanes(d);
+  std::size_t k = 0;
+  for (; k + lanes <= n; k += lanes) {
+    const V r = hn::LoadU(d, radiance[0] + k), g = hn::LoadU(d, radiance[1] + k), b = hn::LoadU(d, radiance[2] + k);
+    // x - x is 0 for a finite x, NaN otherwise.
+    const M finite = ((r - r) + (g - g) + (b - b)) == hn::Zero(d);
+    hn::StoreU(hn::LoadU(d, sum[0] + k) + hn::IfThenElseZero(finite, r), d, sum[0] + k);
+    hn::StoreU(hn::LoadU(d, sum[1] + k) + hn::IfThenElseZero(finite, g), d, sum[1] + k);
+    hn::StoreU(hn::LoadU(d, sum[2] + k) + hn::IfThenElseZero(finite, b), d, sum[2] + k);
+    hn::StoreU(hn::LoadU(d, sum[3] + k) + hn::LoadU(d, alpha + k), d, sum[3] + k);
+  }
+  for (; k < n; ++k) {
+    const bool finite = (radiance[0][k] - radiance[0][k]) + (radiance[1][k] - radiance[1][k]) + (radiance[2][k] - radiance[2][k]) == 0.0;
+    for (int c = 0; c < 3; ++c) sum[c][k] += finite ? radiance[c][k] : 0.0;
+    sum[3][k] += alpha[k];
+  }
+}
+
 // NOLINTNEXTLINE(google-readability-namespace-comments)
 }  // namespace HWY_NAMESPACE
 }  // namespace facetfit
@@ -337,6 +357,10 @@ void brdf_slots(const HitBatch& hits, const Rgb& radiance, double tnear, ShadowB
 
 void shadow_values(ShadowBatch& batch, const SlotRanges& ranges, SimdTarget target) {
   FACETFIT_DISPATCH(target, ShadowValues, batch, ranges);
+}
+
+void add_samples(const double* const radiance[3], const double* alpha, double* const sum[4], std::size_t n, SimdTarget target) {
+  FACETFIT_DISPATCH(target, AddSamples, radiance, alpha, sum, n);
 }
 
 }  // namespace facetfit

@@ -133,4 +133,10 @@ void brdf_slots(const HitBatch& hits, const Rgb& radiance, double tnear, ShadowB
 // times the cosine; casts 0 for a BRDF sample of zero density.
 void shadow_values(ShadowBatch& batch, const SlotRanges& ranges, SimdTarget target = SimdTarget::best);
 
+// A sample's radiance and alpha added to each of n pixels' sums, as the renderer's one-ray path adds them:
+// sum[c][k] += radiance[c][k] (c = r, g, b) where all three are finite, nothing where one is not, and
+// sum[3][k] += alpha[k].
+void add_samples(const double* const radiance[3], const double* alpha, double* const sum[4], std::size_t n,
+                 SimdTarget target = SimdTarget::best);
+
 }  // namespace facetfit
