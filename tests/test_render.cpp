@@ -492,8 +492,37 @@ TEST(Wavefront, HitsAndSlotsEqualTheOneHitPath) {
   }
 }
 
+TEST(Wavefront, SamplesAddToTheSumsAsOneAtATime) {
+  // Lengths around the lane counts, radiance with a NaN or an infinity in one channel (the pixel adds
+  // nothing but its alpha), every target; the sums exactly.
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (const std::size_t n : {1u, 3u, 4u, 7u, 8u, 9u, 17u, 256u})
+    for (const SimdTarget target : kSimdTargets) {
+      std::vector<double> radiance[3], alpha(n), sum[4], want[4];
+      for (auto& c : radiance) c.resize(n);
+      for (int c = 0; c < 4; ++c) sum[c].resize(n);
+      for (std::size_t k = 0; k < n; ++k) {
+        for (auto& c : radiance) c[k] = u(rng);
+        if (k % 5 == 1) radiance[k % 3][k] = k % 2 ? std::numeric_limits<double>::quiet_NaN() : std::numeric_limits<double>::infinity();
+        alpha[k] = double(k % 2);
+        for (int c = 0; c < 4; ++c) sum[c][k] = u(rng);
+      }
+      for (int c = 0; c < 4; ++c) want[c] = sum[c];
+      for (std::size_t k = 0; k < n; ++k) {
+        const bool finite = std::isfinite(radiance[0][k]) && std::isfinite(radiance[1][k]) && std::isfinite(radiance[2][k]);
+        for (int c = 0; c < 3; ++c) want[c][k] += finite ? radiance[c][k] : 0.0;
+        want[3][k] += alpha[k];
+      }
+      const double* in[3] = {radiance[0].data(), radiance[1].data(), radiance[2].data()};
+      double* out[4] = {sum[0].data(), sum[1].data(), sum[2].data(), sum[3].data()};
+      add_samples(in, alpha.data(), out, n, target);
+      for (int c = 0; c < 4; ++c) EXPECT_EQ(sum[c], want[c]) << n << " " << simd_target_name(target) << " channel " << c;
+    }
+}
+
 TEST(Camera, SamplesInSimdLanesEqualOneAtATime) {
-  // The numbers exactly (integer arithmetic, and 52 bits to a double), the directions to rounding; pixels
+  // The numbers exactly (integer arithmetic, and 32 bits to a double), the directions to rounding; pixels
   // of a wide image (large keys), seeds that set the high bits, sample indices past 2^24 (shifted by 40),
   // batches of every length modulo the lane count; every target (the best one: AVX-512's whole 64-bit
   // multiplications where the CPU has it; AVX2's from 32-bit halves; the baseline).
