@@ -187,7 +187,10 @@ TEST(Tracer, SphereRootsStayAccurateFarAwayAndAtGrazingAngles) {
 TEST(Tracer, SpheresInLanesEqualTheClosedForm) {
   SphereSet spheres;
   const std::vector<std::pair<Vec3, double>> list = {{Vec3(0, 0, 0), 1.0}, {Vec3(1.5, 0.2, -0.3), 0.5}, {Vec3(-2, 1, 1), 0.25}};
-  for (const auto& [c, r] : list) spheres.cx.push_back(c.x), spheres.cy.push_back(c.y), spheres.cz.push_back(c.z), spheres.radius.push_back(r);
+  // Ids other than the indices, as the tracer's object indices may be.
+  for (const auto& [c, r] : list)
+    spheres.cx.push_back(c.x), spheres.cy.push_back(c.y), spheres.cz.push_back(c.z), spheres.radius.push_back(r),
+        spheres.id.push_back(double(10 + spheres.id.size()));
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   const auto direction = [&] {
@@ -218,7 +221,7 @@ TEST(Tracer, SpheresInLanesEqualTheClosedForm) {
     }
     for (const SimdTarget target : kSimdTargets) {
       std::vector<double> t;
-      std::vector<int> which;
+      std::vector<double> which;
       std::vector<char> blocked(n, 0);
       nearest_spheres(spheres, rays, t, which, target);
       blocked_by_spheres(spheres, rays, blocked, target);
@@ -232,7 +235,7 @@ TEST(Tracer, SpheresInLanesEqualTheClosedForm) {
           if (ts < bounded.tfar) bounded.tfar = best = ts, nearest = int(s);
           any = any || std::isfinite(intersect_sphere(list[s].first, list[s].second, scalar[k]));
         }
-        EXPECT_EQ(which[k], nearest) << n << " " << k << " " << simd_target_name(target);
+        EXPECT_EQ(which[k], nearest >= 0 ? 10.0 + nearest : -1.0) << n << " " << k << " " << simd_target_name(target);
         if (nearest >= 0) {
           EXPECT_NEAR(t[k], best, 1e-14 * best) << n << " " << k << " " << simd_target_name(target);
         }

@@ -105,15 +105,16 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
   }
 
   const Tracer tracer = referenced_by("a mesh object", [&] { return Tracer(desc); });
-  // Per object: its material, and what the lanes read of it per hit (a sphere's centre and the reciprocal
-  // of its radius; 0 for a mesh), so that the tile loop does not reach into the scene's description.
+  // Per object: its material, and what the lanes read of it per hit (its material where the lanes shade
+  // it, set below; a sphere's centre and the reciprocal of its radius, 0 for a mesh), so that the tile loop
+  // does not reach into the scene's description.
   std::vector<int> object_material;
-  std::vector<double> object_inv_radius;
-  std::vector<Vec3> object_center;
+  LaneObjects objects;
   for (const ObjectDesc& o : desc.objects) {
     object_material.push_back(material_index.at(o.material));
     const bool sphere = o.kind == ObjectDesc::Kind::sphere;
-    object_inv_radius.push_back(sphere ? 1.0 / o.radius : 0.0), object_center.push_back(sphere ? o.center : Vec3(0.0));
+    const Vec3 c = sphere ? o.center : Vec3(0.0);
+    objects.cx.push_back(c.x), objects.cy.push_back(c.y), objects.cz.push_back(c.z), objects.inv_radius.push_back(sphere ? 1.0 / o.radius : 0.0);
   }
 
   const CameraDesc& cam = desc.camera;
@@ -180,6 +181,11 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
   // Per material: whether the stream path shades its hits in lanes.
   std::vector<char> in_lanes;
   for (std::size_t m = 0; m < materials.size(); ++m) in_lanes.push_back(materials[m]->has_lanes() && !stretch_textures[m]);
+  bool one_at_a_time = false;  // whether some object's hits are shaded by plan()
+  for (const int m : object_material) {
+    objects.material.push_back(in_lanes[std::size_t(m)] ? double(m) : -1.0);
+    one_at_a_time = one_at_a_time || !in_lanes[std::size_t(m)];
+  }
   std::vector<LaneLight> lane_lights;
   bool point_lights = false;  // whether the lanes' hits need their positions
   for (const LightDesc& light : desc.lights) {
@@ -202,8 +208,9 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
     }
     const Vec3 p = cam.position + hit.t * dir;
     // On a sphere p lies at its radius: (p - centre) / radius is the unit normal, as the lanes have it.
-    const double inv_radius = object_inv_radius[std::size_t(hit.object)];
-    Vec3 n = inv_radius != 0.0 ? (p - object_center[std::size_t(hit.object)]) * inv_radius : glm::normalize(hit.ng);
+    const std::size_t o = std::size_t(hit.object);
+    const double inv_radius = objects.inv_radius[o];
+    Vec3 n = inv_radius != 0.0 ? (p - Vec3(objects.cx[o], objects.cy[o], objects.cz[o])) * inv_radius : glm::normalize(hit.ng);
     if (glm::dot(n, dir) > 0.0) n = -n;  // shade the side the camera sees
     const std::optional<Vec3>& tangent = tangents[std::size_t(object_material[std::size_t(hit.object)])];
     planned.frame = tangent ? Frame(n, *tangent) : Frame(n);
@@ -340,7 +347,7 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
   // perf put 16% of a two-thread GGX render in the kernel).
   struct TileSpace {
     RayBatch cameras;
-    std::vector<Hit> hits;
+    RayHits hits;
     std::vector<Planned> planned;
     std::vector<Ray> rays;
     std::vector<Rgb> values;  // of plan()'s rays
@@ -349,7 +356,6 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
     std::vector<Wave> waves;
     CameraSampleBatch samples;
     TileHits tile_hits;
-    std::vector<char> present;  // per material: whether the lanes shade some hit of this sample index
     // Per pixel of the tile, in columns: one sample's radiance and alpha, and the pixel's sums (the image's,
     // read at the tile's start and written back at its end, so each sample adds to them in the same order
     // as on the one-ray path). Added in columns, not through Planned, so that the lanes' values land with
@@ -367,7 +373,7 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
     const std::size_t n = std::size_t(count);
     TileSpace& space = tile_spaces.local();
     RayBatch& cameras = space.cameras;
-    std::vector<Hit>& hits = space.hits;
+    RayHits& hits = space.hits;
     std::vector<Planned>& planned = space.planned;
     std::vector<Ray>& rays = space.rays;
     std::vector<Rgb>& values = space.values;
@@ -375,15 +381,15 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
     Textured& textured = space.textured;
     std::vector<Wave>& waves = space.waves;
     TileHits& tile_hits = space.tile_hits;
-    std::vector<char>& present = space.present;
     std::vector<std::uint32_t>& planned_pixels = space.planned_pixels;
     double* radiance[3];
-    for (int c = 0; c < 3; ++c) space.radiance[c].resize(n), radiance[c] = space.radiance[c].data();
-    space.alpha.resize(n);
+    // Padded as the tile's columns, which take_hits() writes whole.
+    const std::size_t padded_n = (n + Columns::kPadding - 1) / Columns::kPadding * Columns::kPadding;
+    for (int c = 0; c < 3; ++c) space.radiance[c].resize(padded_n), radiance[c] = space.radiance[c].data();
+    space.alpha.resize(padded_n);
     double* const alpha = space.alpha.data();
     double* sum[4];
     for (int c = 0; c < 4; ++c) space.sum[c].resize(n), sum[c] = space.sum[c].data();
-    present.resize(materials.size());
     planned.resize(n), waves.resize(materials.size());
     cameras.reserve(n), cameras.set_size(n);
     const std::size_t padded = cameras.padded_size();
@@ -412,48 +418,41 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
       std::copy_n(samples.dz.begin(), padded, cameras.dz.begin());
       tracer.intersect(cameras, hits, true);
       rays.clear(), values.clear();
-      // Each pixel's hit: shaded here one at a time where its material has no lanes, otherwise given to
-      // the lanes in the tile's columns.
-      std::fill(present.begin(), present.end(), char(0));
+      // Each pixel's hit given to the lanes in the tile's columns, with alpha and the radiance of what no
+      // shading changes (the environment seen past everything, as place() has it); then, where the scene
+      // has them, the hits shaded here one at a time (materials without lanes) and the environment's
+      // light samples.
+      take_hits(hits, objects, constant_radiance, tile_hits, alpha, radiance);
       planned_pixels.clear();
-      for (int c = 0; c < 3; ++c) std::fill_n(radiance[c], n, 0.0);
-      for (std::size_t k = 0; k < n; ++k) {
-        const Hit& hit = hits[k];
-        tile_hits.material[k] = -1.0;
-        if (!hit.found()) {  // the environment seen past everything, as place() has it
-          const Rgb seen = background(samples.d(k));
-          for (int c = 0; c < 3; ++c) radiance[c][k] = seen[c];
-          alpha[k] = 0.0;
-          continue;
+      if (one_at_a_time || light_sampled)
+        for (std::size_t k = 0; k < n; ++k) {
+          if (hits.object[k] < 0.0) {
+            if (light_sampled) {
+              const Rgb seen = background(samples.d(k));
+              for (int c = 0; c < 3; ++c) radiance[c][k] = seen[c];
+            }
+            continue;
+          }
+          const Hit hit = hits.at(k);
+          if (!in_lanes[std::size_t(object_material[std::size_t(hit.object)])]) {
+            Planned& pk = planned[k];
+            place(hit, samples.d(k), pk);
+            const double u[5] = {samples.u[2][k], samples.u[3][k], samples.u[4][k], samples.u[5][k], samples.u[6][k]};
+            plan(hit, u, textured, pk, rays, values);
+            alpha[k] = pk.alpha;
+            planned_pixels.push_back(std::uint32_t(k));
+          } else if (light_sampled) {
+            const Environment::Sample ls = env->sample(samples.u[2][k], samples.u[3][k]);
+            tile_hits.lx[k] = ls.d.x, tile_hits.ly[k] = ls.d.y, tile_hits.lz[k] = ls.d.z, tile_hits.light_pdf[k] = ls.pdf;
+            tile_hits.light_r[k] = ls.radiance.r, tile_hits.light_g[k] = ls.radiance.g, tile_hits.light_b[k] = ls.radiance.b;
+          }
         }
-        const std::size_t object = std::size_t(hit.object), material = std::size_t(object_material[object]);
-        if (!in_lanes[material]) {
-          Planned& pk = planned[k];
-          place(hit, samples.d(k), pk);
-          const double u[5] = {samples.u[2][k], samples.u[3][k], samples.u[4][k], samples.u[5][k], samples.u[6][k]};
-          plan(hit, u, textured, pk, rays, values);
-          alpha[k] = pk.alpha;
-          planned_pixels.push_back(std::uint32_t(k));
-          continue;
-        }
-        alpha[k] = 1.0;
-        present[material] = 1;
-        tile_hits.material[k] = double(material), tile_hits.t[k] = hit.t;
-        const double inv_radius = object_inv_radius[object];
-        const Vec3 g = inv_radius != 0.0 ? object_center[object] : hit.ng;
-        tile_hits.inv_radius[k] = inv_radius, tile_hits.gx[k] = g.x, tile_hits.gy[k] = g.y, tile_hits.gz[k] = g.z;
-        if (light_sampled) {
-          const Environment::Sample ls = env->sample(samples.u[2][k], samples.u[3][k]);
-          tile_hits.lx[k] = ls.d.x, tile_hits.ly[k] = ls.d.y, tile_hits.lz[k] = ls.d.z, tile_hits.light_pdf[k] = ls.pdf;
-          tile_hits.light_r[k] = ls.radiance.r, tile_hits.light_g[k] = ls.radiance.g, tile_hits.light_b[k] = ls.radiance.b;
-        }
-      }
       std::copy_n(samples.dx.begin(), padded, tile_hits.dx.begin()), std::copy_n(samples.dy.begin(), padded, tile_hits.dy.begin());
       std::copy_n(samples.dz.begin(), padded, tile_hits.dz.begin());
       std::copy_n(samples.u[4].begin(), padded, tile_hits.u1.begin()), std::copy_n(samples.u[5].begin(), padded, tile_hits.u2.begin());
       std::copy_n(samples.u[6].begin(), padded, tile_hits.u3.begin());
       for (std::size_t m = 0; m < materials.size(); ++m) {
-        if (present[m])
+        if (in_lanes[m])
           place_hits(tile_hits, cam.position, eps, double(m), tangents[m] ? &*tangents[m] : nullptr, point_lights, waves[m].hits);
         else
           waves[m].hits.clear();

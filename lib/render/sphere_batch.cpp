@@ -84,25 +84,24 @@ void BlockedBySpheres(const SphereSet& spheres, const RayBatch& rays, std::vecto
   }
 }
 
-void NearestSpheres(const SphereSet& spheres, const RayBatch& rays, std::vector<double>& t, std::vector<int>& sphere) {
+void NearestSpheres(const SphereSet& spheres, const RayBatch& rays, std::vector<double>& t, std::vector<double>& id) {
   const D d;
   const std::size_t lanes = hn::Lanes(d), n = rays.padded_size();
-  t.resize(n), sphere.resize(n);
+  if (t.size() < n) t.resize(n);
+  if (id.size() < n) id.resize(n);
   const V inf = hn::Set(d, std::numeric_limits<double>::infinity());
-  double which[hn::MaxLanes(D())];
   for (std::size_t k = 0; k < n; k += lanes) {
     const RayV r = ray_at(d, rays, k);
-    V tfar = r.tfar, best = inf, index = hn::Set(d, -1.0);
+    V tfar = r.tfar, best = inf, which = hn::Set(d, -1.0);
     for (std::size_t s = 0; s < spheres.size(); ++s) {
       const V ts = intersect(d, hn::Set(d, spheres.cx[s]), hn::Set(d, spheres.cy[s]), hn::Set(d, spheres.cz[s]), hn::Set(d, spheres.radius[s]),
                              r, tfar);
       const auto nearer = ts < tfar;
       tfar = hn::IfThenElse(nearer, ts, tfar), best = hn::IfThenElse(nearer, ts, best);
-      index = hn::IfThenElse(nearer, hn::Set(d, double(s)), index);
+      which = hn::IfThenElse(nearer, hn::Set(d, spheres.id[s]), which);
     }
     hn::StoreU(best, d, t.data() + k);
-    hn::StoreU(index, d, which);
-    for (std::size_t j = 0; j < lanes; ++j) sphere[k + j] = int(which[j]);
+    hn::StoreU(which, d, id.data() + k);
   }
 }
 
@@ -119,8 +118,8 @@ void blocked_by_spheres(const SphereSet& spheres, const RayBatch& rays, std::vec
   FACETFIT_DISPATCH(target, BlockedBySpheres, spheres, rays, blocked);
 }
 
-void nearest_spheres(const SphereSet& spheres, const RayBatch& rays, std::vector<double>& t, std::vector<int>& sphere, SimdTarget target) {
-  FACETFIT_DISPATCH(target, NearestSpheres, spheres, rays, t, sphere);
+void nearest_spheres(const SphereSet& spheres, const RayBatch& rays, std::vector<double>& t, std::vector<double>& id, SimdTarget target) {
+  FACETFIT_DISPATCH(target, NearestSpheres, spheres, rays, t, id);
 }
 
 }  // namespace facetfit

@@ -35,9 +35,10 @@ struct RayBatch : Columns {
   }
 };
 
-// The spheres of a scene, in columns.
+// The spheres of a scene, in columns, and the id nearest_spheres() reports for each (the tracer's: the
+// scene's object index).
 struct SphereSet {
-  std::vector<double> cx, cy, cz, radius;
+  std::vector<double> cx, cy, cz, radius, id;
   std::size_t size() const { return radius.size(); }
 };
 
@@ -45,8 +46,9 @@ struct SphereSet {
 // where one does and left as it is otherwise.
 void blocked_by_spheres(const SphereSet& spheres, const RayBatch& rays, std::vector<char>& blocked, SimdTarget target = SimdTarget::best);
 
-// Per ray, the nearest sphere in (tnear, tfar): t (infinity where none) and its index in the set (-1).
-void nearest_spheres(const SphereSet& spheres, const RayBatch& rays, std::vector<double>& t, std::vector<int>& sphere,
+// Per ray, the nearest sphere in (tnear, tfar): t (infinity where none) and its id (-1 where none), for
+// the batch's padded_size() rays (columns shorter than that grow).
+void nearest_spheres(const SphereSet& spheres, const RayBatch& rays, std::vector<double>& t, std::vector<double>& id,
                      SimdTarget target = SimdTarget::best);
 
 }  // namespace facetfit

@@ -36,6 +36,18 @@ struct Hit {
   bool found() const { return object >= 0; }
 };
 
+// Hits of rays in columns (the stream path's camera rays): t (infinity for none), the object's index (-1
+// for none) and, on a triangle, its geometric normal (not normalized; 0 on a sphere).
+struct RayHits : Columns {
+  std::vector<double> t, object, ngx, ngy, ngz;
+  // n hits, written in place; columns padded as Columns has them.
+  void resize_to(std::size_t n) {
+    ensure(n, [this](std::size_t m) { resize({&t, &object, &ngx, &ngy, &ngz}, m, 0.0); });
+    set_size(n);
+  }
+  Hit at(std::size_t k) const { return object[k] >= 0.0 ? Hit{t[k], int(object[k]), Vec3(ngx[k], ngy[k], ngz[k])} : Hit{}; }
+};
+
 // Nearest root t in (tnear, tfar) of |origin + t dir - center| = radius, or infinity. Written as
 // Ray Tracing Gems I, ch. 7 recommends: the discriminant from the distance of the centre to the line and
 // the smaller root from the larger one, which keeps both accurate for rays far from or grazing the sphere.
@@ -57,7 +69,7 @@ class Tracer {
   void occluded(const std::vector<Ray>& rays, std::vector<char>& blocked) const;
   // The same for rays in columns, the spheres in SIMD lanes (render/sphere_batch.h): what the renderer's
   // stream path asks.
-  void intersect(const RayBatch& rays, std::vector<Hit>& hits, bool coherent) const;
+  void intersect(const RayBatch& rays, RayHits& hits, bool coherent) const;
   void occluded(const RayBatch& rays, std::vector<char>& blocked) const;
 
  private:

@@ -193,6 +193,45 @@ void PlaceHits(const TileHits& tile, const Vec3& camera, double eps, double mate
   out.set_size(size);
 }
 
+void TakeHits(const RayHits& hits, const LaneObjects& objects, const Rgb& background, TileHits& tile, double* alpha,
+              double* const radiance[3]) {
+  const D d;
+  const std::size_t n = hits.padded_size(), lanes = hn::Lanes(d);
+  const V zero = hn::Zero(d), one = hn::Set(d, 1.0), none = hn::Set(d, -1.0);
+  const V seen[3] = {hn::Set(d, background.r), hn::Set(d, background.g), hn::Set(d, background.b)};
+  for (std::size_t k = 0; k < n; k += lanes) {
+    const V object = load(d, hits.object, k);
+    const M hit = object >= zero;
+    V material = none, inv_radius = zero, cx = zero, cy = zero, cz = zero;
+    if (!hn::AllFalse(d, hit)) {
+      const V first = hn::MaxOfLanes(d, object);  // an object some lane hit
+      if (hn::AllTrue(d, hn::Or(hn::Not(hit), object == first))) {
+        const std::size_t o = std::size_t(hn::GetLane(first));
+        material = hn::Set(d, objects.material[o]), inv_radius = hn::Set(d, objects.inv_radius[o]);
+        cx = hn::Set(d, objects.cx[o]), cy = hn::Set(d, objects.cy[o]), cz = hn::Set(d, objects.cz[o]);
+      } else {
+        HWY_ALIGN double which[hn::MaxLanes(D())], m[hn::MaxLanes(D())], r[hn::MaxLanes(D())], x[hn::MaxLanes(D())],
+            y[hn::MaxLanes(D())], z[hn::MaxLanes(D())];
+        hn::Store(object, d, which);
+        for (std::size_t j = 0; j < lanes; ++j) {
+          const std::size_t o = which[j] >= 0.0 ? std::size_t(which[j]) : 0;  // a miss reads object 0, masked below
+          m[j] = objects.material[o], r[j] = objects.inv_radius[o], x[j] = objects.cx[o], y[j] = objects.cy[o], z[j] = objects.cz[o];
+        }
+        material = hn::Load(d, m), inv_radius = hn::Load(d, r), cx = hn::Load(d, x), cy = hn::Load(d, y), cz = hn::Load(d, z);
+      }
+    }
+    const M sphere = inv_radius != zero;
+    hn::StoreU(load(d, hits.t, k), d, tile.t.data() + k);
+    hn::StoreU(hn::IfThenElse(hit, material, none), d, tile.material.data() + k);
+    hn::StoreU(hn::IfThenElseZero(hit, inv_radius), d, tile.inv_radius.data() + k);
+    hn::StoreU(hn::IfThenElse(sphere, cx, load(d, hits.ngx, k)), d, tile.gx.data() + k);
+    hn::StoreU(hn::IfThenElse(sphere, cy, load(d, hits.ngy, k)), d, tile.gy.data() + k);
+    hn::StoreU(hn::IfThenElse(sphere, cz, load(d, hits.ngz, k)), d, tile.gz.data() + k);
+    hn::StoreU(hn::IfThenElseZero(hit, one), d, alpha + k);
+    for (int c = 0; c < 3; ++c) hn::StoreU(hn::IfThenZeroElse(hit, seen[c]), d, radiance[c] + k);
+  }
+}
+
 HWY_INLINE Vec3V view_at(D d, const HitBatch& h, std::size_t k) {
   return {load(d, h.draws.ox, k), load(d, h.draws.oy, k), load(d, h.draws.oz, k)};
 }
@@ -342,6 +381,11 @@ namespace facetfit {
 void place_hits(const TileHits& tile, const Vec3& camera, double eps, double material, const Vec3* tangent, bool positions, HitBatch& out,
                 SimdTarget target) {
   FACETFIT_DISPATCH(target, PlaceHits, tile, camera, eps, material, tangent, positions, out);
+}
+
+void take_hits(const RayHits& hits, const LaneObjects& objects, const Rgb& background, TileHits& tile, double* alpha,
+               double* const radiance[3], SimdTarget target) {
+  FACETFIT_DISPATCH(target, TakeHits, hits, objects, background, tile, alpha, radiance);
 }
 
 void light_slots(const HitBatch& hits, const std::vector<LaneLight>& lights, double tnear, ShadowBatch& out, SlotRanges& ranges,

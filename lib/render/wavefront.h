@@ -15,6 +15,7 @@
 #include "render/shading_batch.h"
 #include "render/sphere_batch.h"
 #include "render/simd_targets.h"
+#include "render/tracer.h"
 
 namespace facetfit {
 
@@ -40,6 +41,21 @@ struct TileHits : Columns {
     set_size(n);
   }
 };
+
+// Per object of a scene, what the lanes read of a hit on it: its material's index where the lanes shade
+// that material (-1 where it is shaded one hit at a time), and a sphere's centre and the reciprocal of its
+// radius (0 for a mesh).
+struct LaneObjects {
+  std::vector<double> material, cx, cy, cz, inv_radius;
+};
+
+// The tile's columns of its camera rays' hits (t, material, inv_radius, g) from the tracer's, for their
+// padded_size() entries: material -1 where a ray hit nothing or an object shaded one hit at a time. Per
+// pixel also alpha (1 where its ray hit something, else 0) and radiance (r, g, b: `background` where its
+// ray hit nothing, else 0). Per vector of rays, the lookups of one object where every lane that hit
+// something hit it (the inside of a sphere and its outline), lane by lane otherwise.
+void take_hits(const RayHits& hits, const LaneObjects& objects, const Rgb& background, TileHits& tile, double* alpha,
+               double* const radiance[3], SimdTarget target = SimdTarget::best);
 
 // The hits on one material, for one sample index, in columns: the shading frame, the hit and the shadow
 // rays' origin, the environment's light sample, the pixel's index in the tile (owner), and the BRDF
