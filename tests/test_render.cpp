@@ -495,6 +495,49 @@ TEST(Wavefront, HitsAndSlotsEqualTheOneHitPath) {
   }
 }
 
+TEST(Wavefront, TakeHitsLooksUpEachPixelsObject) {
+  // Objects: a sphere shaded in lanes, a mesh shaded in lanes, a sphere shaded one hit at a time. Runs of
+  // one object (the one-lookup vectors), mixed vectors and misses; every target; every entry exactly.
+  LaneObjects objects;
+  objects.material = {0.0, 1.0, -1.0};
+  objects.cx = {0.5, 0.0, -2.0}, objects.cy = {1.0, 0.0, 3.0}, objects.cz = {-1.0, 0.0, 0.25};
+  objects.inv_radius = {2.0, 0.0, 0.125};
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const Rgb background(0.3, 0.2, 0.1);
+  for (const std::size_t n : {1u, 5u, 16u, 37u, 256u})
+    for (const SimdTarget target : kSimdTargets) {
+      RayHits hits;
+      hits.resize_to(n);
+      for (std::size_t k = 0; k < hits.padded_size(); ++k) {
+        const int run = int(k / 8) % 4;  // 8 alike, then mixed
+        hits.object[k] = run == 3 ? double(int(u(rng) * 4.0) - 1) : double(run) - (run == 2 ? 3.0 : 0.0);
+        hits.t[k] = hits.object[k] >= 0.0 ? 1.0 + u(rng) : std::numeric_limits<double>::infinity();
+        hits.ngx[k] = hits.object[k] == 1.0 ? u(rng) : 0.0, hits.ngy[k] = hits.object[k] == 1.0 ? 1.0 : 0.0, hits.ngz[k] = 0.0;
+      }
+      TileHits tile;
+      tile.resize_to(n);
+      std::vector<double> alpha(hits.padded_size()), radiance[3];
+      for (auto& c : radiance) c.assign(hits.padded_size(), -7.0);
+      double* out[3] = {radiance[0].data(), radiance[1].data(), radiance[2].data()};
+      take_hits(hits, objects, background, tile, alpha.data(), out, target);
+      const std::string where = std::to_string(n) + " " + simd_target_name(target);
+      for (std::size_t k = 0; k < hits.padded_size(); ++k) {
+        const double o = hits.object[k];
+        const bool hit = o >= 0.0;
+        const std::size_t i = hit ? std::size_t(o) : 0;
+        EXPECT_EQ(tile.material[k], hit ? objects.material[i] : -1.0) << where << " " << k;
+        EXPECT_EQ(alpha[k], hit ? 1.0 : 0.0) << where << " " << k;
+        EXPECT_EQ(radiance[1][k], hit ? 0.0 : background.g) << where << " " << k;
+        if (!hit) continue;
+        EXPECT_EQ(tile.t[k], hits.t[k]) << where << " " << k;
+        EXPECT_EQ(tile.inv_radius[k], objects.inv_radius[i]) << where << " " << k;
+        EXPECT_EQ(tile.gx[k], i == 1 ? hits.ngx[k] : objects.cx[i]) << where << " " << k;
+        EXPECT_EQ(tile.gy[k], i == 1 ? hits.ngy[k] : objects.cy[i]) << where << " " << k;
+      }
+    }
+}
+
 TEST(Wavefront, SamplesAddToTheSumsAsOneAtATime) {
   // Lengths around the lane counts, radiance with a NaN or an infinity in one channel (the pixel adds
   // nothing but its alpha), every target; the sums exactly.
