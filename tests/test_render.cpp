@@ -242,6 +242,31 @@ TEST(Tracer, SpheresInLanesEqualTheClosedForm) {
         EXPECT_EQ(bool(blocked[k]), any) << n << " " << k << " " << simd_target_name(target);
       }
     }
+    // Rays from one point (a camera's: outside every sphere, and inside the first), as the closed form.
+    for (const Vec3 origin : {Vec3(0.3, 0.4, 4.0), Vec3(0.1, -0.2, 0.3)}) {
+      std::vector<double> dx, dy, dz;
+      for (std::size_t k = 0; k < rays.padded_size(); ++k) {
+        // Toward the spheres, or anywhere.
+        const Vec3 v = k % 2 ? glm::normalize(list[k % 3].first + 0.5 * direction() - origin) : direction();
+        dx.push_back(v.x), dy.push_back(v.y), dz.push_back(v.z);
+      }
+      for (const SimdTarget target : kSimdTargets) {
+        std::vector<double> t, which;
+        nearest_spheres(spheres, RaysFromPoint{origin, dx.data(), dy.data(), dz.data(), n}, t, which, target);
+        for (std::size_t k = 0; k < n; ++k) {
+          Ray ray(origin, Vec3(dx[k], dy[k], dz[k]));
+          int nearest = -1;
+          for (std::size_t s = 0; s < list.size(); ++s) {
+            const double ts = intersect_sphere(list[s].first, list[s].second, ray);
+            if (ts < ray.tfar) ray.tfar = ts, nearest = int(s);
+          }
+          EXPECT_EQ(which[k], nearest >= 0 ? 10.0 + nearest : -1.0) << n << " " << k << " " << simd_target_name(target);
+          if (nearest >= 0) {
+            EXPECT_NEAR(t[k], ray.tfar, 1e-14 * ray.tfar) << n << " " << k << " " << simd_target_name(target);
+          }
+        }
+      }
+    }
   }
 }
 
@@ -349,11 +374,15 @@ TEST(Wavefront, HitsAndSlotsEqualTheOneHitPath) {
     if (!constant) lights.push_back({false, -2.0, 3.0, 1.0, 5, 4, 3});
     TileHits tile;
     tile.resize_to(n);
+    // The directions and numbers the tile reads in place, padded (finite past n).
+    std::vector<double> dx(tile.padded_size(), 0.0), dy(tile.padded_size(), 0.0), dz(tile.padded_size(), 1.0);
+    std::vector<double> u1(tile.padded_size(), 0.5), u2(tile.padded_size(), 0.5), u3(tile.padded_size(), 0.5);
+    tile.dx = dx.data(), tile.dy = dy.data(), tile.dz = dz.data(), tile.u1 = u1.data(), tile.u2 = u2.data(), tile.u3 = u3.data();
     // Constant: the light sample's columns hold something (not to be read).
     tile.light_sampled = !constant;
     for (std::size_t k = 0; k < n; ++k) {
       const Vec3 d = glm::normalize(Vec3(u(rng) - 0.5, u(rng) - 0.5, -4.0));
-      tile.dx[k] = d.x, tile.dy[k] = d.y, tile.dz[k] = d.z;
+      dx[k] = d.x, dy[k] = d.y, dz[k] = d.z;
       tile.t[k] = 3.0 + u(rng), tile.material[k] = double(k % 3 == 2 ? 1 : 0);
       const Vec3 g = k % 2 ? Vec3(u(rng), u(rng), -u(rng)) : unit();  // a centre, or a triangle's normal
       // A sphere through the hit: its radius the centre's distance from it.
@@ -362,7 +391,7 @@ TEST(Wavefront, HitsAndSlotsEqualTheOneHitPath) {
       const Vec3 l = unit();
       tile.lx[k] = l.x, tile.ly[k] = l.y, tile.lz[k] = l.z, tile.light_pdf[k] = k % 5 ? 0.1 : 0.0;
       tile.light_r[k] = 0.1 * double(k % 4), tile.light_g[k] = 0.2, tile.light_b[k] = 0.1;
-      tile.u1[k] = u(rng), tile.u2[k] = u(rng), tile.u3[k] = u(rng);
+      u1[k] = u(rng), u2[k] = u(rng), u3[k] = u(rng);
     }
     for (const bool with_tangent : {false, true})
       for (const SimdTarget target : kSimdTargets) {

@@ -346,7 +346,6 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
   // pages were mapped and unmapped again and again, and unmapping stops the other threads (TLB shootdowns:
   // perf put 16% of a two-thread GGX render in the kernel).
   struct TileSpace {
-    RayBatch cameras;
     RayHits hits;
     std::vector<Planned> planned;
     std::vector<Ray> rays;
@@ -372,7 +371,6 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
     const int tw = int(tile.cols().size()), count = tw * int(tile.rows().size());
     const std::size_t n = std::size_t(count);
     TileSpace& space = tile_spaces.local();
-    RayBatch& cameras = space.cameras;
     RayHits& hits = space.hits;
     std::vector<Planned>& planned = space.planned;
     std::vector<Ray>& rays = space.rays;
@@ -391,11 +389,6 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
     double* sum[4];
     for (int c = 0; c < 4; ++c) space.sum[c].resize(n), sum[c] = space.sum[c].data();
     planned.resize(n), waves.resize(materials.size());
-    cameras.reserve(n), cameras.set_size(n);
-    const std::size_t padded = cameras.padded_size();
-    std::fill_n(cameras.ox.begin(), padded, cam.position.x), std::fill_n(cameras.oy.begin(), padded, cam.position.y);
-    std::fill_n(cameras.oz.begin(), padded, cam.position.z), std::fill_n(cameras.tnear.begin(), padded, 0.0);
-    std::fill_n(cameras.tfar.begin(), padded, infinity);
     // At most two environment rays and one per light per sample: room for all from the start, so that the
     // first sample of a tile does not grow them piece by piece.
     const std::size_t most = n * (2 + desc.lights.size());
@@ -411,12 +404,12 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
       for (int c = 0; c < 4; ++c) sum[c][k] = acc[c];
     }
     tile_hits.resize_to(n);
+    tile_hits.dx = samples.dx.data(), tile_hits.dy = samples.dy.data(), tile_hits.dz = samples.dz.data();
+    tile_hits.u1 = samples.u[4].data(), tile_hits.u2 = samples.u[5].data(), tile_hits.u3 = samples.u[6].data();
     tile_hits.light_sampled = light_sampled;
     for (int s = first; s < last; ++s) {
       camera_sample_batch(camera, seed, s, samples, SimdTarget::best, numbers_read);
-      std::copy_n(samples.dx.begin(), padded, cameras.dx.begin()), std::copy_n(samples.dy.begin(), padded, cameras.dy.begin());
-      std::copy_n(samples.dz.begin(), padded, cameras.dz.begin());
-      tracer.intersect(cameras, hits, true);
+      tracer.intersect(RaysFromPoint{cam.position, samples.dx.data(), samples.dy.data(), samples.dz.data(), n}, hits, true);
       rays.clear(), values.clear();
       // Each pixel's hit given to the lanes in the tile's columns, with alpha and the radiance of what no
       // shading changes (the environment seen past everything, as place() has it); then, where the scene
@@ -447,10 +440,6 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
             tile_hits.light_r[k] = ls.radiance.r, tile_hits.light_g[k] = ls.radiance.g, tile_hits.light_b[k] = ls.radiance.b;
           }
         }
-      std::copy_n(samples.dx.begin(), padded, tile_hits.dx.begin()), std::copy_n(samples.dy.begin(), padded, tile_hits.dy.begin());
-      std::copy_n(samples.dz.begin(), padded, tile_hits.dz.begin());
-      std::copy_n(samples.u[4].begin(), padded, tile_hits.u1.begin()), std::copy_n(samples.u[5].begin(), padded, tile_hits.u2.begin());
-      std::copy_n(samples.u[6].begin(), padded, tile_hits.u3.begin());
       for (std::size_t m = 0; m < materials.size(); ++m) {
         if (in_lanes[m])
           place_hits(tile_hits, cam.position, eps, double(m), tangents[m] ? &*tangents[m] : nullptr, point_lights, waves[m].hits);

@@ -84,14 +84,16 @@ void BlockedBySpheres(const SphereSet& spheres, const RayBatch& rays, std::vecto
   }
 }
 
-void NearestSpheres(const SphereSet& spheres, const RayBatch& rays, std::vector<double>& t, std::vector<double>& id) {
+// The nearest sphere of the rays ray_at(d, k) for k < n, as NearestSpheres below.
+template <class RayAt>
+HWY_INLINE void nearest(const SphereSet& spheres, std::size_t n, const RayAt& ray_at, std::vector<double>& t, std::vector<double>& id) {
   const D d;
-  const std::size_t lanes = hn::Lanes(d), n = rays.padded_size();
+  const std::size_t lanes = hn::Lanes(d);
   if (t.size() < n) t.resize(n);
   if (id.size() < n) id.resize(n);
   const V inf = hn::Set(d, std::numeric_limits<double>::infinity());
   for (std::size_t k = 0; k < n; k += lanes) {
-    const RayV r = ray_at(d, rays, k);
+    const RayV r = ray_at(d, k);
     V tfar = r.tfar, best = inf, which = hn::Set(d, -1.0);
     for (std::size_t s = 0; s < spheres.size(); ++s) {
       const V ts = intersect(d, hn::Set(d, spheres.cx[s]), hn::Set(d, spheres.cy[s]), hn::Set(d, spheres.cz[s]), hn::Set(d, spheres.radius[s]),
@@ -103,6 +105,19 @@ void NearestSpheres(const SphereSet& spheres, const RayBatch& rays, std::vector<
     hn::StoreU(best, d, t.data() + k);
     hn::StoreU(which, d, id.data() + k);
   }
+}
+
+void NearestSpheres(const SphereSet& spheres, const RayBatch& rays, std::vector<double>& t, std::vector<double>& id) {
+  nearest(spheres, rays.padded_size(), [&rays](D d, std::size_t k) { return ray_at(d, rays, k); }, t, id);
+}
+
+void NearestSpheresFromPoint(const SphereSet& spheres, const RaysFromPoint& rays, std::vector<double>& t, std::vector<double>& id) {
+  const D d;
+  const V ox = hn::Set(d, rays.origin.x), oy = hn::Set(d, rays.origin.y), oz = hn::Set(d, rays.origin.z);
+  const V tnear = hn::Zero(d), tfar = hn::Set(d, std::numeric_limits<double>::infinity());
+  nearest(spheres, rays.padded_size(), [&](D, std::size_t k) {
+    return RayV{ox, oy, oz, hn::LoadU(d, rays.dx + k), hn::LoadU(d, rays.dy + k), hn::LoadU(d, rays.dz + k), tnear, tfar};
+  }, t, id);
 }
 
 // NOLINTNEXTLINE(google-readability-namespace-comments)
@@ -120,6 +135,10 @@ void blocked_by_spheres(const SphereSet& spheres, const RayBatch& rays, std::vec
 
 void nearest_spheres(const SphereSet& spheres, const RayBatch& rays, std::vector<double>& t, std::vector<double>& id, SimdTarget target) {
   FACETFIT_DISPATCH(target, NearestSpheres, spheres, rays, t, id);
+}
+
+void nearest_spheres(const SphereSet& spheres, const RaysFromPoint& rays, std::vector<double>& t, std::vector<double>& id, SimdTarget target) {
+  FACETFIT_DISPATCH(target, NearestSpheresFromPoint, spheres, rays, t, id);
 }
 
 }  // namespace facetfit

@@ -51,4 +51,16 @@ void blocked_by_spheres(const SphereSet& spheres, const RayBatch& rays, std::vec
 void nearest_spheres(const SphereSet& spheres, const RayBatch& rays, std::vector<double>& t, std::vector<double>& id,
                      SimdTarget target = SimdTarget::best);
 
+// Rays from one point (a camera's) along directions (dx, dy, dz), for t in (0, infinity): `size` rays, in
+// columns the caller owns with room for size rounded up to Columns::kPadding. A camera's rays need no
+// columns of origins and bounds, and their shared terms are computed once per sphere.
+struct RaysFromPoint {
+  Vec3 origin;
+  const double *dx, *dy, *dz;
+  std::size_t size;
+  std::size_t padded_size() const { return (size + Columns::kPadding - 1) / Columns::kPadding * Columns::kPadding; }
+};
+void nearest_spheres(const SphereSet& spheres, const RaysFromPoint& rays, std::vector<double>& t, std::vector<double>& id,
+                     SimdTarget target = SimdTarget::best);
+
 }  // namespace facetfit

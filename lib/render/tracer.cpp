@@ -136,6 +136,12 @@ void take_triangle_hit(const RTCRayHit& rh, const std::vector<int>& object, Hit&
     hit = Hit{double(rh.ray.tfar), object[rh.hit.geomID], Vec3(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z)};
 }
 
+// Every ray of the columns (their padded size) finds nothing.
+void miss_all(RayHits& hits) {
+  std::fill_n(hits.t.begin(), hits.padded_size(), std::numeric_limits<double>::infinity());
+  std::fill_n(hits.object.begin(), hits.padded_size(), -1.0);
+}
+
 }  // namespace
 
 Hit Tracer::intersect(const Ray& ray) const {
@@ -183,18 +189,12 @@ void Tracer::intersect(const std::vector<Ray>& rays, std::vector<Hit>& hits, boo
 
 void Tracer::occluded(const std::vector<Ray>& rays, std::vector<char>& blocked) const { occluded(ray_batch(rays), blocked); }
 
-void Tracer::intersect(const RayBatch& rays, RayHits& hits, bool coherent) const {
-  const std::size_t n = rays.size(), padded = rays.padded_size();
-  hits.resize_to(n);
-  if (!spheres_.empty()) {
-    nearest_spheres(sphere_set_, rays, hits.t, hits.object);
-  } else {
-    std::fill_n(hits.t.begin(), padded, std::numeric_limits<double>::infinity());
-    std::fill_n(hits.object.begin(), padded, -1.0);
-  }
+// The triangles nearer than the spheres' hits, through Embree's ray streams (no-op without triangles).
+template <class RayAt>
+void Tracer::add_triangle_hits(std::size_t n, const RayAt& ray_at, RayHits& hits, bool coherent) const {
   if (!triangles_ || n == 0) return;
   std::vector<RTCRayHit> rh(n);
-  for (std::size_t k = 0; k < n; ++k) rh[k] = embree_ray_hit(ray_at(rays, k), hits.at(k));
+  for (std::size_t k = 0; k < n; ++k) rh[k] = embree_ray_hit(ray_at(k), hits.at(k));
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);
   if (coherent) ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
@@ -204,6 +204,26 @@ void Tracer::intersect(const RayBatch& rays, RayHits& hits, bool coherent) const
     take_triangle_hit(rh[k], triangles_->object, hit);
     hits.t[k] = hit.t, hits.object[k] = double(hit.object), hits.ngx[k] = hit.ng.x, hits.ngy[k] = hit.ng.y, hits.ngz[k] = hit.ng.z;
   }
+}
+
+void Tracer::intersect(const RayBatch& rays, RayHits& hits, bool coherent) const {
+  hits.resize_to(rays.size());
+  if (!spheres_.empty()) {
+    nearest_spheres(sphere_set_, rays, hits.t, hits.object);
+  } else {
+    miss_all(hits);
+  }
+  add_triangle_hits(rays.size(), [&rays](std::size_t k) { return ray_at(rays, k); }, hits, coherent);
+}
+
+void Tracer::intersect(const RaysFromPoint& rays, RayHits& hits, bool coherent) const {
+  hits.resize_to(rays.size);
+  if (!spheres_.empty()) {
+    nearest_spheres(sphere_set_, rays, hits.t, hits.object);
+  } else {
+    miss_all(hits);
+  }
+  add_triangle_hits(rays.size, [&rays](std::size_t k) { return Ray(rays.origin, Vec3(rays.dx[k], rays.dy[k], rays.dz[k])); }, hits, coherent);
 }
 
 void Tracer::occluded(const RayBatch& rays, std::vector<char>& blocked) const {

@@ -70,6 +70,7 @@ class Tracer {
   // The same for rays in columns, the spheres in SIMD lanes (render/sphere_batch.h): what the renderer's
   // stream path asks.
   void intersect(const RayBatch& rays, RayHits& hits, bool coherent) const;
+  void intersect(const RaysFromPoint& rays, RayHits& hits, bool coherent) const;
   void occluded(const RayBatch& rays, std::vector<char>& blocked) const;
 
  private:
@@ -80,6 +81,8 @@ class Tracer {
   };
   struct Embree;
   Hit nearest_sphere(const Ray& ray) const;
+  template <class RayAt>
+  void add_triangle_hits(std::size_t n, const RayAt& ray_at, RayHits& hits, bool coherent) const;
   bool blocked_by_sphere(const Ray& ray) const;
   std::vector<Sphere> spheres_;
   SphereSet sphere_set_;  // the same spheres in columns, for the lanes

@@ -42,6 +42,7 @@ struct FrameV {
 };
 
 V load(D d, const std::vector<double>& column, std::size_t k) { return hn::LoadU(d, column.data() + k); }
+V load(D d, const double* column, std::size_t k) { return hn::LoadU(d, column + k); }
 
 FrameV frame_at(D d, const HitBatch& h, std::size_t k) {
   return {{load(d, h.tx, k), load(d, h.ty, k), load(d, h.tz, k)},
