@@ -1,5 +1,6 @@
 #include "render/renderer.h"
 
+#include <tbb/blocked_range.h>
 #include <tbb/blocked_range2d.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
@@ -516,9 +517,12 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
         render_tile_scalar(tile, first, last);
     });
     done = last;
-    for (std::size_t k = 0; k < accum.size(); ++k) image.rgba[k] = float(accum[k] / done);
     if (settings.progress) settings.progress(pass + 1, passes);
   }
+  // The image once, at the end (the progress callback does not see it), over the threads.
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, accum.size(), 1 << 14), [&](const tbb::blocked_range<std::size_t>& part) {
+    for (std::size_t k = part.begin(); k < part.end(); ++k) image.rgba[k] = float(accum[k] / done);
+  });
   image.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return image;
 }
