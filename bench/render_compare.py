@@ -14,7 +14,8 @@ with its GGX time) and a measured RGL file (Mitsuba's `measured` plugin, the for
 Two times per renderer: one render (facetfit: the time it prints, which covers loading the material,
 building the scene and rendering; Mitsuba: the second render in its process, after its kernels are
 compiled and with the scene loaded) and the whole process from launch to exit (Mitsuba llvm_ad_rgb: with
-its kernel cache warm, the second process). Median of RUNS. Mitsuba's llvm_ad_rgb variant needs LLVM >= 16:
+its kernel cache warm, the second process). Median of RUNS, facetfit's runs in turn with Mitsuba
+llvm_ad_rgb's (a shared machine's load changes from minute to minute). Mitsuba's llvm_ad_rgb variant needs LLVM >= 16:
 Debian's libllvm19, through DRJIT_LIBLLVM_PATH; without it that column says so.
 """
 import json
@@ -120,38 +121,59 @@ def write_scene(work, material, spp, environment=True, light=True, seed=1):
     return path
 
 
+def medians(runs):
+    """Per field, the median over runs of equal tuples."""
+    return tuple(median([run[i] for run in runs]) for i in range(len(runs[0])))
+
+
+def facetfit_once(binary, work, path, prefix=()):
+    """One facetfit render of the scene file: (render time it prints, whole process, peak memory in MiB)."""
+    start = time.perf_counter()
+    run = subprocess.run(list(prefix) + ["/usr/bin/time", "-f", "%M", binary, "render", path, "-o", os.path.join(work, "facetfit.exr")],
+                         check=True, capture_output=True, text=True)
+    process = time.perf_counter() - start
+    return (float(re.search(r"spp, ([0-9.]+) s\)", run.stdout).group(1)), process, float(run.stderr.strip().splitlines()[-1]) / 1024.0)
+
+
 def facetfit_run(binary, work, material, spp, prefix=(), environment=True, light=True):
     """(render time it prints, whole process, peak memory in MiB), medians; without the environment or the
     light where told (the stages of docs/render-speed.md)."""
-    prefix = list(prefix)
     path = write_scene(work, material, spp, environment, light)
-    renders, processes, memory = [], [], []
-    for _ in range(runs_at(spp)):
-        start = time.perf_counter()
-        run = subprocess.run(prefix + ["/usr/bin/time", "-f", "%M", binary, "render", path, "-o", os.path.join(work, "facetfit.exr")],
-                             check=True, capture_output=True, text=True)
-        processes.append(time.perf_counter() - start)
-        renders.append(float(re.search(r"spp, ([0-9.]+) s\)", run.stdout).group(1)))
-        memory.append(float(run.stderr.strip().splitlines()[-1]) / 1024.0)
-    return median(renders), median(processes), median(memory)
+    return medians([facetfit_once(binary, work, path, prefix) for _ in range(runs_at(spp))])
+
+
+def mitsuba_launch(python, variant, material, spp, env, prefix, renders):
+    """One Mitsuba process rendering `renders` times: (its render times, wall time, peak memory in MiB)."""
+    start = time.perf_counter()
+    out = subprocess.run(list(prefix) + ["/usr/bin/time", "-f", "%M", python, "-c", MITSUBA_SCRIPT, variant, str(spp),
+                          json.dumps(material), str(renders)], check=True, capture_output=True, text=True, env=env)
+    wall = time.perf_counter() - start
+    return json.loads(out.stdout.split("facetfit-times ")[-1]), wall, float(out.stderr.strip().splitlines()[-1]) / 1024.0
+
+
+def mitsuba_once(python, variant, material, spp, env, prefix=()):
+    """(second render's time, whole process of one render, its peak memory in MiB)."""
+    second = mitsuba_launch(python, variant, material, spp, env, prefix, 2)[0][1]
+    _, wall, mib = mitsuba_launch(python, variant, material, spp, env, prefix, 1)
+    return second, wall, mib
 
 
 def mitsuba_run(python, variant, material, spp, env, prefix=()):
-    """(second render's time, whole process of one render, its peak memory in MiB), medians."""
-    def launch(renders):
-        start = time.perf_counter()
-        out = subprocess.run(list(prefix) + ["/usr/bin/time", "-f", "%M", python, "-c", MITSUBA_SCRIPT, variant, str(spp),
-                              json.dumps(material), str(renders)], check=True, capture_output=True, text=True, env=env)
-        wall = time.perf_counter() - start
-        return json.loads(out.stdout.split("facetfit-times ")[-1]), wall, float(out.stderr.strip().splitlines()[-1]) / 1024.0
-    launch(1)  # warms the kernel cache
-    renders, processes, memory = [], [], []
+    """mitsuba_once's figures, medians, after a launch that warms the kernel cache."""
+    mitsuba_launch(python, variant, material, spp, env, prefix, 1)
+    return medians([mitsuba_once(python, variant, material, spp, env, prefix) for _ in range(runs_at(spp))])
+
+
+def side_by_side(facetfit, work, ff_material, python, mi_material, spp, env):
+    """facetfit_run's and mitsuba_run's (llvm_ad_rgb) figures from runs taken in turn, so that both renderers
+    meet the same load on a shared machine."""
+    path = write_scene(work, ff_material, spp)
+    mitsuba_launch(python, "llvm_ad_rgb", mi_material, spp, env, (), 1)
+    ff, mi = [], []
     for _ in range(runs_at(spp)):
-        renders.append(launch(2)[0][1])
-        _, wall, mib = launch(1)
-        processes.append(wall)
-        memory.append(mib)
-    return median(renders), median(processes), median(memory)
+        ff.append(facetfit_once(facetfit, work, path))
+        mi.append(mitsuba_once(python, "llvm_ad_rgb", mi_material, spp, env))
+    return medians(ff), medians(mi)
 
 
 def noise(facetfit, python, work, ff_material, mi_material, spp, env, variant):
@@ -237,16 +259,20 @@ def main(facetfit, mitsuba_python, dst, rgl=None):
         subprocess.run([facetfit, "bake", rgl, "-o", lut_dir], check=True, capture_output=True)
         cases.append(("measured RGL (%s)" % name, {"type": "measured", "file": rgl, "proposal": os.path.join(lut_dir, name + ".exr")},
                       {"type": "measured", "file": rgl}))
-    rows, mitsuba_cache = [], {}
+    # Each case's facetfit runs alternate with Mitsuba llvm_ad_rgb's (side_by_side): on a shared machine the
+    # load changes from minute to minute, and a ratio of runs minutes apart measured it. The scalar variant,
+    # slower and only for reference, once per Mitsuba material.
+    rows, scalar_cache = [], {}
     for spp in SPPS:
         for label, ff, mi_material in cases:
-            f_render, f_process, f_memory = facetfit_run(facetfit, work, ff, spp)
             key = (json.dumps(mi_material), spp)
-            if key not in mitsuba_cache:
-                scalar = mitsuba_run(mitsuba_python, "scalar_rgb", mi_material, spp, env)
-                jit = mitsuba_run(mitsuba_python, "llvm_ad_rgb", mi_material, spp, env) if llvm else None
-                mitsuba_cache[key] = (scalar, jit)
-            scalar, jit = mitsuba_cache[key]
+            if key not in scalar_cache:
+                scalar_cache[key] = mitsuba_run(mitsuba_python, "scalar_rgb", mi_material, spp, env)
+            scalar = scalar_cache[key]
+            if llvm:
+                (f_render, f_process, f_memory), jit = side_by_side(facetfit, work, ff, mitsuba_python, mi_material, spp, env)
+            else:
+                (f_render, f_process, f_memory), jit = facetfit_run(facetfit, work, ff, spp), None
             rows.append((label, spp, f_render, f_process, f_memory, scalar, jit, mi_material["type"] == "ggx" and ff["type"] != "ggx"))
             print("%s %d spp: facetfit %.3f / %.3f s, scalar %.3f / %.3f s, llvm %s" % (
                 label, spp, f_render, f_process, scalar[0], scalar[1], "%.3f / %.3f s" % jit[:2] if jit else "absent"), file=sys.stderr)
@@ -300,7 +326,7 @@ def main(facetfit, mitsuba_python, dst, rgl=None):
     with open(dst + ".tmp", "w") as out:
         out.write("# Reference renderer against Mitsuba 3\n\nGenerated by `make bench` (bench/render_compare.py); do not edit by hand.\n\n")
         out.write("The scene of `../shared/data/realref` at %d x %d (constant environment 0.3, one directional light, a unit\n"
-                  "sphere; direct lighting), %d CPUs, every renderer on all of them, median of %d runs (one at 1024 spp), Mitsuba 3 from PyPI.\n"
+                  "sphere; direct lighting), %d CPUs, every renderer on all of them, median of %d runs (one at 1024 spp; facetfit's in turn with Mitsuba LLVM's), Mitsuba 3 from PyPI.\n"
                   "*render*: one render (facetfit: the time it prints, including loading the material and building the\n"
                   "scene; Mitsuba: the second render in its process, scene loaded and kernels compiled). *process*: launch\n"
                   "to exit (llvm_ad_rgb with a warm kernel cache). Ratios are facetfit's time over Mitsuba's: below 1,\n"
