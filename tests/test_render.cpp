@@ -539,10 +539,10 @@ TEST(Wavefront, TakeHitsLooksUpEachPixelsObject) {
       RayHits hits;
       hits.resize_to(n);
       for (std::size_t k = 0; k < hits.padded_size(); ++k) {
-        const int run = int(k / 8) % 4;  // 8 alike, then mixed
-        hits.object[k] = run == 3 ? double(int(u(rng) * 4.0) - 1) : double(run) - (run == 2 ? 3.0 : 0.0);
+        const int run = int(k / 8) % 5;  // 8 alike (objects 0, 1, 2, a miss), then mixed
+        hits.object[k] = run == 4 ? double(int(u(rng) * 4.0) - 1) : run == 3 ? -1.0 : double(run);
         hits.t[k] = hits.object[k] >= 0.0 ? 1.0 + u(rng) : std::numeric_limits<double>::infinity();
-        hits.ngx[k] = hits.object[k] == 1.0 ? u(rng) : 0.0, hits.ngy[k] = hits.object[k] == 1.0 ? 1.0 : 0.0, hits.ngz[k] = 0.0;
+        hits.ngx[k] = hits.object[k] == 1.0 ? u(rng) : 0.0, hits.ngy[k] = hits.object[k] == 1.0 ? 1.0 : 0.0, hits.ngz[k] = hits.object[k] == 1.0 ? -0.5 : 0.0;
       }
       TileHits tile;
       tile.resize_to(n);
@@ -557,12 +557,13 @@ TEST(Wavefront, TakeHitsLooksUpEachPixelsObject) {
         const std::size_t i = hit ? std::size_t(o) : 0;
         EXPECT_EQ(tile.material[k], hit ? objects.material[i] : -1.0) << where << " " << k;
         EXPECT_EQ(alpha[k], hit ? 1.0 : 0.0) << where << " " << k;
-        EXPECT_EQ(radiance[1][k], hit ? 0.0 : background.g) << where << " " << k;
+        for (int c = 0; c < 3; ++c) EXPECT_EQ(radiance[c][k], hit ? 0.0 : background[c]) << where << " " << k << " channel " << c;
         if (!hit) continue;
         EXPECT_EQ(tile.t[k], hits.t[k]) << where << " " << k;
         EXPECT_EQ(tile.inv_radius[k], objects.inv_radius[i]) << where << " " << k;
         EXPECT_EQ(tile.gx[k], i == 1 ? hits.ngx[k] : objects.cx[i]) << where << " " << k;
         EXPECT_EQ(tile.gy[k], i == 1 ? hits.ngy[k] : objects.cy[i]) << where << " " << k;
+        EXPECT_EQ(tile.gz[k], i == 1 ? hits.ngz[k] : objects.cz[i]) << where << " " << k;
       }
     }
 }
