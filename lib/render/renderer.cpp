@@ -383,7 +383,7 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
     std::vector<std::uint32_t>& planned_pixels = space.planned_pixels;
     double* radiance[3];
     // Padded as the tile's columns, which take_hits() writes whole.
-    const std::size_t padded_n = (n + Columns::kPadding - 1) / Columns::kPadding * Columns::kPadding;
+    const std::size_t padded_n = Columns::padded(n);
     for (int c = 0; c < 3; ++c) space.radiance[c].resize(padded_n), radiance[c] = space.radiance[c].data();
     space.alpha.resize(padded_n);
     double* const alpha = space.alpha.data();

@@ -21,8 +21,11 @@ class Columns {
   // entries at once).
   static constexpr std::size_t kPadding = 16;
 
+  // n rounded up to a multiple of kPadding: how far a kernel reads columns of n entries.
+  static constexpr std::size_t padded(std::size_t n) { return (n + kPadding - 1) / kPadding * kPadding; }
+
   std::size_t size() const { return size_; }
-  std::size_t padded_size() const { return (size_ + kPadding - 1) / kPadding * kPadding; }
+  std::size_t padded_size() const { return padded(size_); }
   void clear() { size_ = 0; }
 
  protected:
@@ -35,8 +38,7 @@ class Columns {
   // Room for n entries (columns of at least n's padded size), for kernels that write entries in place.
   template <class Grow>
   void ensure(std::size_t n, const Grow& grow) {
-    const std::size_t padded = (n + kPadding - 1) / kPadding * kPadding;
-    if (padded > capacity_) grow(capacity_ = padded);
+    if (padded(n) > capacity_) grow(capacity_ = padded(n));
   }
   void set_size(std::size_t n) { size_ = n; }
   static void resize(std::initializer_list<std::vector<double>*> columns, std::size_t n, double fill) {

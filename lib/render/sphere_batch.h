@@ -58,7 +58,7 @@ struct RaysFromPoint {
   Vec3 origin;
   const double *dx, *dy, *dz;
   std::size_t size;
-  std::size_t padded_size() const { return (size + Columns::kPadding - 1) / Columns::kPadding * Columns::kPadding; }
+  std::size_t padded_size() const { return Columns::padded(size); }
 };
 void nearest_spheres(const SphereSet& spheres, const RaysFromPoint& rays, std::vector<double>& t, std::vector<double>& id,
                      SimdTarget target = SimdTarget::best);

@@ -206,24 +206,25 @@ void Tracer::add_triangle_hits(std::size_t n, const RayAt& ray_at, RayHits& hits
   }
 }
 
-void Tracer::intersect(const RayBatch& rays, RayHits& hits, bool coherent) const {
-  hits.resize_to(rays.size());
+// The n rays' nearest hits: the spheres in lanes (nearest_spheres() of either kind of rays), then the
+// triangles, the k-th ray as ray_at(k).
+template <class Rays, class RayAt>
+void Tracer::nearest_hits(const Rays& rays, std::size_t n, const RayAt& ray_at, RayHits& hits, bool coherent) const {
+  hits.resize_to(n);
   if (!spheres_.empty()) {
     nearest_spheres(sphere_set_, rays, hits.t, hits.object);
   } else {
     miss_all(hits);
   }
-  add_triangle_hits(rays.size(), [&rays](std::size_t k) { return ray_at(rays, k); }, hits, coherent);
+  add_triangle_hits(n, ray_at, hits, coherent);
+}
+
+void Tracer::intersect(const RayBatch& rays, RayHits& hits, bool coherent) const {
+  nearest_hits(rays, rays.size(), [&rays](std::size_t k) { return ray_at(rays, k); }, hits, coherent);
 }
 
 void Tracer::intersect(const RaysFromPoint& rays, RayHits& hits, bool coherent) const {
-  hits.resize_to(rays.size);
-  if (!spheres_.empty()) {
-    nearest_spheres(sphere_set_, rays, hits.t, hits.object);
-  } else {
-    miss_all(hits);
-  }
-  add_triangle_hits(rays.size, [&rays](std::size_t k) { return Ray(rays.origin, Vec3(rays.dx[k], rays.dy[k], rays.dz[k])); }, hits, coherent);
+  nearest_hits(rays, rays.size, [&rays](std::size_t k) { return Ray(rays.origin, Vec3(rays.dx[k], rays.dy[k], rays.dz[k])); }, hits, coherent);
 }
 
 void Tracer::occluded(const RayBatch& rays, std::vector<char>& blocked) const {

@@ -81,6 +81,8 @@ class Tracer {
   };
   struct Embree;
   Hit nearest_sphere(const Ray& ray) const;
+  template <class Rays, class RayAt>
+  void nearest_hits(const Rays& rays, std::size_t n, const RayAt& ray_at, RayHits& hits, bool coherent) const;
   template <class RayAt>
   void add_triangle_hits(std::size_t n, const RayAt& ray_at, RayHits& hits, bool coherent) const;
   bool blocked_by_sphere(const Ray& ray) const;
