@@ -95,7 +95,8 @@ void run_render(const RenderArgs& args, Context& ctx) {
       MaterialDesc subject;
       subject.type = args.material_type;
       subject.file = args.material;
-      const bool needs_lut = subject.type == "lut" || subject.type == "ggx" || subject.type == "beckmann" || subject.type == "lsq";
+      const bool needs_lut = subject.type == "lut" || subject.type == "ggx" || subject.type == "beckmann" || subject.type == "lsq" ||
+                             subject.type == "closures";
       if (needs_lut && fs::path(subject.file).extension() != ".exr") {
         baked_dir.reset(new fs::path(fs::temp_directory_path() / ("facetfit-render-" + std::to_string(::getpid()))));
         fs::create_directories(*baked_dir);
@@ -164,9 +165,9 @@ void add_render_command(CLI::App& app, Context& ctx) {
   cmd->add_option("--height", args->height, "Image height (default: the scene's)")->check(CLI::Range(1, 16384));
   add_max_memory_option(cmd, args->max_memory);
   cmd->add_option("--material", args->material, "Default scene only: the sphere's material file")->capture_default_str();
-  cmd->add_option("--material-type", args->material_type, "Default scene only: measured, lut, ggx, beckmann or lsq (a measurement is baked first for the last four), "
+  cmd->add_option("--material-type", args->material_type, "Default scene only: measured, lut, ggx, beckmann, lsq or closures (a measurement is baked first for the last five), "
                   "analytic (a built-in's analytic model) or lambert (albedo 0.8)")
-      ->check(CLI::IsMember({"measured", "lut", "ggx", "beckmann", "lsq", "analytic", "lambert"}))
+      ->check(CLI::IsMember({"measured", "lut", "ggx", "beckmann", "lsq", "closures", "analytic", "lambert"}))
       ->capture_default_str();
   cmd->callback([args, cmd, &ctx] {
     // They shape the default scene only: with a scene of one's own they would be silently ignored.

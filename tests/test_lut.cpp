@@ -71,7 +71,7 @@ TEST(Lut, MetadataRoundTrip) {
   TempDir dir;
   write_lut(dir.file("copper.exr"), lut);
   const LutMetadata m = read_lut(dir.file("copper.exr")).meta;
-  EXPECT_EQ(m.format_version, kLutFormatVersion);
+  EXPECT_EQ(m.format_version, kLutClosuresVersion);
   EXPECT_EQ(m.facetfit_version, FACETFIT_VERSION);
   EXPECT_EQ(m.source, "/data/copper.binary");
   EXPECT_EQ(m.source_sha256, std::string(64, 'f'));
@@ -88,6 +88,72 @@ TEST(Lut, MetadataRoundTrip) {
   EXPECT_GT(m.ndf_error_ggx, 0.05);
   EXPECT_EQ(m.representation, Representation::beckmann);
   EXPECT_TRUE(m.sampling);
+  // The closures come back to float precision.
+  const Closures &c = m.closures, &want = b.fit.closures.closures;
+  ASSERT_EQ(c.lobes.size(), want.lobes.size());
+  ASSERT_FALSE(c.empty());
+  EXPECT_FLOAT_EQ(float(c.coat.alpha), float(want.coat.alpha));
+  for (std::size_t k = 0; k < c.lobes.size(); ++k) {
+    EXPECT_EQ(c.lobes[k].type, want.lobes[k].type);
+    EXPECT_EQ(c.lobes[k].fresnel, want.lobes[k].fresnel);
+    EXPECT_FLOAT_EQ(float(c.lobes[k].alpha_x), float(want.lobes[k].alpha_x));
+    EXPECT_FLOAT_EQ(float(c.lobes[k].weight), float(want.lobes[k].weight));
+    EXPECT_FLOAT_EQ(float(c.lobes[k].exponent), float(want.lobes[k].exponent));
+    for (int e = 0; e < 3; ++e) {
+      EXPECT_FLOAT_EQ(float(c.lobes[k].f0[e]), float(want.lobes[k].f0[e]));
+      EXPECT_FLOAT_EQ(float(c.lobes[k].f82[e]), float(want.lobes[k].f82[e]));
+      EXPECT_FLOAT_EQ(float(c.lobes[k].f90[e]), float(want.lobes[k].f90[e]));
+    }
+  }
+}
+
+// Version 5's closures: each attribute is checked on reading, and a LUT without them (versions 1 to 4)
+// gives its recommended family's fit as one lobe, what the material shader rendered of it.
+TEST(Lut, ClosuresAreValidatedAndOlderLutsGetOneLobe) {
+  const Baked b = fit_of(MicrofacetBrdf(Ndf::isotropic(NdfType::ggx, 0.2), Smith::correlated, Fresnel::schlick(Rgb(0.9, 0.6, 0.3))));
+  TempDir dir;
+  write_lut(dir.file("g.exr"), make_lut(b.fit, b.fitter.quadrature(), "x", "", 0.02, true));
+  auto in = OIIO::ImageInput::open(dir.file("g.exr"));
+  const OIIO::ImageSpec original = in->spec();
+  std::vector<float> px(std::size_t(original.width) * std::size_t(original.height) * std::size_t(original.nchannels));
+  ASSERT_TRUE(in->read_image(0, 0, 0, original.nchannels, OIIO::TypeDesc::FLOAT, px.data()));
+  const auto damaged = [&](const char* name, float value, const std::string& expected) {
+    OIIO::ImageSpec spec = original;
+    if (std::isinf(value))
+      spec.erase_attribute(name);
+    else if (std::string(name).find("code") != std::string::npos || std::string(name).find("lobes") != std::string::npos)
+      spec.attribute(name, int(value));
+    else
+      spec.attribute(name, value);
+    auto out = OIIO::ImageOutput::create(dir.file("bad.exr"));
+    ASSERT_TRUE(out->open(dir.file("bad.exr"), spec) && out->write_image(OIIO::TypeDesc::FLOAT, px.data()) && out->close());
+    const std::string e = error_of([&] { read_lut(dir.file("bad.exr")); });
+    EXPECT_NE(e.find("bad.exr: facetfit:" + expected), std::string::npos) << name << " " << value << ": " << e;
+  };
+  const float kAbsent = std::numeric_limits<float>::infinity();
+  damaged("facetfit:closures_lobes", 0, "closures_lobes is 0: must be 1 to 3");
+  damaged("facetfit:closures_lobes", 4, "closures_lobes is 4");
+  damaged("facetfit:closures_lobes", kAbsent, "closures_lobes is -1");
+  damaged("facetfit:closures_lobe0_alpha_x", std::nanf(""), "closures_lobe0_alpha_x is missing or outside");
+  damaged("facetfit:closures_lobe0_alpha_y", 0.0f, "closures_lobe0_alpha_y is missing or outside");
+  damaged("facetfit:closures_lobe0_weight", -1.0f, "closures_lobe0_weight is missing or outside");
+  damaged("facetfit:closures_lobe0_family_code", 3, "closures_lobe0_family_code is missing");
+  damaged("facetfit:closures_lobe0_fresnel_code", 0, "closures_lobe0_fresnel_code is missing");
+  damaged("facetfit:closures_lobe0_exponent", kAbsent, "closures_lobe0_exponent is missing");
+  damaged("facetfit:closures_coat_f0", 2.0f, "closures_coat_f0 is missing or outside");
+  damaged("facetfit:closures_body", kAbsent, "closures_body is missing");
+
+  FitResult old = b.fit;
+  old.closures = {};
+  write_lut(dir.file("old.exr"), make_lut(old, b.fitter.quadrature(), "x", "", 0.02, true));
+  const Lut lut = read_lut(dir.file("old.exr"));
+  EXPECT_EQ(lut.meta.format_version, kLutFormatVersion);
+  const Closures c = lut.closures();
+  ASSERT_EQ(c.lobes.size(), 1u);
+  EXPECT_EQ(c.lobes[0].type, NdfType::ggx);
+  EXPECT_FLOAT_EQ(float(c.lobes[0].alpha_x), float(lut.meta.ggx.alpha));
+  EXPECT_EQ(c.lobes[0].weight, 1.0);
+  EXPECT_EQ(c.lobes[0].fresnel, ClosureLobe::Fresnel::f82_tint);
 }
 
 TEST(Lut, ToleranceChoosesTheRepresentation) {
@@ -139,8 +205,19 @@ TEST(Lut, AnisotropicLobeRoundTrip) {
   UtiaBrdf::tabulate(MicrofacetBrdf(Ndf{NdfType::ggx, 0.5, 0.25}, Smith::correlated, Fresnel::schlick(Rgb(0.9, 0.6, 0.3))))
       .write(dir.file("a.bin"));
   const Fitter fitter{FitOptions::paper()};
-  const FitResult fit = fitter.fit(load_table(dir.file("a.bin")));
+  FitResult fit = fitter.fit(load_table(dir.file("a.bin")));
   ASSERT_TRUE(fit.ok() && fit.anisotropic) << fit.problem;
+  // With its closures, version 5 with the same rows: its closure is the anisotropic GGX fit.
+  write_lut(dir.file("a5.exr"), make_lut(fit, fitter.quadrature(), "a.bin", "", 0.02, true));
+  const Lut five = read_lut(dir.file("a5.exr"));
+  EXPECT_EQ(five.meta.format_version, kLutClosuresVersion);
+  ASSERT_TRUE(five.anisotropic);
+  ASSERT_EQ(five.meta.closures.lobes.size(), 1u);
+  EXPECT_NEAR(five.meta.closures.lobes[0].alpha_x, fit.anisotropic->ggx.alpha.alpha_x, 1e-6);
+  EXPECT_NEAR(five.meta.closures.lobes[0].alpha_y, fit.anisotropic->ggx.alpha.alpha_y, 1e-6);
+  EXPECT_NEAR(five.meta.closures.lobes[0].angle, fit.anisotropic->ggx.alpha.angle, 1e-6);
+  // Without closures (what earlier facetfits wrote), the versions below.
+  fit.closures = {};
   const Lut baked = make_lut(fit, fitter.quadrature(), "a.bin", "", 0.02, true);
   write_lut(dir.file("a.exr"), baked);
   const Lut lut = read_lut(dir.file("a.exr"));
@@ -197,6 +274,7 @@ TEST(Lut, ABodyExponentMakesVersionFour) {
   // which earlier readers take; they refuse version 4 rather than render its body as Lambert's.
   TempDir dir;
   Baked b = fit_of(MicrofacetBrdf(Ndf::isotropic(NdfType::ggx, 0.2), Smith::correlated, Fresnel::one()));
+  b.fit.closures = {};  // without them, as earlier facetfits wrote (with them, version 5)
   b.fit.lobe.body = Rgb(0.4, 0.3, 0.2);
   b.fit.lobe.body_exponent = 1.6;
   write_lut(dir.file("k.exr"), make_lut(b.fit, b.fitter.quadrature(), "x", "", 0.02, true));

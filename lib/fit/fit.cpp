@@ -14,6 +14,7 @@
 #include "fit/roughness.h"
 #include "model/fresnel.h"
 #include "model/tabulated.h"
+#include "model/visible_slopes.h"
 
 namespace facetfit {
 
@@ -123,6 +124,10 @@ void Fitter::refine_on_measurement(const MerlTable& table, FitResult& result) co
     if (error < result.error) result.error = error, choice = candidate;
   }
   result.lobe = *choice;
+  // The closures, from the GGX fit, matching the measurement's albedo too, drawn by the tabulated lobe's
+  // proposal (fit/closure_fit.h).
+  const AlbedoTarget albedo = albedo_target(table, VisibleSlopeProposal(result.lobe.tables(smith)));
+  result.closures = fit_closures(closure_bins(table), &albedo, bins, result.ggx);
   result.alpha_ggx = alpha_ggx_from_moments(result.ndf(), quadrature_);
   result.alpha_beckmann = alpha_beckmann_from_moments(result.ndf(), quadrature_);
 }
@@ -191,6 +196,7 @@ FitResult Fitter::fit(const MerlTable& table) const {
   result.ggx = moments(NdfType::ggx, result.alpha_ggx, ParametricFit::FresnelForm::f82);
   result.beckmann = moments(NdfType::beckmann, result.alpha_beckmann, ParametricFit::FresnelForm::f82);
   result.lsq = moments(NdfType::ggx, result.alpha_ggx, ParametricFit::FresnelForm::schlick);
+  result.closures.closures = closures_of(result.ggx);
   // The paper's method alone measures nothing else: no bins, no errors (they stay 0).
   if (refine) refine_on_measurement(table, result);
   result.f0 = result.fresnel().value[0];
@@ -217,6 +223,7 @@ FitResult Fitter::fit(const MerlTable& table) const {
       a.residual = e.residual;
       a.tables = AnisotropicTables{quadrature.grid(), quadrature.phi_count(), e.ndf, e.sigma, options_.smith, paper_fresnel};
       fit_anisotropic_lobes(table, paper_fresnel, result, a);
+      result.closures = {closures_of(a.ggx), a.ggx.error};
       result.anisotropic = a;
       // Anisotropic beyond what the 15-degree grid resolves (a 10% ratio): say what an isotropic LUT loses.
       if (a.alpha_ggx.alpha_x > 1.1 * a.alpha_ggx.alpha_y) {

@@ -10,6 +10,7 @@
 #include <vector>
 #include <string>
 
+#include "fit/closure_fit.h"
 #include "fit/extract.h"
 #include "fit/extract_2d.h"
 #include "fit/fresnel_fit.h"
@@ -26,8 +27,9 @@ namespace facetfit {
 // a different fit. 2: an RGL file's refinement reads its two one-sided estimates (fit/measurement.h);
 // 3: the parametric fits solved by fit/small_problem.h; 4: the refinement solved to convergence in two
 // passes, a UTIA file's isotropic fits on its own nodes; 5: its anisotropic lobes on its node pairs;
-// 6: the grazing pairs' soft L1 loss (fit/measurement.h); 7: the tabulated body's Minnaert exponent (model/body.h).
-constexpr int kFitRevision = 7;
+// 6: the grazing pairs' soft L1 loss (fit/measurement.h); 7: the tabulated body's Minnaert exponent (model/body.h);
+// 8: the closure representation (fit/closure_fit.h).
+constexpr int kFitRevision = 8;
 
 struct FitOptions {
   int resolution = 90;  // intervals of the u grid; R + 1 nodes
@@ -78,6 +80,10 @@ struct FitResult {
   // Parametric fits on the whole measurement (with Refine::none: the moment alphas, no body, f0 and
   // f82 of the curve); lsq is the classical Lambert + GGX + Schlick baseline.
   ParametricFit ggx, beckmann, lsq;
+  // The renderers' closures (fit/closure_fit.h): with Refine::full fitted on the whole measurement from the
+  // nearer of ggx and beckmann, for an anisotropic source its anisotropic GGX lobe; with Refine::none the
+  // ggx moment fit as one lobe (error 0).
+  ClosureFit closures;
   // Distance from the measurement (fit/measurement.h) of the paper's pure fit and of `lobe`.
   double error_extraction = 0.0, error = 0.0;
   Smith smith = Smith::correlated;  // the model the NDF is consistent with

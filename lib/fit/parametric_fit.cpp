@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "core/frame.h"
+#include "fit/lobe_terms.h"
 #include "fit/small_problem.h"
 #include "model/fresnel.h"
 #include "model/parametric.h"
@@ -15,6 +16,8 @@
 namespace facetfit {
 
 namespace {
+
+using namespace lobe_terms;
 
 // The parametric fits' bounds: the first `alphas` entries of `log_alpha` within log [1e-3, 4], a nonnegative
 // body, reflectances f0 and f82 in [0, 1] (the starts are clamped there by the callers).
@@ -31,91 +34,6 @@ void bound_lobe(SmallProblem& problem, double* log_alpha, int alphas, double* bo
 
 // The parametric fits' solve: a dense problem of 8 to 14 unknowns (fit/small_problem.h).
 void solve(SmallProblem& problem, int max_iterations) { problem.Solve(max_iterations, 1e-6); }
-
-// A value and its derivative with respect to alpha.
-struct WithSlope {
-  double value = 0.0, slope = 0.0;
-};
-
-// Smith's Lambda of the two families at cos(theta) = c, and d/dalpha.
-WithSlope lambda_of(NdfType type, double alpha, double c) {
-  const double s2 = std::max(0.0, 1.0 - c * c);
-  if (s2 <= 0.0) return {};
-  if (type == NdfType::ggx) {
-    // Lambda = (sqrt(1 + alpha^2 tan^2) - 1) / 2.
-    const double q = s2 / (c * c), root = std::sqrt(1.0 + alpha * alpha * q);
-    return {0.5 * (root - 1.0), 0.5 * alpha * q / root};
-  }
-  // Beckmann, x = cot(theta) / alpha: Lambda = (erf(x) - 1) / 2 + exp(-x^2) / (2 x sqrt(pi)),
-  // dLambda/dalpha = exp(-x^2) / (2 sqrt(pi) x alpha).
-  const double s = std::sqrt(s2), x = c / (alpha * s), e = std::exp(-x * x);
-  constexpr double kSqrtPi = 1.7724538509055160273;
-  return {0.5 * (std::erf(x) - 1.0) + e / (2.0 * kSqrtPi * x), e / (2.0 * kSqrtPi * x * alpha)};
-}
-
-// D of the two families at cos(theta_h) = c, and d/dalpha.
-WithSlope ndf_of(NdfType type, double alpha, double c) {
-  const double c2 = c * c, t2 = (1.0 - c2) / c2, a2 = alpha * alpha, c4 = c2 * c2;
-  if (type == NdfType::ggx) {
-    // D = a2 / (pi c^4 (a2 + t2)^2); dD/da2 = (t2 - a2) / (pi c^4 (a2 + t2)^3).
-    const double den = a2 + t2, d = a2 / (kPi * c4 * den * den);
-    return {d, 2.0 * alpha * (t2 - a2) / (kPi * c4 * den * den * den)};
-  }
-  // D = exp(-t2 / a2) / (pi a2 c^4); dD/da2 = D (t2 / a2 - 1) / a2.
-  const double d = std::exp(-t2 / a2) / (kPi * a2 * c4);
-  return {d, 2.0 * alpha * d * (t2 / a2 - 1.0) / a2};
-}
-
-// G2 of Lambda_i, Lambda_o, and d/dalpha through both.
-WithSlope g2_of(Smith smith, const WithSlope& li, const WithSlope& lo) {
-  switch (smith) {
-    case Smith::masking: {
-      const WithSlope& l = li.value > lo.value ? li : lo;
-      const double g = 1.0 / (1.0 + l.value);
-      return {g, -g * g * l.slope};
-    }
-    case Smith::correlated: {
-      const double g = 1.0 / (1.0 + li.value + lo.value);
-      return {g, -g * g * (li.slope + lo.slope)};
-    }
-    case Smith::separable: {
-      const double gi = 1.0 / (1.0 + li.value), go = 1.0 / (1.0 + lo.value);
-      return {gi * go, -gi * go * (gi * li.slope + go * lo.slope)};
-    }
-  }
-  return {};
-}
-
-// 1 - Schlick's weight: d Schlick(f0, mu) / d f0.
-double schlick_slope(double mu) {
-  const double m = 1.0 - mu, m2 = m * m;
-  return 1.0 - m2 * m2 * m;
-}
-
-// mu (1 - mu)^6: the shape of the F82-tint correction.
-double f82_basis(double mu) {
-  const double m = 1.0 - mu, m3 = m * m * m;
-  return mu * m3 * m3;
-}
-
-// One channel's Fresnel in the fits' forms and its derivatives in f0 and f82: F82-tint,
-//   F = Schlick(f0, mu) - (Schlick(f0, 1/7) - f82) mu (1 - mu)^6 / b82,
-// or, without `tint`, Schlick alone (f82 unused).
-struct FresnelTerms {
-  double value = 0.0, d_f0 = 0.0, d_f82 = 0.0;
-};
-FresnelTerms fresnel_terms(double f0, double f82, double mu, bool tint) {
-  const double s_mu = schlick_slope(mu);
-  FresnelTerms f{f0 * s_mu + (1.0 - s_mu), s_mu, 0.0};
-  if (!tint) return f;
-  constexpr double kMu82 = 1.0 / 7.0;
-  const double b82 = f82_basis(kMu82), schlick82 = 1.0 - schlick_slope(kMu82), basis = f82_basis(mu);
-  const double shift = (f0 * (1.0 - schlick82) + schlick82 - f82) / b82;
-  f.value -= shift * basis;
-  f.d_f0 -= (1.0 - schlick82) / b82 * basis;
-  f.d_f82 = basis / b82;
-  return f;
-}
 
 // The derivatives of residual r (channel e) in the colour blocks, body (0), f0 (2) and f82 (3), of a model
 // body / pi + F lobe + ...; dm is the residual's derivative in the model.
@@ -252,6 +170,8 @@ ParametricFit fit_parametric(const MeasuredBins& bins, const MeasuredBins& error
 }
 
 namespace {
+
+using namespace lobe_terms;
 
 // The anisotropic lobe without its Fresnel, D(h') G2(o', i') / (4 cos theta_i cos theta_o), primes in the
 // frame turned by `angle`: the library's own NDF and masking, so what is fitted is what is rendered.

@@ -1,6 +1,7 @@
 #include "lut/lut.h"
 
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 #include "core/error.h"
@@ -43,6 +44,73 @@ int representation_code(Representation r) {
     case Representation::beckmann: return 2;
   }
   return -1;
+}
+
+// A closure lobe's family as an integer (Cycles' OSL reads no string attribute): 1 GGX, 2 Beckmann, as
+// representation_code.
+int family_code(NdfType type) { return type == NdfType::ggx ? 1 : 2; }
+
+// The attribute of closure lobe k: facetfit:closures_lobe<k>_<name>.
+std::string lobe_key(std::size_t k, const char* name) { return "closures_lobe" + std::to_string(k) + "_" + name; }
+
+void write_closures(ImageSpec& spec, const LutMetadata& m) {
+  const Closures& c = m.closures;
+  spec.set(key("closures_lobes"), int(c.lobes.size()));
+  set_color(spec, "closures_body", c.body);
+  spec.set(key("closures_coat_alpha"), float(c.coat.alpha));
+  spec.set(key("closures_coat_f0"), float(c.coat.f0));
+  spec.set(key("closures_error"), float(m.error_closures));
+  for (std::size_t k = 0; k < c.lobes.size(); ++k) {
+    const ClosureLobe& l = c.lobes[k];
+    spec.set(key(lobe_key(k, "family_code").c_str()), family_code(l.type));
+    spec.set(key(lobe_key(k, "alpha_x").c_str()), float(l.alpha_x));
+    spec.set(key(lobe_key(k, "alpha_y").c_str()), float(l.alpha_y));
+    spec.set(key(lobe_key(k, "angle").c_str()), float(l.angle));
+    spec.set(key(lobe_key(k, "weight").c_str()), float(l.weight));
+    spec.set(key(lobe_key(k, "fresnel_code").c_str()), l.fresnel == ClosureLobe::Fresnel::f82_tint ? 1 : 2);
+    set_color(spec, lobe_key(k, "f0").c_str(), l.f0);
+    set_color(spec, lobe_key(k, "f82").c_str(), l.f82);
+    set_color(spec, lobe_key(k, "f90").c_str(), l.f90);
+    spec.set(key(lobe_key(k, "exponent").c_str()), float(l.exponent));
+  }
+}
+
+// Version 5's closures, each attribute present and in range, or one line naming it.
+void read_closures(const std::string& path, const ImageSpec& spec, LutMetadata& m) {
+  const auto number = [&](const std::string& name, double lo, double hi) {
+    const double v = spec.get_float(key(name.c_str()), std::numeric_limits<float>::quiet_NaN());
+    if (!(v >= lo && v <= hi)) {
+      std::ostringstream s;
+      s << "facetfit:" << name << " is missing or outside [" << lo << ", " << hi << "]";
+      fail(path, s.str());
+    }
+    return v;
+  };
+  const auto colour = [&](const std::string& name) {
+    const auto c = get_color(spec, name.c_str());
+    if (!c || !(std::min({c->r, c->g, c->b}) >= 0.0 && std::max({c->r, c->g, c->b}) <= 1e3))
+      fail(path, "facetfit:" + name + " is missing or not a colour in [0, 1000]");
+    return *c;
+  };
+  Closures& c = m.closures;
+  const int lobes = spec.get_int(key("closures_lobes"), -1);
+  if (lobes < 1 || lobes > Closures::kMaxLobes)
+    fail(path, "facetfit:closures_lobes is " + std::to_string(lobes) + ": must be 1 to " + std::to_string(Closures::kMaxLobes));
+  c.body = colour("closures_body");
+  c.coat = {number("closures_coat_alpha", 0.0, 10.0), number("closures_coat_f0", 0.0, 1.0)};
+  m.error_closures = number("closures_error", 0.0, 1e30);
+  for (std::size_t k = 0; k < std::size_t(lobes); ++k) {
+    const int code = spec.get_int(key(lobe_key(k, "family_code").c_str()), -1);
+    if (code != 1 && code != 2) fail(path, "facetfit:" + lobe_key(k, "family_code") + " is missing or not 1 (GGX) or 2 (Beckmann)");
+    const int fresnel = spec.get_int(key(lobe_key(k, "fresnel_code").c_str()), -1);
+    if (fresnel != 1 && fresnel != 2)
+      fail(path, "facetfit:" + lobe_key(k, "fresnel_code") + " is missing or not 1 (F82-tint) or 2 (generalized Schlick)");
+    c.lobes.push_back({code == 1 ? NdfType::ggx : NdfType::beckmann, number(lobe_key(k, "alpha_x"), 1e-4, 10.0),
+                       number(lobe_key(k, "alpha_y"), 1e-4, 10.0), number(lobe_key(k, "angle"), -kPi, kPi),
+                       number(lobe_key(k, "weight"), 0.0, 1e3),
+                       fresnel == 1 ? ClosureLobe::Fresnel::f82_tint : ClosureLobe::Fresnel::schlick, colour(lobe_key(k, "f0")),
+                       colour(lobe_key(k, "f82")), colour(lobe_key(k, "f90")), number(lobe_key(k, "exponent"), 0.0, 100.0)});
+  }
 }
 
 }  // namespace
@@ -122,6 +190,9 @@ Lut make_lut(const FitResult& fit, const Quadrature& quadrature, const std::stri
     m.anisotropic_ggx = fit.anisotropic->ggx;
   }
   if (m.body_exponent != 1.0) m.format_version = kLutBodyExponentVersion;
+  m.closures = fit.closures.closures;
+  m.error_closures = fit.closures.error;
+  if (!m.closures.empty()) m.format_version = kLutClosuresVersion;
   return lut;
 }
 
@@ -204,6 +275,7 @@ void write_lut(const std::string& path, const Lut& lut) {
     set_color(spec, "anisotropic_ggx_f82", g.f82);
     spec.set(key("anisotropic_ggx_error"), float(g.error));
   }
+  if (m.format_version >= kLutClosuresVersion) write_closures(spec, m);
   // One line per warning; absent when there is none.
   if (!m.warnings.empty()) {
     std::string text;
@@ -219,6 +291,19 @@ std::optional<ParametricBrdf> Lut::parametric(const std::string& family, Smith s
   if (!p) return std::nullopt;
   const NdfType type = family == "beckmann" ? NdfType::beckmann : NdfType::ggx;
   return ParametricBrdf(Ndf::isotropic(type, p->alpha), smith, p->f0, p->f82, p->body, p->coat);
+}
+
+Closures Lut::closures() const {
+  if (!meta.closures.empty()) return meta.closures;
+  if (anisotropic && meta.representation != Representation::beckmann) return closures_of(meta.anisotropic_ggx);
+  const bool beckmann = meta.representation == Representation::beckmann ||
+                        (meta.representation == Representation::tabulated && meta.error_beckmann < meta.error_ggx);
+  const LutMetadata::Parametric& p = beckmann ? meta.beckmann : meta.ggx;
+  Closures c;
+  c.body = p.body;
+  c.coat = p.coat;
+  c.lobes.push_back({beckmann ? NdfType::beckmann : NdfType::ggx, p.alpha, p.alpha, 0.0, 1.0, ClosureLobe::Fresnel::f82_tint, p.f0, p.f82});
+  return c;
 }
 
 namespace {
@@ -272,9 +357,9 @@ Lut read_lut(const std::string& path) {
   const ImageSpec& spec = image.spec();
   const int version = spec.get_int(key("format_version"), -1);
   if (version < 0) fail(path, "not a facetfit LUT (no facetfit:format_version attribute)");
-  if (version < 1 || version > kLutBodyExponentVersion)
+  if (version < 1 || version > kLutClosuresVersion)
     fail(path, "LUT format version " + std::to_string(version) + "; this facetfit reads versions 1 to " +
-                   std::to_string(kLutBodyExponentVersion));
+                   std::to_string(kLutClosuresVersion));
 
   Lut lut;
   LutMetadata& m = lut.meta;
@@ -342,8 +427,9 @@ Lut read_lut(const std::string& path) {
     m.error_extraction = spec.get_float(key("error_extraction"));
   }
 
-  // Version 3 always has the anisotropic rows; version 4 where it says so.
-  if (version == kLutAnisotropicVersion || (version == kLutBodyExponentVersion && spec.get_int(key("anisotropic_phi_count"), 0) > 0)) {
+  if (version >= kLutClosuresVersion) read_closures(path, spec, m);
+  // Version 3 always has the anisotropic rows; versions 4 and 5 where they say so.
+  if (version == kLutAnisotropicVersion || (version >= kLutBodyExponentVersion && spec.get_int(key("anisotropic_phi_count"), 0) > 0)) {
     m.anisotropic_resolution = spec.get_int(key("anisotropic_resolution"), -1);
     m.anisotropic_phi_count = spec.get_int(key("anisotropic_phi_count"), -1);
     // Bounded before anything is sized from them; the quadrature's own limits.

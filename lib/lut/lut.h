@@ -17,9 +17,13 @@ namespace facetfit {
 // Version 4 adds facetfit:body_exponent (Minnaert's k of the tabulated body, model/body.h), with or
 // without the anisotropic rows; it is written only when k is not 1, so a Lambertian body's LUT stays
 // version 2 or 3 and earlier readers, which would render the body Lambertian, refuse the others.
+// Version 5 is version 4 with the closure representation (facetfit:closures_*, model/closures.h): what
+// the production shader renders. Every LUT of this facetfit is version 5; versions 1 to 4 still read,
+// without closures.
 constexpr int kLutFormatVersion = 2;
 constexpr int kLutAnisotropicVersion = 3;
 constexpr int kLutBodyExponentVersion = 4;
+constexpr int kLutClosuresVersion = 5;
 
 // Which model a renderer should use for this material.
 enum class Representation { tabulated, ggx, beckmann };
@@ -63,6 +67,9 @@ struct LutMetadata {
   // GGX fit (fit/fit.h, AnisotropicFit::ggx: principal alphas, axis, body, F82-tint Fresnel).
   int anisotropic_resolution = 0, anisotropic_phi_count = 0;
   AnisotropicParametricFit anisotropic_ggx;
+  // The closure representation (version 5; empty before) and its distance from the measurement.
+  Closures closures;
+  double error_closures = 0.0;
   std::vector<std::string> warnings;  // implausible values found when fitting (fit/plausibility.h)
 };
 
@@ -89,6 +96,9 @@ struct Lut {
   // One of the parametric fits it carries ("ggx", "beckmann" or "lsq"): alpha, body, coat and its
   // F82-tint Fresnel (Schlick for lsq), evaluated with `smith`. nullopt for another name.
   std::optional<ParametricBrdf> parametric(const std::string& family, Smith smith) const;
+  // The closure representation: version 5's, or for an older LUT its recommended family's fit as one
+  // lobe (the anisotropic GGX fit where it has one), what the material shader rendered of it.
+  Closures closures() const;
 };
 
 // Builds the LUT of a fit and chooses its representation: the parametric NDF with the smaller error

@@ -27,6 +27,15 @@ class Proposal {
   virtual double pdf(const Vec3& o, const Vec3& i) const = 0;
 };
 
+// A direction of density cos(theta) / pi from two uniform numbers: r = sqrt(u1) on the unit disk, lifted
+// to the hemisphere; nullopt on the horizon.
+inline std::optional<Vec3> cosine_direction(double u1, double u2) {
+  const double r = std::sqrt(u1), phi = 2.0 * kPi * u2;
+  const Vec3 i(r * std::cos(phi), r * std::sin(phi), std::sqrt(std::max(0.0, 1.0 - r * r)));
+  if (i.z <= 0.0) return std::nullopt;
+  return i;
+}
+
 // The three parts of a fitted material and their probabilities (lobe + body + coat = 1).
 struct ProposalParts {
   double lobe = 1.0, body = 0.0;
@@ -46,12 +55,7 @@ struct ProposalParts {
   std::optional<Vec3> sample(const Vec3& o, double u1, double u2, const LobeDirection& lobe_direction) const {
     if (u1 < lobe) return lobe_direction(u1 / lobe, u2);
     u1 -= lobe;
-    if (u1 < body) {  // the cosine: r = sqrt(u) on the unit disk, lifted to the hemisphere
-      const double r = std::sqrt(u1 / body), phi = 2.0 * kPi * u2;
-      const Vec3 i(r * std::cos(phi), r * std::sin(phi), std::sqrt(std::max(0.0, 1.0 - r * r)));
-      if (i.z <= 0.0) return std::nullopt;
-      return i;
-    }
+    if (u1 < body) return cosine_direction(u1 / body, u2);
     return coat.sample_direction(o, clamp((u1 - body) / coat_weight(), 0.0, 1.0 - 1e-16), u2);
   }
   // The mixture's density, given the lobe's.

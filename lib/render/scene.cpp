@@ -17,6 +17,7 @@
 #include "lut/record.h"
 #include "model/analytic.h"
 #include "model/builtin.h"
+#include "model/closures.h"
 #include "model/parametric.h"
 #include "model/rotated.h"
 #include "model/visible_slopes.h"
@@ -109,10 +110,10 @@ MaterialDesc parse_material(const std::string& name, const json& j, const std::s
   MaterialDesc m;
   m.type = get<std::string>(j, "type", "", path);
   if (m.type != "measured" && m.type != "lut" && m.type != "ggx" && m.type != "beckmann" && m.type != "lsq" &&
-      m.type != "lambert" && m.type != "analytic")
-    fail(path, "material " + name + ": type must be measured, lut, ggx, beckmann, lsq, lambert or analytic");
+      m.type != "closures" && m.type != "lambert" && m.type != "analytic")
+    fail(path, "material " + name + ": type must be measured, lut, ggx, beckmann, lsq, closures, lambert or analytic");
   m.file = get<std::string>(j, "file", "", path);
-  if ((m.type == "measured" || m.type == "lut" || m.type == "lsq" || m.type == "analytic") && m.file.empty())
+  if ((m.type == "measured" || m.type == "lut" || m.type == "lsq" || m.type == "closures" || m.type == "analytic") && m.file.empty())
     fail(path, "material " + name + " needs a \"file\"");
   m.alpha = get<double>(j, "alpha", 0.0, path);
   if (!(m.alpha >= 0.0 && m.alpha <= 10.0)) fail(path, "material " + name + ": alpha must be in [0, 10]");
@@ -130,8 +131,8 @@ MaterialDesc parse_material(const std::string& name, const json& j, const std::s
   if (!smith) fail(path, "material " + name + ": smith must be masking, correlated or separable");
   m.smith = *smith;
   if (j.contains("albedo")) m.albedo = nonnegative(j["albedo"], "material " + name + ": albedo", path);
-  if (j.contains("tangent") && m.type != "lut" && m.type != "measured" && m.type != "ggx")
-    fail(path, "material " + name + ": \"tangent\" is for lut, ggx and measured materials (an anisotropic fit or measurement turns with it)");
+  if (j.contains("tangent") && m.type != "lut" && m.type != "measured" && m.type != "ggx" && m.type != "closures")
+    fail(path, "material " + name + ": \"tangent\" is for lut, ggx, closures and measured materials (an anisotropic fit or measurement turns with it)");
   if (j.contains("tangent")) m.tangent = direction(j["tangent"], "material " + name + ": tangent", path);
   if (j.contains("anisotropic")) {
     if ((m.type != "lut" && m.type != "ggx") || !j["anisotropic"].is_boolean())
@@ -139,7 +140,10 @@ MaterialDesc parse_material(const std::string& name, const json& j, const std::s
     m.anisotropic = j["anisotropic"].get<bool>();
   }
   if (j.contains("stretch") || j.contains("rotation") || j.contains("stretch_texture")) {
-    if (m.type != "lut") fail(path, "material " + name + ": \"stretch\", \"rotation\" and \"stretch_texture\" are for lut materials");
+    if (m.type != "lut" && m.type != "closures")
+      fail(path, "material " + name + ": \"stretch\" and \"rotation\" are for lut and closures materials");
+    if (m.type == "closures" && j.contains("stretch_texture"))
+      fail(path, "material " + name + ": \"stretch_texture\" is for lut materials");
     m.stretch_texture = get<std::string>(j, "stretch_texture", "", path);
     if (j.contains("stretch_texture") && m.stretch_texture.empty()) fail(path, "material " + name + ": stretch_texture must name an image");
     double sx = 1.0, sy = 1.0;
@@ -449,9 +453,15 @@ std::shared_ptr<const ShadingModel> load_material(const SceneDesc& scene, const 
     const auto model = sampled_lut_model(std::move(lut));
     return std::make_shared<ShadingModel>(model, VisibleSlopeProposal::of(*model));
   }
+  if (m.type == "closures") {
+    // The LUT's closure representation as the production shader emits it (osl/facetfit_material.osl), the
+    // artist's scales along each lobe's axes, turned by the rotation.
+    const Closures closures = read_lut(resolve(scene, m.file)).closures().stretched(m.stretch.x, m.stretch.y, m.stretch.rotation());
+    return std::make_shared<ShadingModel>(std::make_shared<ClosureBrdf>(closures), std::make_shared<ClosureProposal>(closures));
+  }
   // ggx | beckmann | lsq (the LUT's classical baseline: Lambert + GGX + Schlick); nothing else renders as them
   if (m.type != "ggx" && m.type != "beckmann" && m.type != "lsq")
-    fail("material type '" + m.type + "'", "must be measured, lut, ggx, beckmann, lsq, lambert or analytic");
+    fail("material type '" + m.type + "'", "must be measured, lut, ggx, beckmann, lsq, closures, lambert or analytic");
   if (!m.file.empty()) return lut_parametric_model(read_lut(resolve(scene, m.file)), m.type, m.smith, m.fresnel == "curve", m.anisotropic);
   const Ndf ndf = Ndf::isotropic(m.type == "beckmann" ? NdfType::beckmann : NdfType::ggx, m.alpha);
   // The proposal samples the lobe, weighted by f0: GGX's visible normals in closed form (model/proposal.h),

@@ -35,7 +35,7 @@ struct LightDesc {
 };
 
 struct MaterialDesc {
-  // measured | lut | ggx | beckmann | lsq | lambert | analytic
+  // measured | lut | ggx | beckmann | lsq | closures | lambert | analytic
   std::string type = "lambert";
   std::string file;       // measured: any facetfit input; lut: the LUT; ggx/beckmann: optional LUT to take alpha and Fresnel from
   double alpha = 0.0;     // ggx/beckmann without a LUT

@@ -1,0 +1,446 @@
+#include "fit/closure_fit.h"
+
+#include <ceres/ceres.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include "fit/lobe_terms.h"
+#include "fit/small_problem.h"
+#include "model/ggx_visible.h"
+
+namespace facetfit {
+
+namespace {
+
+using namespace lobe_terms;
+
+// The unknowns of a solve, in the blocks the cost function reads: body (3), coat (log alpha, f0), then per
+// lobe its shape (log alpha, and the weight of an F82-tint lobe or the exponent of a Schlick one), f0 (3)
+// and the second colour (f82 or f90, 3). A Schlick lobe's weight is 1: f90 scales it.
+struct Unknowns {
+  struct Lobe {
+    NdfType type = NdfType::ggx;
+    ClosureLobe::Fresnel fresnel = ClosureLobe::Fresnel::f82_tint;
+    std::array<double, 2> shape{};
+    std::array<double, 3> f0{}, second{};
+  };
+  std::array<double, 3> body{};
+  std::array<double, 2> coat{};
+  bool with_coat = false;
+  std::vector<Lobe> lobes;
+
+  explicit Unknowns(const Closures& c) : with_coat(c.coat.present()) {
+    body = {c.body.r, c.body.g, c.body.b};
+    coat = {std::log(with_coat ? c.coat.alpha : 0.1), c.coat.f0};
+    for (const ClosureLobe& l : c.lobes) {
+      const bool tint = l.fresnel == ClosureLobe::Fresnel::f82_tint;
+      const Rgb& second = tint ? l.f82 : l.f90;
+      lobes.push_back({l.type, l.fresnel, {std::log(std::max(l.alpha_x, 1e-3)), tint ? l.weight : l.exponent}, {l.f0.r, l.f0.g, l.f0.b},
+                       {second.r, second.g, second.b}});
+    }
+  }
+  Closures closures() const {
+    Closures c;
+    c.body = Rgb(body[0], body[1], body[2]);
+    if (with_coat) c.coat = Coat{std::exp(coat[0]), coat[1]};
+    for (const Lobe& l : lobes) {
+      ClosureLobe lobe;
+      lobe.type = l.type;
+      lobe.alpha_x = lobe.alpha_y = std::exp(l.shape[0]);
+      lobe.fresnel = l.fresnel;
+      lobe.f0 = Rgb(l.f0[0], l.f0[1], l.f0[2]);
+      const Rgb second(l.second[0], l.second[1], l.second[2]);
+      if (l.fresnel == ClosureLobe::Fresnel::f82_tint)
+        lobe.weight = l.shape[1], lobe.f82 = second;
+      else
+        lobe.exponent = l.shape[1], lobe.f90 = second;
+      c.lobes.push_back(lobe);
+    }
+    return c;
+  }
+  std::vector<double*> blocks() {
+    std::vector<double*> b{body.data(), coat.data()};
+    for (Lobe& l : lobes) b.insert(b.end(), {l.shape.data(), l.f0.data(), l.second.data()});
+    return b;
+  }
+};
+
+// A lobe's Fresnel in each channel, times its weight, and the derivatives in the lobe's unknowns: the
+// second shape entry (weight or exponent), f0 and the second colour.
+struct LobeFresnel {
+  double value = 0.0, d_shape = 0.0, d_f0 = 0.0, d_second = 0.0;
+};
+using LobeFresnelRgb = std::array<LobeFresnel, 3>;
+LobeFresnelRgb lobe_fresnel(ClosureLobe::Fresnel form, double shape, const double* f0, const double* second, double mu) {
+  LobeFresnelRgb f;
+  if (form == ClosureLobe::Fresnel::f82_tint) {  // w F82-tint(f0, f82)
+    for (int e = 0; e < 3; ++e) {
+      const FresnelTerms t = fresnel_terms(f0[e], second[e], mu, true);
+      f[std::size_t(e)] = {shape * t.value, t.value, shape * t.d_f0, shape * t.d_f82};
+    }
+    return f;
+  }
+  // f0 + (f90 - f0) x, x = (1 - mu)^e: dF/de = (f90 - f0) x log(1 - mu).
+  const double m = 1.0 - mu, x = m > 0.0 ? std::pow(m, shape) : 0.0, x_log = m > 0.0 ? x * std::log(m) : 0.0;
+  for (int e = 0; e < 3; ++e) f[std::size_t(e)] = {f0[e] + (second[e] - f0[e]) * x, (second[e] - f0[e]) * x_log, 1.0 - x, x};
+  return f;
+}
+
+// The residuals of one row of bins (3 per bin), with analytic derivatives:
+//   m = body / pi + sum_k F_k(mu) D_k G2_k / (4 cos_i cos_o) + Schlick(coat_f0, mu) D_c G2_c / (4 cos_i cos_o),
+// F_k the lobe's weighted Fresnel (lobe_fresnel), G2 height-correlated throughout (the closures').
+class ClosureRowCost final : public ceres::CostFunction {
+ public:
+  ClosureRowCost(const MeasuredBins& bins, const MeasuredBins::Row& row, std::vector<Unknowns::Lobe> forms, bool with_coat)
+      : bins_(bins), row_(row), forms_(std::move(forms)), with_coat_(with_coat) {
+    set_num_residuals(int(3 * (row.end - row.begin)));
+    for (int size : {3, 2}) mutable_parameter_block_sizes()->push_back(size);
+    for (std::size_t k = 0; k < forms_.size(); ++k)
+      for (int size : {2, 3, 3}) mutable_parameter_block_sizes()->push_back(size);
+  }
+
+  bool Evaluate(double const* const* p, double* residuals, double** jacobians) const override {
+    const std::size_t n = row_.end - row_.begin, lobes = forms_.size();
+    if (jacobians)
+      for (std::size_t b = 0; b < parameter_block_sizes().size(); ++b)
+        if (jacobians[b]) std::fill(jacobians[b], jacobians[b] + 3 * n * std::size_t(parameter_block_sizes()[b]), 0.0);
+    const double coat_alpha = std::exp(p[1][0]), coat_f0 = p[1][1];
+    std::array<double, Closures::kMaxLobes> lobe{}, lobe_slope{};
+    for (std::size_t q = 0; q < n; ++q) {
+      const std::size_t k = row_.begin + q;
+      const double ci = bins_.i[k].z, co = bins_.o[k].z, mu = bins_.cos_d[k], ch = bins_.cos_h[k];
+      const double inv4 = 1.0 / (4.0 * ci * co), s_mu = schlick_slope(mu);
+      for (std::size_t l = 0; l < lobes; ++l) {  // D G2 / (4 cos_i cos_o) and its derivative in log alpha
+        const NdfType type = forms_[l].type;
+        const double alpha = std::exp(p[2 + 3 * l][0]);
+        const WithSlope d = ndf_of(type, alpha, ch);
+        const WithSlope g = g2_of(Smith::correlated, lambda_of(type, alpha, ci), lambda_of(type, alpha, co));
+        lobe[l] = d.value * g.value * inv4;
+        lobe_slope[l] = (d.slope * g.value + d.value * g.slope) * inv4 * alpha;
+      }
+      double coat = 0.0, coat_d_log_alpha = 0.0, coat_d_f0 = 0.0;
+      if (with_coat_) {
+        const WithSlope dc = ndf_of(NdfType::ggx, coat_alpha, ch);
+        const WithSlope gc = g2_of(Smith::correlated, lambda_of(NdfType::ggx, coat_alpha, ci), lambda_of(NdfType::ggx, coat_alpha, co));
+        const double fc = coat_f0 * s_mu + (1.0 - s_mu);
+        coat = fc * dc.value * gc.value * inv4;
+        coat_d_log_alpha = fc * (dc.slope * gc.value + dc.value * gc.slope) * inv4 * coat_alpha;
+        coat_d_f0 = s_mu * dc.value * gc.value * inv4;
+      }
+      std::array<LobeFresnelRgb, Closures::kMaxLobes> fresnel;
+      for (std::size_t l = 0; l < lobes; ++l) fresnel[l] = lobe_fresnel(forms_[l].fresnel, p[2 + 3 * l][1], p[3 + 3 * l], p[4 + 3 * l], mu);
+      const double w = std::sqrt(bins_.weight[k]), c = bins_.cosine[k];
+      const bool grazing = grazing_pair(bins_.o[k], bins_.i[k]);
+      for (int e = 0; e < 3; ++e) {
+        const std::size_t r = 3 * q + std::size_t(e);
+        if (!(bins_.valid[k] >> e & 1u)) {
+          residuals[r] = 0.0;
+          continue;
+        }
+        double m = p[0][e] * kInvPi + coat;
+        for (std::size_t l = 0; l < lobes; ++l) m += fresnel[l][std::size_t(e)].value * lobe[l];
+        const MetricResidual res = metric_residual(m, c, bins_.lightness[k][e], grazing);
+        residuals[r] = w * res.value;
+        if (!jacobians || m < 0.0) continue;
+        const double dm = w * res.slope;
+        if (jacobians[0]) jacobians[0][3 * r + std::size_t(e)] = dm * kInvPi;
+        if (jacobians[1]) jacobians[1][2 * r] = dm * coat_d_log_alpha, jacobians[1][2 * r + 1] = dm * coat_d_f0;
+        for (std::size_t l = 0; l < lobes; ++l) {
+          const LobeFresnel& f = fresnel[l][std::size_t(e)];
+          if (double* j = jacobians[2 + 3 * l]) j[2 * r] = dm * f.value * lobe_slope[l], j[2 * r + 1] = dm * f.d_shape * lobe[l];
+          if (double* j = jacobians[3 + 3 * l]) j[3 * r + std::size_t(e)] = dm * f.d_f0 * lobe[l];
+          if (double* j = jacobians[4 + 3 * l]) j[3 * r + std::size_t(e)] = dm * f.d_second * lobe[l];
+        }
+      }
+    }
+    return true;
+  }
+
+ private:
+  const MeasuredBins& bins_;
+  const MeasuredBins::Row& row_;
+  std::vector<Unknowns::Lobe> forms_;  // each lobe's family and Fresnel form
+  bool with_coat_;
+};
+
+// The directional albedo of each lobe and of the coat, at the views of an AlbedoTarget, as a sum over
+// GGX visible normals drawn from a fixed grid of numbers: rho(o) = mean of F(o.h) G2(o, i) / G1(o)
+// (model/ggx_visible.h), smooth in alpha because the grid is fixed. The residuals, one per view and channel,
+//   sqrt(weight_j) D(L(rho_j) - L(target_j)),  L = metric_transform(rho / pi) (CIE L* of rho, over 116),
+// D(x) = sign(x) max(0, |x| - kAlbedoTolerance), hold what a rendering under an environment shows of every
+// pixel and the bins do not: how much light the material returns from all directions, at the grazing views
+// of a sphere's rim too. The tolerance, 0.5 units of L* (about 1.3% of the albedo), is of the order of the
+// target's and this sum's own errors (0.75% apart at most on a two-lobe mixture): with errors of 1% (a
+// target from a grid's midpoints, this sum on 8 x 8 numbers) a two-lobe GGX mixture written in MERL came
+// back with a weight 5% off (tests/test_refine.cpp, ClosureFit).
+constexpr double kAlbedoTolerance = 0.5 / 116.0;
+class AlbedoCost final : public ceres::CostFunction {
+ public:
+  AlbedoCost(const AlbedoTarget& target, std::vector<Unknowns::Lobe> forms, bool with_coat)
+      : target_(target), forms_(std::move(forms)), with_coat_(with_coat) {
+    set_num_residuals(int(3 * target.cos_o.size()));
+    for (int size : {3, 2}) mutable_parameter_block_sizes()->push_back(size);
+    for (std::size_t k = 0; k < forms_.size(); ++k)
+      for (int size : {2, 3, 3}) mutable_parameter_block_sizes()->push_back(size);
+  }
+
+  bool Evaluate(double const* const* p, double* residuals, double** jacobians) const override {
+    const std::size_t views = target_.cos_o.size(), lobes = forms_.size();
+    if (jacobians)
+      for (std::size_t b = 0; b < parameter_block_sizes().size(); ++b)
+        if (jacobians[b]) std::fill(jacobians[b], jacobians[b] + 3 * views * std::size_t(parameter_block_sizes()[b]), 0.0);
+    constexpr double kStep = 1e-4;  // of log alpha, for the forward differences
+    for (std::size_t j = 0; j < views; ++j) {
+      const double c = target_.cos_o[j];
+      const Vec3 o(std::sqrt(std::max(0.0, 1.0 - c * c)), 0.0, c);
+      // Per channel: rho, and its derivatives in each lobe's blocks and the coat's.
+      std::array<double, 3> rho{};
+      std::array<std::array<double, 3 * 3>, Closures::kMaxLobes> d_lobe{};  // log alpha, shape[1], f0, second per channel
+      std::array<std::array<double, 3>, Closures::kMaxLobes> d_f0{}, d_second{};
+      std::array<double, 2> d_coat{};
+      for (int e = 0; e < 3; ++e) rho[e] = p[0][e];
+      for (std::size_t l = 0; l < lobes; ++l) {
+        const double *shape = p[2 + 3 * l], *f0 = p[3 + 3 * l], *second = p[4 + 3 * l];
+        const auto fresnel = [&](double mu) { return lobe_fresnel(forms_[l].fresnel, shape[1], f0, second, mu); };
+        const double alpha = std::exp(shape[0]);
+        std::array<double, 3> lobe_rho{};
+        for_each_visible_normal(o, alpha, [&](double mu, double ratio) {
+          const LobeFresnelRgb f = fresnel(mu);
+          for (std::size_t e = 0; e < 3; ++e) {
+            lobe_rho[e] += f[e].value * ratio;
+            d_lobe[l][3 + e] += f[e].d_shape * ratio;
+            d_f0[l][e] += f[e].d_f0 * ratio;
+            d_second[l][e] += f[e].d_second * ratio;
+          }
+        });
+        for (std::size_t e = 0; e < 3; ++e) rho[e] += lobe_rho[e], d_lobe[l][e] -= lobe_rho[e] / kStep;
+        if (jacobians && jacobians[2 + 3 * l])
+          for_each_visible_normal(o, alpha * std::exp(kStep), [&](double mu, double ratio) {
+            const LobeFresnelRgb f = fresnel(mu);
+            for (std::size_t e = 0; e < 3; ++e) d_lobe[l][e] += f[e].value * ratio / kStep;
+          });
+      }
+      if (with_coat_) {
+        const double coat_alpha = std::exp(p[1][0]), coat_f0 = p[1][1];
+        const auto schlick = [&](double mu) { const double m = 1.0 - mu, m2 = m * m; return coat_f0 + (1.0 - coat_f0) * m2 * m2 * m; };
+        double coat_rho = 0.0;
+        for_each_visible_normal(o, coat_alpha, [&](double mu, double ratio) {
+          coat_rho += schlick(mu) * ratio;
+          d_coat[1] += schlick_slope(mu) * ratio;
+        });
+        for (int e = 0; e < 3; ++e) rho[e] += coat_rho;
+        d_coat[0] = -coat_rho / kStep;
+        if (jacobians && jacobians[1])
+          for_each_visible_normal(o, coat_alpha * std::exp(kStep), [&](double mu, double ratio) { d_coat[0] += schlick(mu) * ratio / kStep; });
+      }
+      const double w = std::sqrt(target_.weight[j]);
+      for (int e = 0; e < 3; ++e) {
+        const std::size_t r = 3 * j + std::size_t(e);
+        double slope = 0.0;
+        const double difference = metric_transform(rho[e] * kInvPi, &slope) - target_.lightness[j][e];
+        const double beyond = std::max(0.0, std::abs(difference) - kAlbedoTolerance);
+        residuals[r] = w * std::copysign(beyond, difference);
+        if (!jacobians || beyond <= 0.0) continue;
+        const double dm = w * slope * kInvPi;
+        if (jacobians[0]) jacobians[0][3 * r + std::size_t(e)] = dm;
+        if (jacobians[1]) jacobians[1][2 * r] = dm * d_coat[0], jacobians[1][2 * r + 1] = dm * d_coat[1];
+        for (std::size_t l = 0; l < lobes; ++l) {
+          if (double* jac = jacobians[2 + 3 * l]) jac[2 * r] = dm * d_lobe[l][e], jac[2 * r + 1] = dm * d_lobe[l][3 + e];
+          if (double* jac = jacobians[3 + 3 * l]) jac[3 * r + std::size_t(e)] = dm * d_f0[l][e];
+          if (double* jac = jacobians[4 + 3 * l]) jac[3 * r + std::size_t(e)] = dm * d_second[l][e];
+        }
+      }
+    }
+    return true;
+  }
+
+  // Calls visit(o.h, G2(o, i) / G1(o) / N) for the grid's N visible normals of GGX `alpha` seen from o
+  // (G2 height-correlated; 0 where i falls below the horizon): 16 radii, where the horizon cuts the
+  // lobe, by 8 azimuths.
+  static constexpr int kRadii = 16, kAzimuths = 8;
+  template <class Visit>
+  static void for_each_visible_normal(const Vec3& o, double alpha, const Visit& visit) {
+    static const std::array<std::array<double, 2>, kAzimuths> azimuths = [] {
+      std::array<std::array<double, 2>, kAzimuths> a{};
+      for (int b = 0; b < kAzimuths; ++b) a[std::size_t(b)] = {std::cos(2.0 * kPi * (b + 0.5) / kAzimuths), std::sin(2.0 * kPi * (b + 0.5) / kAzimuths)};
+      return a;
+    }();
+    const Ndf ndf = Ndf::isotropic(NdfType::ggx, alpha);
+    const double lambda_o = ndf.lambda(o), g1_o = 1.0 / (1.0 + lambda_o), n = double(kRadii * kAzimuths);
+    for (int a = 0; a < kRadii; ++a) {
+      const double r = std::sqrt((a + 0.5) / kRadii);
+      for (const auto& [cos_phi, sin_phi] : azimuths) {
+        const auto i = ggx_visible_direction_of_disk(o, alpha, r, cos_phi, sin_phi);
+        if (!i) continue;
+        const Vec3 h = glm::normalize(*i + o);
+        visit(clamp(glm::dot(o, h), 0.0, 1.0), smith_g2(Smith::correlated, lambda_o, ndf.lambda(*i)) / g1_o / n);
+      }
+    }
+  }
+
+ private:
+  const AlbedoTarget& target_;
+  std::vector<Unknowns::Lobe> forms_;
+  bool with_coat_;
+};
+
+// Every unknown solved from `start` on `bins`, within the bounds: alphas in [1e-3, 1] (Cycles clamps a
+// closure's alpha to 1), weights and colours in [0, 1], exponents in [0.25, 10], a nonnegative body, the
+// coat as fit/parametric_fit.cpp bounds it.
+// A solve's closures and its objective, 1/2 the sum of the squared residuals of the bins and the albedo.
+struct Solved {
+  Closures closures;
+  double cost = 0.0;
+};
+
+Solved solve(const MeasuredBins& bins, const AlbedoTarget* albedo, const Closures& start, int max_iterations) {
+  Unknowns u(start);
+  SmallProblem problem;
+  for (const MeasuredBins::Row& row : bins.rows) problem.AddResidualBlock(new ClosureRowCost(bins, row, u.lobes, u.with_coat), nullptr, u.blocks());
+  if (albedo && !albedo->cos_o.empty()) problem.AddResidualBlock(new AlbedoCost(*albedo, u.lobes, u.with_coat), nullptr, u.blocks());
+  if (bins.rows.empty()) return {start, 0.0};
+  for (int c = 0; c < 3; ++c) problem.SetParameterLowerBound(u.body.data(), c, 0.0);
+  if (u.with_coat) {
+    problem.SetParameterLowerBound(u.coat.data(), 0, std::log(1e-3));
+    problem.SetParameterUpperBound(u.coat.data(), 0, 0.0);
+    problem.SetParameterLowerBound(u.coat.data(), 1, 0.0);
+    problem.SetParameterUpperBound(u.coat.data(), 1, 1.0);
+  } else {
+    problem.SetParameterBlockConstant(u.coat.data());
+  }
+  for (Unknowns::Lobe& l : u.lobes) {
+    const bool tint = l.fresnel == ClosureLobe::Fresnel::f82_tint;
+    problem.SetParameterLowerBound(l.shape.data(), 0, std::log(1e-3));
+    problem.SetParameterUpperBound(l.shape.data(), 0, 0.0);
+    problem.SetParameterLowerBound(l.shape.data(), 1, tint ? 0.0 : 0.25);
+    problem.SetParameterUpperBound(l.shape.data(), 1, tint ? 1.0 : 10.0);
+    for (double* block : {l.f0.data(), l.second.data()})
+      for (int c = 0; c < 3; ++c) problem.SetParameterLowerBound(block, c, 0.0), problem.SetParameterUpperBound(block, c, 1.0);
+  }
+  const double cost = problem.Solve(max_iterations, 1e-6).final_cost;
+  return {u.closures(), cost};
+}
+
+// `fit` with one more GGX lobe of Fresnel `form`, `scale` times the alpha of its strongest lobe (by weight
+// times the luminance of F at 60 degrees), of its colour, taking a quarter of every lobe's weight.
+Closures with_lobe(const Closures& fit, ClosureLobe::Fresnel form, double scale) {
+  Closures c = fit;
+  const auto strength = [](const ClosureLobe& l) { return l.weight * luminance(l.fresnel_at(0.5)); };
+  const ClosureLobe strongest = *std::max_element(c.lobes.begin(), c.lobes.end(),
+                                                  [&](const ClosureLobe& a, const ClosureLobe& b) { return strength(a) < strength(b); });
+  for (ClosureLobe& l : c.lobes) l.weight *= 0.75;
+  ClosureLobe lobe;
+  lobe.alpha_x = lobe.alpha_y = std::clamp(strongest.alpha_x * scale, 2e-3, 1.0);
+  lobe.fresnel = form;
+  lobe.f0 = strongest.f0;
+  if (form == ClosureLobe::Fresnel::f82_tint) {
+    lobe.weight = 0.25;
+    lobe.f82 = strongest.f82;
+  } else {  // a quarter of the strongest's F at normal incidence, rising as (1 - mu)^2 to a quarter of it at 82 degrees
+    lobe.f0 = 0.25 * strongest.fresnel_at(1.0);
+    lobe.f90 = 0.25 * strongest.fresnel_at(1.0 / 7.0);
+    lobe.exponent = 2.0;
+  }
+  c.lobes.push_back(lobe);
+  return c;
+}
+
+}  // namespace
+
+Rgb closure_albedo(const Closures& closures, double cos_o) {
+  const Vec3 o(std::sqrt(std::max(0.0, 1.0 - cos_o * cos_o)), 0.0, cos_o);
+  Rgb rho = closures.body;
+  for (const ClosureLobe& l : closures.lobes)
+    AlbedoCost::for_each_visible_normal(o, l.alpha_x, [&](double mu, double ratio) { rho += l.weight * l.fresnel_at(mu) * ratio; });
+  const Coat& coat = closures.coat;
+  if (coat.present())
+    AlbedoCost::for_each_visible_normal(o, coat.alpha, [&](double mu, double ratio) { rho += fresnel_schlick(Rgb(coat.f0), mu) * ratio; });
+  return rho;
+}
+
+double closure_error(const MeasuredBins& bins, const Closures& closures) { return measurement_error(bins, ClosureBrdf(closures)); }
+
+AlbedoTarget albedo_target(const Brdf& model, const Proposal& proposal, double share) {
+  constexpr int kViews = 16, kGrid = 128;
+  std::mt19937_64 rng(1);  // jitter within the strata: a grid's midpoints through the mixture's choice of part alias
+  std::uniform_real_distribution<double> jitter(0.0, 1.0);
+  AlbedoTarget t;
+  for (int j = 0; j < kViews; ++j) {
+    // Nodes uniform in r = sin theta_o, a sphere's image radius: each stands for an annulus of its pixels.
+    const double r = (j + 0.5) / kViews, c = std::sqrt(1.0 - r * r);
+    const Vec3 o(r, 0.0, c);
+    Rgb sum(0.0);
+    for (int a = 0; a < kGrid; ++a)
+      for (int b = 0; b < kGrid; ++b) {
+        const auto i = proposal.sample_direction(o, (a + jitter(rng)) / kGrid, (b + jitter(rng)) / kGrid);
+        const double pdf = i ? proposal.pdf(o, *i) : 0.0;
+        const auto f = i && pdf > 0.0 ? model.eval(o, *i) : std::nullopt;
+        if (f) sum += *f * (i->z / pdf);
+      }
+    const Rgb albedo = sum / double(kGrid * kGrid);
+    t.cos_o.push_back(c);
+    t.weight.push_back(share * 2.0 * r / kViews);
+    t.albedo.push_back(albedo);
+    t.lightness.push_back(Rgb(metric_transform(albedo.r * kInvPi), metric_transform(albedo.g * kInvPi), metric_transform(albedo.b * kInvPi)));
+  }
+  return t;
+}
+
+ClosureFit fit_closures(const MeasuredBins& bins, const AlbedoTarget* albedo, const MeasuredBins& error_bins,
+                        const ParametricFit& start, const ClosureFitOptions& options) {
+  return fit_closures(bins, albedo, error_bins, closures_of(start), options);
+}
+
+ClosureFit fit_closures(const MeasuredBins& bins, const AlbedoTarget* albedo, const MeasuredBins& error_bins,
+                        const Closures& start, const ClosureFitOptions& options) {
+  Solved current = solve(bins, albedo, start, options.max_iterations);
+  while (int(current.closures.lobes.size()) < options.max_lobes) {
+    // A sharper and a broader generalized-Schlick lobe, solved concurrently. (On the six RGL materials the
+    // Schlick candidates were taken over F82-tint ones of the same alpha, or within 0.1% of them: their
+    // exponent bends the colour over the middle angles, where the first lobe's F82-tint is flat.)
+    constexpr std::array<double, 2> kScales{0.5, 2.0};
+    std::array<Solved, kScales.size()> tried;
+    tbb::parallel_for(std::size_t(0), kScales.size(), [&](std::size_t t) {
+      tried[t] = solve(bins, albedo, with_lobe(current.closures, ClosureLobe::Fresnel::schlick, kScales[t]), options.max_iterations);
+    });
+    const Solved& best = *std::min_element(tried.begin(), tried.end(), [](const Solved& a, const Solved& b) { return a.cost < b.cost; });
+    // The objective's distance, sqrt(2 cost) (the bins' weights sum to 1), must come `lobe_gain` of itself
+    // nearer, and at least `min_gain`: below that a lobe only takes over what a solve of fewer lobes had
+    // left unconverged.
+    const double before = std::sqrt(2.0 * current.cost), after = std::sqrt(2.0 * best.cost);
+    if (!(after < before - std::max(options.lobe_gain * before, options.min_gain))) break;
+    current = best;
+  }
+  // The choice made, its solve carried on to convergence.
+  current = solve(bins, albedo, current.closures, options.polish_iterations);
+  return {current.closures, closure_error(error_bins, current.closures)};
+}
+
+Closures closures_of(const ParametricFit& fit) {
+  Closures c;
+  c.body = fit.body;
+  c.coat = fit.coat;
+  c.lobes.push_back({fit.type, fit.alpha, fit.alpha, 0.0, 1.0, ClosureLobe::Fresnel::f82_tint, fit.f0, fit.f82});
+  return c;
+}
+
+Closures closures_of(const AnisotropicParametricFit& fit) {
+  Closures c;
+  c.body = fit.body;
+  c.lobes.push_back({fit.type, fit.alpha.alpha_x, fit.alpha.alpha_y, fit.alpha.angle, 1.0, ClosureLobe::Fresnel::f82_tint, fit.f0, fit.f82});
+  return c;
+}
+
+double closure_jacobian_error(const MeasuredBins& bins, const Closures& at) {
+  Unknowns u(at);
+  double worst = 0.0;
+  for (const MeasuredBins::Row& row : bins.rows) worst = std::max(worst, jacobian_error(ClosureRowCost(bins, row, u.lobes, u.with_coat), u.blocks()));
+  return worst;
+}
+
+}  // namespace facetfit
