@@ -83,7 +83,7 @@ TEST(Refine, MinnaertBodyPlusGgxThroughTheMerlWriter) {
   const fs::path lut_file = fs::path(::testing::TempDir()) / "minnaert_ggx.exr";
   write_lut(lut_file.string(), make_lut(r, fitter.quadrature(), "minnaert", "0", 0.02, true));
   const Lut lut = read_lut(lut_file.string());
-  EXPECT_EQ(lut.meta.format_version, kLutBodyExponentVersion);
+  EXPECT_EQ(lut.meta.format_version, kLutClosuresVersion);  // 4's body exponent, and the closures
   EXPECT_NEAR(lut.tables.body_exponent, r.lobe.body_exponent, 1e-6);
   const TabulatedMicrofacet model = lut.model();
   for (const double grazing : {0.0, 0.6, 1.2}) {  // theta_i 0 to 69 degrees, the view at 40
@@ -168,7 +168,7 @@ TEST(Refine, LutCarriesBodyCoatAndParametricFits) {
   const fs::path file = fs::path(::testing::TempDir()) / "coated.exr";
   write_lut(file.string(), make_lut(r, fitter.quadrature(), "coated", "0", 0.02, true));
   const Lut lut = read_lut(file.string());
-  EXPECT_EQ(lut.meta.format_version, 2);
+  EXPECT_EQ(lut.meta.format_version, kLutClosuresVersion);
   expect_rgb_near(lut.tables.body, r.body(), 1e-6, "body");
   EXPECT_NEAR(lut.tables.coat.alpha, r.lobe.coat.alpha, 1e-6);
   EXPECT_NEAR(lut.meta.ggx.alpha, r.ggx.alpha, 1e-6);

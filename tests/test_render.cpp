@@ -1118,7 +1118,7 @@ TEST(Render, StretchedLutMaterials) {
   EXPECT_NE(test::error_of([&] {
               parse_scene_text(R"({"materials": {"m": {"type": "ggx", "alpha": 0.2, "stretch": [2, 1]}},
                                    "objects": [{"type": "sphere", "material": "m"}]})", "t.json", ".");
-            }).find("are for lut materials"), std::string::npos);
+            }).find("are for lut and closures materials"), std::string::npos);
 }
 
 // A constant environment is lit by the BRDF sample alone, a map by a light sample and a BRDF sample
@@ -1250,9 +1250,8 @@ TEST(Render, AnisotropicLutRendersNearerItsMeasurementThanTheIsotropicLobe) {
   write_lut(dir.file("aniso.exr"), make_lut(fit, Quadrature(90), "aniso.bsdf", "", 0.05, true));
   const Lut lut = read_lut(dir.file("aniso.exr"));
   ASSERT_TRUE(lut.anisotropic.has_value());
-  // Version 3, or 4 where the isotropic fit's body is Minnaert's (this one: a faint body, k 3, fills the
-  // azimuthal mean of the turned lobe).
-  EXPECT_TRUE(lut.meta.format_version == kLutAnisotropicVersion || lut.meta.format_version == kLutBodyExponentVersion);
+  // Version 5 (the closures), with the anisotropic rows.
+  EXPECT_EQ(lut.meta.format_version, kLutClosuresVersion);
   const auto image = [&](const std::string& material) { return sphere_under_sky(dir, material, 32, 1024); };
   const std::string tangent = R"("tangent": [0.6, 0.8, 0])";
   const RenderedImage measured = image(R"({"type": "measured", "file": "aniso.bsdf", "proposal": "aniso.exr", )" + tangent + "}");

@@ -6,6 +6,11 @@
     python cycles_render.py sphere SHADER OUT.exr SIZE SPP ENV.exr [NAME=VALUE ...]
         The reference renderer's default view (docs/scene-format.md) of a unit sphere shaded by SHADER
         under the lat-long map ENV.exr, direct lighting, box pixel filter, transparent film.
+    python cycles_render.py batch JOBS.json
+        Several renders in one Blender process (its start-up is most of a small render's time): JOBS.json is
+        a list of {"command": "sphere" or "sun", "shader", "out", "size", "spp", "environment" (sphere),
+        "params": {NAME: VALUE}}. "sun" is the same view of the sphere under a constant world of 0.3 and a sun
+        lamp of strength 3 toward facetfit's (0.3, 1, 0.5): the scene of ../shared/data/realref.
 
 NAME=VALUE set the shader's parameters (ints, floats, strings, or vectors as x,y,z, as the parameter's type).
 stretch_texture=IMAGE (sphere only) drives roughness_scale_x and roughness_scale_y by the image's R and G times
@@ -113,7 +118,8 @@ def probe(shader, out, size, params):
     render(scene, out)
 
 
-def sphere(shader, out, size, spp, environment, params):
+def shaded_sphere(shader, size, spp, params):
+    """A new scene of the unit sphere shaded by SHADER, seen from the reference renderer's default camera."""
     scene = new_scene(size, spp)
     bpy.ops.mesh.primitive_uv_sphere_add(segments=256, ring_count=128, radius=1.0)
     bpy.ops.object.shade_smooth()
@@ -130,6 +136,11 @@ def sphere(shader, out, size, spp, environment, params):
     camera.data.sensor_fit = "VERTICAL"
     camera.data.angle_y = math.radians(30)
     scene.camera = camera
+    return scene
+
+
+def sphere(shader, out, size, spp, environment, params):
+    scene = shaded_sphere(shader, size, spp, params)
     world = bpy.data.worlds.new("environment")
     world.use_nodes = True
     tree = world.node_tree
@@ -150,7 +161,40 @@ def sphere(shader, out, size, spp, environment, params):
     render(scene, out)
 
 
+def sun(shader, out, size, spp, params):
+    from mathutils import Vector
+    scene = shaded_sphere(shader, size, spp, params)
+    world = bpy.data.worlds.new("constant")
+    world.use_nodes = True
+    world.node_tree.nodes["Background"].inputs["Color"].default_value = (0.3, 0.3, 0.3, 1)
+    scene.world = world
+    lamp = bpy.data.lights.new("sun", "SUN")
+    lamp.energy = 3.0
+    lamp.angle = 0.0
+    lamp_object = bpy.data.objects.new("sun", lamp)
+    toward = Vector((0.3, -0.5, 1.0)).normalized()  # facetfit's (0.3, 1, 0.5) in Blender's frame
+    lamp_object.rotation_euler = toward.to_track_quat("Z", "Y").to_euler()  # the lamp shines along its -Z
+    scene.collection.objects.link(lamp_object)
+    render(scene, out)
+
+
+def batch(path):
+    import json
+    with open(path) as f:
+        jobs = json.load(f)
+    for job in jobs:
+        params = {k: str(v) for k, v in job.get("params", {}).items()}
+        if job["command"] == "sphere":
+            sphere(job["shader"], job["out"], int(job["size"]), int(job["spp"]), job["environment"], params)
+        elif job["command"] == "sun":
+            sun(job["shader"], job["out"], int(job["size"]), int(job["spp"]), params)
+        else:
+            sys.exit(f"{path}: unknown command {job['command']}")
+
+
 def main(argv):
+    if len(argv) == 3 and argv[1] == "batch":
+        return batch(argv[2])
     if len(argv) < 5:
         sys.exit(__doc__)
     command, shader, out, size = argv[1], argv[2], argv[3], int(argv[4])
