@@ -99,6 +99,30 @@ BENCHMARK(BM_FitRgl)->ArgNames({"threads", "material", "refine"})
     ->Args({1, 0, 0})->Args({1, 0, 1})->Args({0, 0, 1})->Args({1, 1, 0})->Args({1, 1, 1})->Args({0, 1, 1})
     ->Unit(benchmark::kMillisecond);
 
+// The closure step of a full fit (fit/closure_fit.h) alone: its bins, the measurement's albedo and the
+// solves, on the materials of BM_FitRgl, whose refine-full rows include it: their ratio is what the
+// closures add to a fit (the bar: at most 50% of the rest).
+void BM_ClosureFit(benchmark::State& state) {
+  const char* name = state.range(1) == 0 ? "acrylic_felt_green_rgb" : "ilm_l3_37_metallic_rgb";
+  const MerlTable* table = rgl_material(name);
+  if (!table) {
+    state.SkipWithError("no RGL data: set FACETFIT_RGL_DIR");
+    return;
+  }
+  const auto threads = limit_threads(state);
+  const FitResult fit = Fitter(FitOptions{}).fit(*table);
+  const MeasuredBins errors = error_bins(*table);
+  const VisibleSlopeProposal proposal(fit.lobe.tables(fit.smith));
+  ClosureFit closures;
+  for (auto _ : state) {
+    const AlbedoTarget albedo = albedo_target(*table, proposal);
+    benchmark::DoNotOptimize(closures = fit_closures(closure_bins(*table), &albedo, errors, fit.ggx));
+  }
+  state.counters["lobes"] = double(closures.closures.lobes.size());
+  state.SetLabel(name);
+}
+BENCHMARK(BM_ClosureFit)->ArgNames({"threads", "material"})->Args({1, 0})->Args({0, 0})->Args({1, 1})->Args({0, 1})->Unit(benchmark::kMillisecond);
+
 void BM_Extraction(benchmark::State& state) {
   const Quadrature quadrature(int(state.range(0)));
   const Backscatter back = backscatter_of(gold());

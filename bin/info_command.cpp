@@ -31,6 +31,8 @@ nlohmann::json info_json(const Lut& lut) {
   j["metadata"]["ggx"] = parametric(m.ggx, m.error_ggx);
   j["metadata"]["beckmann"] = parametric(m.beckmann, m.error_beckmann);
   j["metadata"]["lsq"] = parametric(m.lsq, m.error_lsq);
+  // What the production OSL material renders: version 5's closures, or an older LUT's one lobe.
+  j["metadata"]["closures"] = closures_json(lut.closures(), m.error_closures);
   const TabulatedNdf& ndf = lut.tables.ndf;
   nlohmann::json& t = j["ndf"];
   for (int k = 0; k < ndf.grid.size(); ++k) {
@@ -46,6 +48,22 @@ nlohmann::json info_json(const Lut& lut) {
     j["fresnel"]["rgb"].push_back(rgb(lut.tables.fresnel.value[std::size_t(k)]));
   }
   return j;
+}
+
+// The closures the material shader emits, a line a part.
+void print_closures(const Closures& c, double error, bool fitted) {
+  std::printf("closures        %s, distance %.4f, body %.4f %.4f %.4f", fitted ? "fitted" : "the older LUT's one lobe", error, c.body.r, c.body.g,
+              c.body.b);
+  if (c.coat.present()) std::printf(", coat alpha %.5f f0 %.4f", c.coat.alpha, c.coat.f0);
+  std::printf("\n");
+  for (const ClosureLobe& l : c.lobes) {
+    std::printf("  lobe          %s alpha %.5f x %.5f at %.1f deg, weight %.4f, f0 %.4f %.4f %.4f", to_string(l.type), l.alpha_x, l.alpha_y,
+                l.angle * 180.0 / kPi, l.weight, l.f0.r, l.f0.g, l.f0.b);
+    if (l.fresnel == ClosureLobe::Fresnel::f82_tint)
+      std::printf(", F82-tint f82 %.4f %.4f %.4f\n", l.f82.r, l.f82.g, l.f82.b);
+    else
+      std::printf(", Schlick f90 %.4f %.4f %.4f exponent %.3f\n", l.f90.r, l.f90.g, l.f90.b, l.exponent);
+  }
 }
 
 void print_info(const Lut& lut) {
@@ -72,6 +90,7 @@ void print_info(const Lut& lut) {
   parametric("ggx", m.ggx);
   parametric("beckmann", m.beckmann);
   parametric("lsq", m.lsq);
+  print_closures(lut.closures(), m.error_closures, m.format_version >= kLutClosuresVersion);
   std::printf("representation  %s (tolerance %.4f)\nsampling tables %s\n", to_string(m.representation), m.tolerance,
               m.sampling ? "yes" : "no (--eval-only)");
   for (const std::string& w : m.warnings) std::printf("warning         %s\n", w.c_str());

@@ -13,6 +13,21 @@ nlohmann::json parametric_json(double alpha, const Rgb& body, const Rgb& f0, con
   return {{"alpha", alpha}, {"body", rgb(body)}, {"f0", rgb(f0)}, {"f82", rgb(f82)}, {"coat", coat_json(coat)}, {"error", error}};
 }
 
+nlohmann::json closures_json(const Closures& closures, double error) {
+  const auto rgb = [](const Rgb& c) { return nlohmann::json{c.r, c.g, c.b}; };
+  nlohmann::json lobes = nlohmann::json::array();
+  for (const ClosureLobe& l : closures.lobes) {
+    nlohmann::json lobe = {{"family", to_string(l.type)}, {"alpha_x", l.alpha_x}, {"alpha_y", l.alpha_y},
+                           {"angle_degrees", l.angle * 180.0 / kPi}, {"weight", l.weight}, {"f0", rgb(l.f0)}};
+    if (l.fresnel == ClosureLobe::Fresnel::f82_tint)
+      lobe["fresnel"] = "f82_tint", lobe["f82"] = rgb(l.f82);
+    else
+      lobe["fresnel"] = "schlick", lobe["f90"] = rgb(l.f90), lobe["exponent"] = l.exponent;
+    lobes.push_back(lobe);
+  }
+  return {{"body", rgb(closures.body)}, {"lobes", lobes}, {"coat", coat_json(closures.coat)}, {"error", error}};
+}
+
 std::string json_text(const nlohmann::json& j, int indent) {
   return j.dump(indent, ' ', false, nlohmann::json::error_handler_t::replace);
 }
@@ -41,6 +56,7 @@ nlohmann::json fit_record(const std::string& source, const FitResult& fit, doubl
     j["error_extraction"] = fit.error_extraction;
     for (const auto& [name, p] : {std::pair<const char*, const ParametricFit*>{"ggx", &fit.ggx}, {"beckmann", &fit.beckmann}, {"lsq", &fit.lsq}})
       j[name] = parametric_json(p->alpha, p->body, p->f0, p->f82, p->coat, p->error);
+    j["closures"] = closures_json(fit.closures.closures, fit.closures.error);
     j["warnings"] = fit.warnings;
     j["anisotropic"] = nullptr;
     if (const auto& a = fit.anisotropic) {

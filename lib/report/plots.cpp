@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <sstream>
 
+#include "model/closures.h"
 #include "model/fresnel.h"
 
 namespace facetfit {
@@ -49,11 +51,11 @@ std::string line_chart_svg(const std::string& title, const std::string& x_label,
 }
 
 std::vector<PlotSeries> incidence_plane(double theta_i_degrees, const std::vector<std::pair<std::string, const Brdf*>>& brdfs) {
-  static const char* kColours[] = {"black", "#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#8c564b"};
+  static const char* kColours[] = {"black", "#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b"};
   const Vec3 i = spherical_direction(theta_i_degrees * kPi / 180.0, kPi);
   std::vector<PlotSeries> out;
   for (std::size_t k = 0; k < brdfs.size(); ++k) {
-    PlotSeries s{brdfs[k].first, kColours[k % 6], {}, k > 0};
+    PlotSeries s{brdfs[k].first, kColours[k % std::size(kColours)], {}, k > 0};
     for (int d = -89; d <= 89; ++d) {
       // theta_o > 0: the mirror side (phi = 0); < 0: the side of i (phi = pi).
       const Vec3 o = spherical_direction(std::abs(d) * kPi / 180.0, d >= 0 ? 0.0 : kPi);
@@ -70,8 +72,10 @@ std::vector<std::pair<std::string, std::string>> material_figures(const Brdf& me
   std::vector<std::pair<std::string, ParametricBrdf>> fits;
   for (const char* family : {"ggx", "beckmann", "lsq"})
     if (auto p = lut.parametric(family, lut.meta.smith); p && p->ndf().alpha_x > 0.0) fits.emplace_back(family, *p);
+  const ClosureBrdf closures(lut.closures());
   std::vector<std::pair<std::string, const Brdf*>> brdfs{{"measured", &measured}, {"tabulated", &tabulated}};
   for (const auto& [name, brdf] : fits) brdfs.emplace_back(name, &brdf);
+  brdfs.emplace_back("closures", &closures);
   std::vector<std::pair<std::string, std::string>> out;
   for (const double theta_i : {0.0, 30.0, 60.0})
     out.emplace_back("lobes_" + std::to_string(int(theta_i)) + ".svg", line_chart_svg("incidence plane, theta_i " + std::to_string(int(theta_i)) + " deg", "theta_o (deg)",

@@ -23,9 +23,25 @@ namespace facetfit {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
+namespace {
+
+// Each column's representation and its colour in the plots. lsq: the classical Lambert + GGX + Schlick
+// least-squares fit, what users get today; closures: what the production OSL material renders.
+struct Column {
+  const char* name;
+  const char* colour;
+};
+constexpr Column kColumns[] = {
+    {"tabulated", "#1f77b4"}, {"ggx", "#d62728"}, {"beckmann", "#2ca02c"}, {"lsq", "#9467bd"}, {"closures", "#ff7f0e"}};
+
+}  // namespace
+
 const std::vector<std::string>& report_representations() {
-  // lsq: the classical Lambert + GGX + Schlick least-squares fit, what users get today.
-  static const std::vector<std::string> names{"tabulated", "ggx", "beckmann", "lsq"};
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> n;
+    for (const Column& c : kColumns) n.push_back(c.name);
+    return n;
+  }();
   return names;
 }
 
@@ -80,7 +96,6 @@ std::string html_escape(const std::string& s) {
 
 // Run time against error: one point per material and representation, log-scaled time.
 std::string time_error_plot(const json& report) {
-  const char* colours[] = {"#1f77b4", "#d62728", "#2ca02c", "#9467bd"};  // one per report_representations()
   double max_de = 0.1, min_t = 1e9, max_t = 1e-9;
   for (const json& m : report["materials"])
     for (const std::string& r : report_representations())
@@ -99,12 +114,12 @@ std::string time_error_plot(const json& report) {
       << "<text x='8' y='30'>" << max_de << "</text>";
   for (std::size_t k = 0; k < report_representations().size(); ++k) {
     const std::string& r = report_representations()[k];
-    svg << "<text x='" << 420 << "' y='" << 30 + 14 * k << "' fill='" << colours[k] << "'>&#9679; " << r << "</text>";
+    svg << "<text x='" << 420 << "' y='" << 30 + 14 * k << "' fill='" << kColumns[k].colour << "'>&#9679; " << r << "</text>";
     for (const json& m : report["materials"]) {
       if (!m["delta_e"].contains(r)) continue;
       const double t = m["seconds"]["render"][r].get<double>(), de = m["delta_e"][r].get<double>();
       const double x = 50 + 490 * (std::log10(std::max(t, 1e-6)) - lo) / (hi - lo), y = 260 - 240 * de / max_de;
-      svg << "<circle cx='" << x << "' cy='" << y << "' r='4' fill='" << colours[k] << "'><title>"
+      svg << "<circle cx='" << x << "' cy='" << y << "' r='4' fill='" << kColumns[k].colour << "'><title>"
           << html_escape(m["name"].get<std::string>()) << " " << r << ": " << de << "</title></circle>";
     }
   }

@@ -26,7 +26,9 @@
 #include "io/input.h"
 #include "lut/bake.h"
 #include "lut/lut.h"
+#include "lut/materialx.h"
 #include "lut/record.h"
+#include "model/closures.h"
 #include "model/ndf.h"
 #include "model/parametric.h"
 #include "model/tabulated.h"
@@ -52,6 +54,11 @@ struct Model {
 Model tabulated_model(const MicrofacetTables& tables) {
   auto m = std::make_shared<TabulatedMicrofacet>(tables);
   return Model{std::make_shared<ShadingModel>(m, m)};
+}
+
+// The closures as the production shader emits them, sampled as the renderer samples them.
+Model closures_model(const Closures& c) {
+  return Model{std::make_shared<ShadingModel>(std::make_shared<ClosureBrdf>(c), std::make_shared<ClosureProposal>(c))};
 }
 
 struct Fit {
@@ -309,6 +316,13 @@ PYBIND11_MODULE(_facetfit, m) {
         if (!f.result.ok()) throw Error(f.source + ": " + f.result.problem);
         return tabulated_model(f.result.lobe.tables(f.result.smith));
       }, "The tabulated model: body + tabulated lobe + coat.")
+      .def_property_readonly("closures", [](const Fit& f) { return to_python(closures_json(f.result.closures.closures, f.result.closures.error)); },
+                             "the closure representation, what the production OSL material renders (docs/osl.md): "
+                             "{body, lobes: [{family, alpha_x, alpha_y, angle_degrees, weight, fresnel, f0, f82 or f90 and exponent}], coat, error}")
+      .def("closures_model", [](const Fit& f) {
+        if (!f.result.ok()) throw Error(f.source + ": " + f.result.problem);
+        return closures_model(f.result.closures.closures);
+      }, "The closure representation as a model.")
       .def(
           "write_lut",
           [](const Fit& f, const std::string& path, double tolerance, bool sampling) {
@@ -344,6 +358,11 @@ PYBIND11_MODULE(_facetfit, m) {
       .def_property_readonly("alpha_beckmann", [](const Lut& l) { return l.meta.alpha_beckmann; })
       .def_property_readonly("warnings", [](const Lut& l) { return l.meta.warnings; })
       .def("model", [](const Lut& l) { return tabulated_model(l.tables); }, "The tabulated model.")
+      .def_property_readonly("closures", [](const Lut& l) { return to_python(closures_json(l.closures(), l.meta.error_closures)); },
+                             "the closures the material shader emits (format 5; an older LUT's one lobe), as Fit.closures")
+      .def("closures_model", [](const Lut& l) { return closures_model(l.closures()); }, "The closure representation as a model.")
+      .def("materialx", [](const Lut& l, const std::string& name) { return materialx_document(materialx_name(name), l); }, py::arg("name"),
+           "The closures as a MaterialX document's text (as `facetfit export` writes it; the name made a valid MaterialX name).")
       .def(
           "parametric",
           [](const Lut& l, const std::string& family) {

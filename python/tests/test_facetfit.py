@@ -131,6 +131,30 @@ def test_lut_round_trip(tmp_path, gold_fit):
         facetfit.read_lut(str(tmp_path / "nope.exr"))
 
 
+def test_closures_in_fit_lut_and_record(tmp_path, gold_fit):
+    # The closure representation, what the production OSL material renders, the same in the fit, its record
+    # and the LUT; its model evaluates it.
+    c = gold_fit.closures
+    assert c == gold_fit.record["closures"]
+    assert 1 <= len(c["lobes"]) <= 3 and c["lobes"][0]["family"] == "ggx"
+    path = str(tmp_path / "gold.exr")
+    gold_fit.write_lut(path)
+    lut = facetfit.read_lut(path)
+    assert len(lut.closures["lobes"]) == len(c["lobes"])
+    assert lut.closures["lobes"][0]["alpha_x"] == pytest.approx(c["lobes"][0]["alpha_x"], rel=1e-6)
+    o, i = directions(500, 11), directions(500, 12)
+    assert np.allclose(lut.closures_model().eval(o, i), gold_fit.closures_model().eval(o, i), rtol=1e-4, atol=1e-6)
+    # Gold is one GGX lobe: its closures evaluate as its tabulated lobe, within 5%.
+    assert np.allclose(lut.closures_model().eval(o, i), lut.model().eval(o, i), rtol=0.05, atol=1e-3)
+    # As MaterialX: MaterialX's own validation accepts the document.
+    mx = pytest.importorskip("MaterialX")
+    doc, stdlib = mx.createDocument(), mx.createDocument()
+    mx.loadLibraries(mx.getDefaultDataLibraryFolders(), mx.getDefaultDataSearchPath(), stdlib)
+    mx.readFromXmlString(doc, lut.materialx("gold 0.15"))
+    doc.importLibrary(stdlib)
+    assert doc.validate()[0] and [m.getName() for m in doc.getMaterialNodes()] == ["gold_0_15"]
+
+
 def test_bake_caches(tmp_path):
     first = facetfit.bake(GOLD, str(tmp_path), refine="none")
     again = facetfit.bake(GOLD, str(tmp_path), refine="none")
