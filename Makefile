@@ -74,8 +74,9 @@ osl-docs: build osl-host
 bench: build
 	scripts/bench.sh $(BUILD)
 
-# Regenerates docs/accuracy.md: ground-truth fits, then the real RGL materials against Mitsuba 3's renders.
-accuracy: build
+# Regenerates docs/accuracy.md: ground-truth fits, then the real RGL materials against Mitsuba 3's renders
+# (facetfit's renderer, and the production OSL material in Cycles).
+accuracy: build osl-host
 	$(BUILD)/bench/facetfit_accuracy docs/accuracy.md ../shared/data/rgl
 	scripts/real_accuracy.sh $(BUILD)/bin/facetfit docs/accuracy.md ../shared/data
 

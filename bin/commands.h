@@ -54,6 +54,7 @@ void add_render_command(CLI::App& app, Context& ctx);
 void add_deltae_command(CLI::App& app, Context& ctx);
 void add_diff_command(CLI::App& app, Context& ctx);
 void add_report_command(CLI::App& app, Context& ctx);
+void add_export_command(CLI::App& app, Context& ctx);
 
 // With -v: "facetfit: COMMAND: <settings>" on stderr (the fit settings and the thread count).
 void report_settings(const Context& ctx, const std::string& command, const FitOptions& options);

@@ -11,6 +11,7 @@ void add_image_commands(CLI::App& app, Context& ctx) {
   add_diff_command(app, ctx);
   add_deltae_command(app, ctx);
   add_report_command(app, ctx);
+  add_export_command(app, ctx);
 }
 
 }  // namespace

@@ -3,9 +3,13 @@
 # facetfit's renderer in the common scene of ../shared/data/realref, and compared with Mitsuba 3's
 # renders there (mean CIE Delta E 2000 over realref/mask.exr). Adds (or replaces) the section with the table, and
 # the mean of each column, to OUT (docs/accuracy.md, which bench/accuracy_table.cpp has just written).
+# The Cycles column renders the production material (osl/facetfit_material.osl) of the same LUT in Blender's
+# Cycles through realref/cycles_scene.py, with BPY_PYTHON (default build/bpy-venv/bin/python: make osl-host).
 # Usage: scripts/real_accuracy.sh FACETFIT OUT.md [SHARED_DATA] [SPP]
 set -euo pipefail
 facetfit=$1 out=$2 data=${3:-../shared/data} spp=${4:-256}
+bpy_python=${BPY_PYTHON:-build/bpy-venv/bin/python}
+material_osl=$(cd "$(dirname "$0")/../osl" && pwd)/facetfit_material.osl
 section="## Rendered against Mitsuba 3: six RGL materials"
 [[ -f "$out" ]] || { echo "real_accuracy: $out does not exist (bench/facetfit_accuracy writes it first)" >&2; exit 1; }
 # The document without this script's section, so that a second run replaces it rather than adding another.
@@ -26,21 +30,34 @@ start=$(date +%s)
 "$facetfit" bake "$data/rgl" -o "$work/full" --refine full >/dev/null
 seconds=$(($(date +%s) - start))
 
+# mean_delta_e IMAGE NAME: mean Delta E 2000 of IMAGE against the reference render of NAME, over the mask.
+mean_delta_e() {
+  "$facetfit" diff "$1" "$data/realref/$2.exr" --mask "$data/realref/mask.exr" --json |
+    python3 -c 'import json, sys; print("%.2f" % json.load(sys.stdin)["mean"])'
+}
+
 # delta_e TYPE LUT NAME: mean Delta E 2000 of the render of material TYPE from LUT against the reference.
 delta_e() {
   python3 "$data/realref/scene.py" "$work/scene.json" "{\"type\": \"$1\", \"file\": \"$2\"}" "$spp"
   "$facetfit" render "$work/scene.json" -o "$work/render.exr" >/dev/null
-  "$facetfit" diff "$work/render.exr" "$data/realref/$3.exr" --mask "$data/realref/mask.exr" --json |
-    python3 -c 'import json, sys; print("%.2f" % json.load(sys.stdin)["mean"])'
+  mean_delta_e "$work/render.exr" "$3"
+}
+
+# cycles_delta_e LUT NAME: the same for Cycles' render of the production material of LUT.
+cycles_delta_e() {
+  "$bpy_python" "$data/realref/cycles_scene.py" "$material_osl" "$work/cycles.exr" "$spp" "lut=$1" >"$work/cycles.log" 2>&1 ||
+    { echo "real_accuracy: Cycles failed on $1:" >&2; tail -5 "$work/cycles.log" >&2; return 1; }
+  mean_delta_e "$work/cycles.exr" "$2"
 }
 
 {
-  echo "| material | paper (tabulated, --refine none) | tabulated | ggx | beckmann | lsq (Lambert + GGX + Schlick) | measured |"
-  echo "|---|---|---|---|---|---|---|"
+  echo "| material | paper (tabulated, --refine none) | tabulated | ggx | beckmann | lsq (Lambert + GGX + Schlick) | closures | Cycles (facetfit_material.osl) | measured |"
+  echo "|---|---|---|---|---|---|---|---|---|"
   for bsdf in "$data"/rgl/*.bsdf; do
     name=$(basename "$bsdf" .bsdf)
     row="| $name | $(delta_e lut "$work/paper/$name.exr" "$name")"
-    for type in lut ggx beckmann lsq; do row="$row | $(delta_e "$type" "$work/full/$name.exr" "$name")"; done
+    for type in lut ggx beckmann lsq closures; do row="$row | $(delta_e "$type" "$work/full/$name.exr" "$name")"; done
+    row="$row | $(cycles_delta_e "$work/full/$name.exr" "$name")"
     echo "$row | $(delta_e measured "$bsdf" "$name") |"
   done > "$work/rows.md"
   # Every cell a number: a render or a diff that failed must not enter the means as 0.
@@ -51,7 +68,7 @@ delta_e() {
   # The mean of each column (the issue's bar is on the tabulated column's mean).
   awk -F'|' '{ for (c = 3; c < NF; ++c) sum[c] += $c; n = NF } END { printf "| mean"; for (c = 3; c < n; ++c) printf " | %.2f", sum[c] / NR; print " |" }' "$work/rows.md"
   echo
-  echo "facetfit renders at $spp samples per pixel; \`measured\` renders the file itself through its own evaluation (view slices, negative entries kept: what Mitsuba renders), the floor of what any fit can reach. Baking the six with \`--refine full\` took ${seconds} s on this machine (2 cores)."
+  echo "facetfit and Cycles render at $spp samples per pixel; \`measured\` renders the file itself through its own evaluation (view slices, negative entries kept: what Mitsuba renders), the floor of what any fit can reach. Baking the six with \`--refine full\` took ${seconds} s on this machine (2 cores)."
 } > "$work/table.md"
 {
   cat "$kept"
@@ -62,8 +79,11 @@ delta_e() {
   echo "the six RGL materials (../shared/data/realref), each material baked by facetfit and rendered by facetfit's"
   echo "renderer in the same scene. Columns: the paper's method alone (\`--refine none\`), then the representations of"
   echo "\`--refine full\` (tabulated = body + tabulated lobe + coat; ggx, beckmann = body + parametric lobe + optional coat,"
-  echo "F82-tint Fresnel; lsq = the classical Lambert + GGX + Schlick least-squares fit). Bars (issue 10): the tabulated"
-  echo "mean at most 3.0, each material at most its lsq."
+  echo "F82-tint Fresnel; lsq = the classical Lambert + GGX + Schlick least-squares fit; closures = the closure representation,"
+  echo "body + one to three GGX lobes + coat, lib/model/closures.h), then the production material osl/facetfit_material.osl of the"
+  echo "same LUT rendered by Blender's Cycles (bpy 5.0.1, OSL on the CPU; realref/cycles_scene.py). Bars: the tabulated mean at"
+  echo "most 3.0, each material at most its lsq (issue 10); Cycles' mean at most the tabulated mean + 0.3, each material at"
+  echo "most its tabulated + 0.6 (issue 45)."
   echo
   cat "$work/table.md"
 } > "$work/doc.md"

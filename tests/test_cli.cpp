@@ -1,8 +1,12 @@
 // The facetfit command as users run it: bad inputs, batches, JSON output.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
@@ -98,13 +102,49 @@ TEST(Cli, BatchGoesOnPastABadFile) {
   EXPECT_NE(r.err.find("1 of 3 inputs failed"), std::string::npos) << r.err;
 }
 
+// export: each LUT's closures as a MaterialX document; a batch goes on past a bad LUT (exit 1, one line
+// naming it). MaterialX's own validation accepts every document where the Python venv has MaterialX
+// (make python installs it); the anisotropic lobe's tangent is turned by rotate3d.
+TEST(Cli, ExportWritesMaterialXDocumentsThatValidate) {
+  TempDir dir;
+  ASSERT_EQ(facetfit("bake builtin:gold-ggx-0.15 builtin:blue-clearcoat-paint builtin:red-plastic -o " + dir.file("luts")).status, 0);
+  const std::vector<unsigned char> bytes =
+      test::serialize(test::microfacet_tensor_fields(Ndf{NdfType::ggx, 0.45, 0.2}, Smith::correlated, 0.5, 25, 32, 64));
+  test::write_bytes(dir.file("aniso.bsdf"), std::string(bytes.begin(), bytes.end()));
+  ASSERT_EQ(facetfit("bake " + dir.file("aniso.bsdf") + " -o " + dir.file("luts")).status, 0);
+  test::write_bytes(dir.file("luts/broken.exr"), "not a LUT");
+  const std::string luts = dir.file("luts/gold-ggx-0.15.exr") + " " + dir.file("luts/broken.exr") + " " + dir.file("luts/blue-clearcoat-paint.exr") +
+                           " " + dir.file("luts/red-plastic.exr") + " " + dir.file("luts/aniso.exr");
+  const RunResult r = facetfit("export " + luts + " -o " + dir.file("mtlx/out"));
+  EXPECT_EQ(r.status, 1);
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_NE(r.err.find("broken.exr"), std::string::npos) << r.err;
+  std::string documents;
+  for (const char* name : {"gold_ggx_0_15", "blue_clearcoat_paint", "red_plastic", "aniso"}) {
+    const std::string path = dir.file(std::string("mtlx/out/") + name + ".mtlx");
+    ASSERT_TRUE(std::filesystem::exists(path)) << path;
+    std::ifstream in(path);
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    EXPECT_NE(text.find("<surfacematerial name=\"" + std::string(name) + "\""), std::string::npos) << text;
+    EXPECT_NE(text.find("generalized_schlick_bsdf"), std::string::npos);
+    documents += " " + path;
+  }
+  std::ifstream aniso(dir.file("mtlx/out/aniso.mtlx"));
+  EXPECT_NE(std::string((std::istreambuf_iterator<char>(aniso)), std::istreambuf_iterator<char>()).find("rotate3d"), std::string::npos);
+  const std::string python = FACETFIT_PY_PYTHON;
+  if (run_command("'" + python + "' -c 'import MaterialX' 2>/dev/null").status != 0)
+    GTEST_SKIP() << "no MaterialX in " << python << " (run: make python): documents written, not validated";
+  const RunResult valid = run_command("'" + python + "' " + std::string(FACETFIT_SOURCE_DIR) + "/tests/materialx/validate.py" + documents);
+  EXPECT_EQ(valid.status, 0) << valid.out << valid.err;
+}
+
 TEST(Cli, JsonHasExactlyTheDocumentedKeys) {
   const RunResult r = facetfit("fit builtin:copper-beckmann-0.30 --json");
   ASSERT_EQ(r.status, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   std::vector<std::string> keys;
   for (const auto& item : j.items()) keys.push_back(item.key());
-  EXPECT_EQ(keys, (std::vector<std::string>{"alpha_beckmann", "alpha_ggx", "anisotropic", "beckmann", "body", "body_exponent", "coat", "error",
+  EXPECT_EQ(keys, (std::vector<std::string>{"alpha_beckmann", "alpha_ggx", "anisotropic", "beckmann", "body", "body_exponent", "closures", "coat", "error",
                                             "error_extraction", "f0", "f82", "ggx", "iterations", "lsq", "refine",
                                             "residual", "seconds", "source", "warnings"}));
   for (const char* fit : {"ggx", "beckmann", "lsq"}) {

@@ -1,0 +1,44 @@
+// facetfit export LUT... -o DIR: each LUT's closure representation as a MaterialX document, DIR/NAME.mtlx
+// (lib/lut/materialx.h). A batch goes on past a LUT it cannot read; the exit status is 1 if any failed.
+#include <cstdio>
+#include <filesystem>
+
+#include "commands.h"
+#include "core/error.h"
+#include "io/atomic_file.h"
+#include "lut/lut.h"
+#include "lut/materialx.h"
+
+namespace facetfit::cli {
+
+void add_export_command(CLI::App& app, Context& ctx) {
+  auto luts = std::make_shared<std::vector<std::string>>();
+  auto out_dir = std::make_shared<std::string>();
+  CLI::App* cmd = app.add_subcommand("export", "Write each LUT's closures as a MaterialX document (pbrlib nodes), OUT/NAME.mtlx");
+  cmd->add_option("luts", *luts, "LUT files (.exr, from bake)")->required();
+  cmd->add_option("-o,--output", *out_dir, "Output folder (created if missing)")->required();
+  cmd->callback([luts, out_dir, &ctx] {
+    namespace fs = std::filesystem;
+    std::error_code ec;
+    fs::create_directories(*out_dir, ec);
+    if (ec) {
+      report_error(*out_dir + ": cannot create the output folder: " + ec.message());
+      ctx.status = 1;
+      return;
+    }
+    remove_stale_temporaries(*out_dir);
+    for (const std::string& path : *luts) {
+      try {
+        const std::string name = materialx_name(fs::path(path).stem().string());
+        const std::string target = (fs::path(*out_dir) / (name + ".mtlx")).string();
+        write_file_atomic(target, materialx_document(name, read_lut(path)));
+        if (!ctx.quiet()) std::printf("%s\n", target.c_str());
+      } catch (const Error& e) {
+        report_error(e.what());
+        ctx.status = 1;
+      }
+    }
+  });
+}
+
+}  // namespace facetfit::cli

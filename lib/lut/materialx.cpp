@@ -1,0 +1,113 @@
+#include "lut/materialx.h"
+
+#include <array>
+#include <cctype>
+#include <cstdio>
+#include <sstream>
+#include <vector>
+
+#include "model/closures.h"
+#include "model/fresnel.h"
+
+namespace facetfit {
+
+namespace {
+
+std::string number(double v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.6g", v);
+  return text;
+}
+
+std::string colour(const Rgb& c) { return number(c.r) + ", " + number(c.g) + ", " + number(c.b); }
+
+// One node: <category name type> with its inputs (name, type, value or nodename=).
+struct Node {
+  std::string category, name, type;
+  std::vector<std::array<std::string, 3>> inputs;  // name, type, value ("@node" connects a node's output)
+
+  void write(std::ostringstream& out) const {
+    out << "  <" << category << " name=\"" << name << "\" type=\"" << type << "\">\n";
+    for (const auto& [input, kind, value] : inputs) {
+      out << "    <input name=\"" << input << "\" type=\"" << kind << "\" ";
+      if (!value.empty() && value[0] == '@')
+        out << "nodename=\"" << value.substr(1) << "\" />\n";
+      else
+        out << "value=\"" << value << "\" />\n";
+    }
+    out << "  </" << category << ">\n";
+  }
+};
+
+// The generalized_schlick_bsdf of a lobe (its tangent node when it is anisotropic, added to `nodes`).
+Node lobe_node(const std::string& name, const ClosureLobe& l, std::vector<Node>& nodes) {
+  Node n{"generalized_schlick_bsdf", name, "BSDF", {}};
+  const bool tint = l.fresnel == ClosureLobe::Fresnel::f82_tint;
+  n.inputs.push_back({"weight", "float", number(l.weight)});
+  n.inputs.push_back({"color0", "color3", colour(l.f0)});
+  // F82-tint: the closure takes f82 as a tint of Schlick's value at mu = 1/7 (osl/facetfit_material.osl).
+  n.inputs.push_back({"color82", "color3", tint ? colour(l.f82 / fresnel_schlick(l.f0, 1.0 / 7.0)) : colour(Rgb(1.0))});
+  n.inputs.push_back({"color90", "color3", tint ? colour(Rgb(1.0)) : colour(l.f90)});
+  n.inputs.push_back({"exponent", "float", number(tint ? 5.0 : l.exponent)});
+  n.inputs.push_back({"roughness", "vector2", number(l.alpha_x) + ", " + number(l.alpha_y)});
+  n.inputs.push_back({"scatter_mode", "string", "R"});
+  if (l.alpha_x != l.alpha_y && l.angle != 0.0) {
+    nodes.push_back({"tangent", name + "_surface_tangent", "vector3", {{"space", "string", "world"}}});
+    nodes.push_back({"normal", name + "_surface_normal", "vector3", {{"space", "string", "world"}}});
+    nodes.push_back({"rotate3d", name + "_tangent", "vector3",
+                     {{"in", "vector3", "@" + name + "_surface_tangent"}, {"amount", "float", number(l.angle * 180.0 / kPi)},
+                      {"axis", "vector3", "@" + name + "_surface_normal"}}});
+    n.inputs.push_back({"tangent", "vector3", "@" + name + "_tangent"});
+  }
+  return n;
+}
+
+}  // namespace
+
+std::string materialx_name(const std::string& stem) {
+  std::string out;
+  for (char c : stem) out += std::isalnum(static_cast<unsigned char>(c)) || c == '_' ? c : '_';
+  if (out.empty() || std::isdigit(static_cast<unsigned char>(out[0]))) out = "m_" + out;
+  return out;
+}
+
+std::string materialx_document(const std::string& name, const Lut& lut) {
+  const Closures c = lut.closures();
+  std::vector<Node> nodes;
+  std::vector<std::string> parts;
+  if (c.body.r > 0.0 || c.body.g > 0.0 || c.body.b > 0.0) {
+    nodes.push_back({"oren_nayar_diffuse_bsdf", name + "_body", "BSDF", {{"color", "color3", colour(c.body)}, {"roughness", "float", "0"}}});
+    parts.push_back(name + "_body");
+  }
+  for (std::size_t k = 0; k < c.lobes.size(); ++k) {
+    const Node lobe = lobe_node(name + "_lobe" + std::to_string(k), c.lobes[k], nodes);
+    nodes.push_back(lobe);
+    parts.push_back(lobe.name);
+  }
+  if (c.coat.present()) {
+    ClosureLobe coat;
+    coat.alpha_x = coat.alpha_y = c.coat.alpha;
+    coat.fresnel = ClosureLobe::Fresnel::schlick;
+    coat.f0 = Rgb(c.coat.f0);
+    coat.f90 = Rgb(1.0);
+    coat.exponent = 5.0;
+    nodes.push_back(lobe_node(name + "_coat", coat, nodes));
+    parts.push_back(name + "_coat");
+  }
+  // The sum, a chain of adds.
+  std::string sum = parts.front();
+  for (std::size_t k = 1; k < parts.size(); ++k) {
+    const std::string add = name + "_sum" + std::to_string(k);
+    nodes.push_back({"add", add, "BSDF", {{"in1", "BSDF", "@" + sum}, {"in2", "BSDF", "@" + parts[k]}}});
+    sum = add;
+  }
+  nodes.push_back({"surface", name + "_surface", "surfaceshader", {{"bsdf", "BSDF", "@" + sum}}});
+  nodes.push_back({"surfacematerial", name, "material", {{"surfaceshader", "surfaceshader", "@" + name + "_surface"}}});
+  std::ostringstream out;
+  out << "<?xml version=\"1.0\"?>\n<materialx version=\"1.39\">\n";
+  for (const Node& n : nodes) n.write(out);
+  out << "</materialx>\n";
+  return out.str();
+}
+
+}  // namespace facetfit
