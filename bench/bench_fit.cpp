@@ -81,13 +81,19 @@ const MerlTable* rgl_material(const char* name) {
 
 // The default fit (--refine full) of real materials against the paper's method alone on the same
 // table (the anchor): extraction, parametric fits, refinement, every distance.
+// The RGL material the benchmark's second argument names (0: acrylic_felt_green_rgb, 1:
+// ilm_l3_37_metallic_rgb), or null after skipping the benchmark without the data.
+const MerlTable* rgl_material_of(benchmark::State& state, const char** name) {
+  *name = state.range(1) == 0 ? "acrylic_felt_green_rgb" : "ilm_l3_37_metallic_rgb";
+  const MerlTable* table = rgl_material(*name);
+  if (!table) state.SkipWithError("no RGL data: set FACETFIT_RGL_DIR");
+  return table;
+}
+
 void BM_FitRgl(benchmark::State& state) {
-  const char* name = state.range(1) == 0 ? "acrylic_felt_green_rgb" : "ilm_l3_37_metallic_rgb";
-  const MerlTable* table = rgl_material(name);
-  if (!table) {
-    state.SkipWithError("no RGL data: set FACETFIT_RGL_DIR");
-    return;
-  }
+  const char* name = nullptr;
+  const MerlTable* table = rgl_material_of(state, &name);
+  if (!table) return;
   const auto threads = limit_threads(state);
   FitOptions options;
   options.refine = state.range(2) ? FitOptions::Refine::full : FitOptions::Refine::none;
@@ -103,12 +109,9 @@ BENCHMARK(BM_FitRgl)->ArgNames({"threads", "material", "refine"})
 // solves, on the materials of BM_FitRgl, whose refine-full rows include it: their ratio is what the
 // closures add to a fit (the bar: at most 50% of the rest).
 void BM_ClosureFit(benchmark::State& state) {
-  const char* name = state.range(1) == 0 ? "acrylic_felt_green_rgb" : "ilm_l3_37_metallic_rgb";
-  const MerlTable* table = rgl_material(name);
-  if (!table) {
-    state.SkipWithError("no RGL data: set FACETFIT_RGL_DIR");
-    return;
-  }
+  const char* name = nullptr;
+  const MerlTable* table = rgl_material_of(state, &name);
+  if (!table) return;
   const auto threads = limit_threads(state);
   const FitResult fit = Fitter(FitOptions{}).fit(*table);
   const MeasuredBins errors = error_bins(*table);

@@ -114,7 +114,7 @@ class ClosureRowCost final : public ceres::CostFunction {
     for (std::size_t q = 0; q < n; ++q) {
       const std::size_t k = row_.begin + q;
       const double ci = bins_.i[k].z, co = bins_.o[k].z, mu = bins_.cos_d[k], ch = bins_.cos_h[k];
-      const double inv4 = 1.0 / (4.0 * ci * co), s_mu = schlick_slope(mu);
+      const double inv4 = 1.0 / (4.0 * ci * co);
       for (std::size_t l = 0; l < lobes; ++l) {  // D G2 / (4 cos_i cos_o) and its derivative in log alpha
         const NdfType type = forms_[l].type;
         const double alpha = std::exp(p[2 + 3 * l][0]);
@@ -123,15 +123,7 @@ class ClosureRowCost final : public ceres::CostFunction {
         lobe[l] = d.value * g.value * inv4;
         lobe_slope[l] = (d.slope * g.value + d.value * g.slope) * inv4 * alpha;
       }
-      double coat = 0.0, coat_d_log_alpha = 0.0, coat_d_f0 = 0.0;
-      if (with_coat_) {
-        const WithSlope dc = ndf_of(NdfType::ggx, coat_alpha, ch);
-        const WithSlope gc = g2_of(Smith::correlated, lambda_of(NdfType::ggx, coat_alpha, ci), lambda_of(NdfType::ggx, coat_alpha, co));
-        const double fc = coat_f0 * s_mu + (1.0 - s_mu);
-        coat = fc * dc.value * gc.value * inv4;
-        coat_d_log_alpha = fc * (dc.slope * gc.value + dc.value * gc.slope) * inv4 * coat_alpha;
-        coat_d_f0 = s_mu * dc.value * gc.value * inv4;
-      }
+      const CoatTerms coat = with_coat_ ? coat_terms(coat_alpha, coat_f0, ch, ci, co, mu) : CoatTerms{};
       std::array<LobeFresnelRgb, Closures::kMaxLobes> fresnel;
       for (std::size_t l = 0; l < lobes; ++l) fresnel[l] = lobe_fresnel(forms_[l].fresnel, p[2 + 3 * l][1], p[3 + 3 * l], p[4 + 3 * l], mu);
       const double w = std::sqrt(bins_.weight[k]), c = bins_.cosine[k];
@@ -142,14 +134,14 @@ class ClosureRowCost final : public ceres::CostFunction {
           residuals[r] = 0.0;
           continue;
         }
-        double m = p[0][e] * kInvPi + coat;
+        double m = p[0][e] * kInvPi + coat.value;
         for (std::size_t l = 0; l < lobes; ++l) m += fresnel[l][std::size_t(e)].value * lobe[l];
         const MetricResidual res = metric_residual(m, c, bins_.lightness[k][e], grazing);
         residuals[r] = w * res.value;
         if (!jacobians || m < 0.0) continue;
         const double dm = w * res.slope;
         if (jacobians[0]) jacobians[0][3 * r + std::size_t(e)] = dm * kInvPi;
-        if (jacobians[1]) jacobians[1][2 * r] = dm * coat_d_log_alpha, jacobians[1][2 * r + 1] = dm * coat_d_f0;
+        if (jacobians[1]) jacobians[1][2 * r] = dm * coat.d_log_alpha, jacobians[1][2 * r + 1] = dm * coat.d_f0;
         for (std::size_t l = 0; l < lobes; ++l) {
           const LobeFresnel& f = fresnel[l][std::size_t(e)];
           if (double* j = jacobians[2 + 3 * l]) j[2 * r] = dm * f.value * lobe_slope[l], j[2 * r + 1] = dm * f.d_shape * lobe[l];

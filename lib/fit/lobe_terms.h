@@ -97,4 +97,17 @@ inline FresnelTerms fresnel_terms(double f0, double f82, double mu, bool tint) {
   return f;
 }
 
+// The clear coat's term, Schlick(f0, mu) D G2 / (4 cos_i cos_o) of GGX `alpha` (height-correlated), at
+// cos theta_h, cos theta_i, cos theta_o and mu = cos theta_d, and its derivatives in log alpha and f0.
+struct CoatTerms {
+  double value = 0.0, d_log_alpha = 0.0, d_f0 = 0.0;
+};
+inline CoatTerms coat_terms(double alpha, double f0, double ch, double ci, double co, double mu) {
+  const double inv4 = 1.0 / (4.0 * ci * co), s_mu = schlick_slope(mu);
+  const WithSlope d = ndf_of(NdfType::ggx, alpha, ch);
+  const WithSlope g = g2_of(Smith::correlated, lambda_of(NdfType::ggx, alpha, ci), lambda_of(NdfType::ggx, alpha, co));
+  const double f = f0 * s_mu + (1.0 - s_mu);  // Schlick(f0, mu)
+  return {f * d.value * g.value * inv4, f * (d.slope * g.value + d.value * g.slope) * inv4 * alpha, s_mu * d.value * g.value * inv4};
+}
+
 }  // namespace facetfit::lobe_terms

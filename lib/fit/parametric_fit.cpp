@@ -73,16 +73,7 @@ class RowCost final : public ceres::CostFunction {
       const WithSlope g = g2_of(smith_, lambda_of(type_, alpha, ci), lambda_of(type_, alpha, co));
       const double lobe = d.value * g.value * inv4;
       const double lobe_slope = (d.slope * g.value + d.value * g.slope) * inv4 * alpha;  // d/d log alpha
-      const double s_mu = schlick_slope(mu);
-      double coat = 0.0, coat_d_log_alpha = 0.0, coat_d_f0 = 0.0;
-      if (with_coat_) {
-        const WithSlope dc = ndf_of(NdfType::ggx, coat_alpha, ch);
-        const WithSlope gc = g2_of(Smith::correlated, lambda_of(NdfType::ggx, coat_alpha, ci), lambda_of(NdfType::ggx, coat_alpha, co));
-        const double fc = coat_f0 * s_mu + (1.0 - s_mu);  // Schlick(coat_f0, mu)
-        coat = fc * dc.value * gc.value * inv4;
-        coat_d_log_alpha = fc * (dc.slope * gc.value + dc.value * gc.slope) * inv4 * coat_alpha;
-        coat_d_f0 = s_mu * dc.value * gc.value * inv4;
-      }
+      const CoatTerms coat = with_coat_ ? coat_terms(coat_alpha, coat_f0, ch, ci, co, mu) : CoatTerms{};
       const double w = std::sqrt(bins_.weight[k]), c = bins_.cosine[k];
       const bool grazing = grazing_pair(bins_.o[k], bins_.i[k]);
       for (int e = 0; e < 3; ++e) {
@@ -92,7 +83,7 @@ class RowCost final : public ceres::CostFunction {
           continue;
         }
         const FresnelTerms fresnel = fresnel_terms(f0[e], f82[e], mu, f82_);
-        const double m = body[e] * kInvPi + fresnel.value * lobe + coat;
+        const double m = body[e] * kInvPi + fresnel.value * lobe + coat.value;
         // F82-tint can dip below zero for extreme f82: no negative reflectance, and no slope there.
         const MetricResidual res = metric_residual(m, c, bins_.lightness[k][e], grazing);
         residuals[r] = w * res.value;
@@ -100,7 +91,7 @@ class RowCost final : public ceres::CostFunction {
         const double dm = w * res.slope;
         colour_jacobians(jacobians, r, e, dm, fresnel, lobe);
         if (jacobians[1]) jacobians[1][r] = dm * fresnel.value * lobe_slope;
-        if (jacobians[4]) jacobians[4][2 * r] = dm * coat_d_log_alpha, jacobians[4][2 * r + 1] = dm * coat_d_f0;
+        if (jacobians[4]) jacobians[4][2 * r] = dm * coat.d_log_alpha, jacobians[4][2 * r + 1] = dm * coat.d_f0;
       }
     }
     return true;

