@@ -11,9 +11,9 @@
 // The start is the one-lobe GGX fit (fit/parametric_fit.h) with its coat, its lobe at weight 1: GGX
 // because every renderer and MaterialX's generalized_schlick_bsdf have it (Cycles' Beckmann masking is
 // a rational approximation, and MaterialX has no Beckmann). Lobes are then added one at a time: from the
-// current fit, a sharper and a broader lobe are tried, every parameter solved again, and the nearer taken
-// if it brings the fit `lobe_gain` of its distance from the measurement nearer; otherwise no more are
-// added. So no lobe stays that does not pay for itself, and a material that is one lobe keeps one.
+// current fit, a sharper and a broader lobe are tried, every parameter solved again (on a third of the
+// bins' rows, a few steps each), and the nearer taken if it brings the fit `lobe_gain` of its distance
+// nearer; otherwise no more are added; the lobes chosen are then solved on every row. So no lobe stays that does not pay for itself, and a material that is one lobe keeps one.
 #pragma once
 
 #include "fit/measurement.h"
@@ -39,8 +39,8 @@ struct ClosureFitOptions {
   int max_lobes = Closures::kMaxLobes;
   double lobe_gain = 0.03;  // the relative distance a lobe must buy to be kept
   double min_gain = 2e-4;   // and the least (0.02 units of L*)
-  int max_iterations = 25;     // Levenberg-Marquardt steps per solve while lobes are chosen
-  int polish_iterations = 300;  // and of the solve of the lobes chosen
+  int max_iterations = 15;     // Levenberg-Marquardt steps per solve while lobes are chosen
+  int polish_iterations = 50;  // and of the solve of the lobes chosen
 };
 
 struct ClosureFit {

@@ -1,5 +1,6 @@
 #include "fit/measurement.h"
 
+#include <algorithm>
 #include <cmath>
 #include <optional>
 #include <utility>
@@ -141,6 +142,25 @@ MeasuredBins measured_bins(const HalfDiffLattice& lattice, int stride) {
     }
   normalize_weights(bins, total);
   return bins;
+}
+
+MeasuredBins every_nth_row(const MeasuredBins& bins, int n) {
+  MeasuredBins out;
+  double total = 0.0;
+  for (std::size_t r = 0; r < bins.rows.size(); r += std::size_t(std::max(n, 1))) {
+    MeasuredBins::Row row = bins.rows[r];
+    const std::size_t begin = out.size();
+    for (std::size_t k = row.begin; k < row.end; ++k) {
+      out.i.push_back(bins.i[k]), out.o.push_back(bins.o[k]), out.cosine.push_back(bins.cosine[k]);
+      out.cos_h.push_back(bins.cos_h[k]), out.cos_d.push_back(bins.cos_d[k]), out.weight.push_back(bins.weight[k]);
+      out.lightness.push_back(bins.lightness[k]), out.valid.push_back(bins.valid[k]);
+      total += bins.weight[k];
+    }
+    row.begin = begin, row.end = out.size();
+    out.rows.push_back(row);
+  }
+  normalize_weights(out, total);
+  return out;
 }
 
 double measurement_error(const MeasuredBins& bins, const Brdf& model) {

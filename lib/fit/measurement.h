@@ -129,6 +129,9 @@ inline MetricResidual metric_residual(double model, double cosine, double lightn
   return {r * s, dr / (q * s)};
 }
 
+// Every n-th row of `bins`, their weights summing to 1 again: a sparser set of the same kind.
+MeasuredBins every_nth_row(const MeasuredBins& bins, int n);
+
 // Root of the metric's weighted mean square: how far `model` is from the measurement.
 double measurement_error(const MeasuredBins& bins, const Brdf& model);
 
