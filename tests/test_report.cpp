@@ -35,14 +35,14 @@ TEST(Report, WritesEveryOutputAndTheRightOrder) {
   EXPECT_TRUE(r["failures"].empty());
   for (const json& m : r["materials"]) {
     const std::string name = m["name"];
-    for (const char* f : {"measured.png", "tabulated.png", "ggx.png", "beckmann.png", "lsq.png", "ggx_delta_e.png",
+    for (const char* f : {"measured.png", "tabulated.png", "ggx.png", "beckmann.png", "lsq.png", "closures.png", "ggx_delta_e.png",
                           "lobes_0.svg", "lobes_30.svg", "lobes_60.svg", "ndf.svg", "fresnel.svg"})
       EXPECT_TRUE(std::filesystem::exists(dir.path() / "images" / name / f)) << name << "/" << f;
     // A lobe figure holds one curve per representation and the measurement.
     const std::string lobes = test::read_bytes((dir.path() / "images" / name / "lobes_30.svg").string());
     std::size_t curves = 0;
     for (std::size_t at = lobes.find("<polyline"); at != std::string::npos; at = lobes.find("<polyline", at + 1)) ++curves;
-    EXPECT_EQ(curves, 5u) << name;
+    EXPECT_EQ(curves, 6u) << name;  // measured, tabulated, ggx, beckmann, lsq, closures
     EXPECT_TRUE(std::filesystem::exists(dir.path() / "luts" / (name + ".exr")));
   }
   // Each family fits its own material; Beckmann cannot fit a GGX lobe (the worst entry of all).
@@ -55,6 +55,9 @@ TEST(Report, WritesEveryOutputAndTheRightOrder) {
   EXPECT_LT(entry("copper-beckmann-0.30")["delta_e"]["beckmann"].get<double>(), 0.5);
   EXPECT_GT(entry("gold-ggx-0.15")["delta_e"]["beckmann"].get<double>(), 3.0);
   EXPECT_EQ(r["worst"][0]["name"], "gold-ggx-0.15");
+  // What production shades with, beside the tabulated model, and what each costs to render.
+  EXPECT_LT(entry("gold-ggx-0.15")["delta_e"]["closures"].get<double>(), 0.5);
+  for (const char* column : {"tabulated", "ggx", "closures"}) EXPECT_GT(r["database_mean_render_seconds"][column].get<double>(), 0.0) << column;
   EXPECT_EQ(read_json(dir.file("report.json")), r);
   const std::string html = test::read_bytes(dir.file("index.html"));
   EXPECT_NE(html.find("<svg"), std::string::npos);          // run time against error

@@ -70,6 +70,16 @@ void summarize(json& report) {
     means[r] = n > 0 ? json(sum / n) : json(nullptr);
   }
   report["database_mean_delta_e"] = means;
+  // And the mean render time of each: what a representation costs beside what it gains.
+  json seconds = json::object();
+  for (const std::string& r : report_representations()) {
+    double sum = 0.0;
+    int n = 0;
+    for (const json& m : report["materials"])
+      if (m["seconds"]["render"].contains(r)) sum += m["seconds"]["render"][r].get<double>(), ++n;
+    seconds[r] = n > 0 ? json(sum / n) : json(nullptr);
+  }
+  report["database_mean_render_seconds"] = seconds;
   std::vector<std::pair<double, std::string>> worst;
   for (const json& m : report["materials"]) {
     double w = 0.0;
@@ -138,12 +148,16 @@ std::string report_html(const json& report) {
     << report["settings"]["spp"] << " spp. Mean CIE Delta E 2000 over the sphere between the render of the measurement "
     << "and of each representation (display-referred sRGB; docs/colour.md).</p><h2>Database mean</h2><table><tr>";
   for (const std::string& r : report_representations()) h << "<th>" << r << "</th>";
-  h << "</tr><tr>";
-  for (const std::string& r : report_representations()) {
-    const json& v = report["database_mean_delta_e"][r];
-    h << "<td>" << (v.is_null() ? std::string("-") : std::to_string(v.get<double>())) << "</td>";
+  h << "<th></th></tr>";
+  for (const auto& [key, label] : {std::pair{"database_mean_delta_e", "mean &Delta;E"}, {"database_mean_render_seconds", "mean render s"}}) {
+    h << "<tr>";
+    for (const std::string& r : report_representations()) {
+      const json& v = report.value(key, json::object()).value(r, json(nullptr));
+      h << "<td>" << (v.is_null() ? std::string("-") : std::to_string(v.get<double>())) << "</td>";
+    }
+    h << "<td>" << label << "</td></tr>";
   }
-  h << "</tr></table>";
+  h << "</table>";
   if (!report["regressions"].empty()) {
     h << "<h2 class='bad'>Regressions against the previous report</h2><ul>";
     for (const json& g : report["regressions"])
