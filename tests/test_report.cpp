@@ -5,6 +5,8 @@
 #include <fstream>
 #include <map>
 
+#include "io/merl.h"
+#include "model/analytic.h"
 #include "report/report.h"
 #include "test_util.h"
 
@@ -21,6 +23,20 @@ ReportOptions small(const std::string& out) {
   o.size = 24;
   o.spp = 4;
   return o;
+}
+
+// A material file named to break out of a single-quoted attribute: its name is escaped in every HTML
+// context, so the page holds no attribute the name wrote (issue 47).
+TEST(Report, AMaterialNameCannotWriteHtml) {
+  TempDir dir;
+  const std::string name = "x' onerror='alert(1)";
+  MerlTable::tabulate(LambertBrdf(Rgb(0.5))).write(dir.file(name + ".binary"));
+  ReportOptions o = small(dir.file("out"));
+  o.inputs = {dir.file(name + ".binary")};
+  run_report(o);
+  const std::string html = test::read_bytes(dir.file("out/index.html"));
+  EXPECT_EQ(html.find("onerror='"), std::string::npos);
+  EXPECT_NE(html.find("x&#39; onerror=&#39;alert(1)"), std::string::npos);
 }
 
 json read_json(const std::string& path) {

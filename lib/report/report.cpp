@@ -99,6 +99,7 @@ std::string html_escape(const std::string& s) {
     else if (c == '>') out += "&gt;";
     else if (c == '&') out += "&amp;";
     else if (c == '"') out += "&quot;";
+    else if (c == '\'') out += "&#39;";  // the page's attributes are single-quoted
     else out += c;
   }
   return out;
