@@ -1,6 +1,7 @@
 // The closure representation fitted on the whole measurement (model/closures.h): a Lambertian body, one
-// to three F82-tint microfacet lobes, each with its own alpha, weight, f0 and f82, and the coat, in the
-// metric of fit/measurement.h, with the closures' own formulas (height-correlated Smith G2, as Cycles).
+// to three GGX lobes, each with its own alpha, weight and Fresnel (F82-tint or generalized Schlick), and
+// the coat, in the metric of fit/measurement.h, with the closures' own formulas (height-correlated Smith
+// G2, as Cycles).
 //
 // Besides the bins, the closures match the measurement's directional albedo (AlbedoTarget below), beyond a
 // tolerance: the bins weigh grazing pairs down (fit/measurement.h) and an RGL file has none past 78.5
@@ -13,7 +14,8 @@
 // a rational approximation, and MaterialX has no Beckmann). Lobes are then added one at a time: from the
 // current fit, a sharper and a broader lobe are tried, every parameter solved again (on a third of the
 // bins' rows, a few steps each), and the nearer taken if it brings the fit `lobe_gain` of its distance
-// nearer; otherwise no more are added; the lobes chosen are then solved on every row. So no lobe stays that does not pay for itself, and a material that is one lobe keeps one.
+// nearer; otherwise no more are added; the lobes chosen are then solved on every row. So no lobe stays
+// that does not pay for itself, and a material that is one lobe keeps one.
 #pragma once
 
 #include "fit/measurement.h"
