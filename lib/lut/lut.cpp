@@ -299,11 +299,10 @@ Closures Lut::closures() const {
   const bool beckmann = meta.representation == Representation::beckmann ||
                         (meta.representation == Representation::tabulated && meta.error_beckmann < meta.error_ggx);
   const LutMetadata::Parametric& p = beckmann ? meta.beckmann : meta.ggx;
-  Closures c;
-  c.body = p.body;
-  c.coat = p.coat;
-  c.lobes.push_back({beckmann ? NdfType::beckmann : NdfType::ggx, p.alpha, p.alpha, 0.0, 1.0, ClosureLobe::Fresnel::f82_tint, p.f0, p.f82});
-  return c;
+  ParametricFit fit;
+  fit.type = beckmann ? NdfType::beckmann : NdfType::ggx;
+  fit.alpha = p.alpha, fit.body = p.body, fit.f0 = p.f0, fit.f82 = p.f82, fit.coat = p.coat;
+  return closures_of(fit);
 }
 
 namespace {
