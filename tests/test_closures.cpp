@@ -9,6 +9,7 @@
 #include "chi2.h"
 #include "fit/closure_fit.h"
 #include "fit/fit.h"
+#include "fit/visible_moments.h"
 #include "io/input.h"
 #include "model/analytic.h"
 #include "model/closures.h"
@@ -128,12 +129,41 @@ TEST(ClosureFit, AlbedoSumAgreesWithTheBrdf) {
   }
 }
 
+TEST(ClosureFit, MomentTableAgreesWithTheDirectSum) {
+  // The table's splines against the sums they interpolate, over the fit's ranges (alpha 1e-3 to 1, e 0
+  // to 10, every view of albedo_target), and its derivatives against central differences of itself.
+  const AlbedoTarget target = albedo_target(ClosureBrdf(two_lobes()), ClosureProposal(two_lobes()));
+  const auto table = VisibleMoments::at_views(target.cos_o);
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  double worst = 0.0, worst_slope = 0.0;
+  for (int k = 0; k < 2000; ++k) {
+    const std::size_t view = std::size_t(rng() % target.cos_o.size());
+    const double log_alpha = std::log(1e-3) * u(rng), e = k % 4 == 0 ? double(k / 4 % 8) : 0.25 + 9.75 * u(rng);
+    const double direct = VisibleMoments::sum(target.cos_o[view], std::exp(log_alpha), e);
+    const VisibleMoments::Moment m = table->at(view, log_alpha, e);
+    const double scale = VisibleMoments::sum(target.cos_o[view], std::exp(log_alpha), 0.0);  // the albedo of F = 1
+    worst = std::max(worst, std::abs(m.value - direct) / scale);
+    constexpr double h = 1e-5;
+    const double d_alpha = (table->at(view, log_alpha + h, e).value - table->at(view, log_alpha - h, e).value) / (2 * h);
+    const double d_e = (table->at(view, log_alpha, e + h).value - table->at(view, log_alpha, e - h).value) / (2 * h);
+    if (e > 0.3) worst_slope = std::max({worst_slope, std::abs(m.d_log_alpha - d_alpha) / scale, std::abs(m.d_exponent - d_e) / scale});
+  }
+  EXPECT_LT(worst, 3e-3);  // 0.25% when written: far under the fit's albedo tolerance (1.3%)
+  EXPECT_LT(worst_slope, 1e-5);
+}
+
 TEST(ClosureFit, DerivativesMatchDifferences) {
   const MeasuredBins bins = measured_bins(MerlTable::tabulate(ClosureBrdf(two_lobes())), 18, 90);
   Closures at = two_lobes();
   at.coat = Coat{0.04, 0.05};
   at.lobes[0].alpha_x = at.lobes[0].alpha_y = 0.1;  // away from the optimum: nonzero residuals
-  EXPECT_LT(closure_jacobian_error(bins, at), 1e-4);
+  at.lobes[1].exponent = 3.3;                         // between the table's nodes
+  // The albedo's residuals too, against a target they are beyond the tolerance of (the lobes half as bright).
+  Closures dim = two_lobes();
+  for (ClosureLobe& l : dim.lobes) l.weight *= 0.5, l.f0 = 0.5 * l.f0, l.f90 = 0.5 * l.f90;
+  const AlbedoTarget albedo = albedo_target(ClosureBrdf(dim), ClosureProposal(dim));
+  EXPECT_LT(closure_jacobian_error(bins, at, &albedo), 1e-4);
 }
 
 // The bar: a two-lobe GGX mixture plus a body, written by the project's MERL writer and fitted as a

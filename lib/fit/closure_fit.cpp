@@ -6,12 +6,13 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <random>
 #include <vector>
 
 #include "fit/lobe_terms.h"
 #include "fit/small_problem.h"
-#include "model/ggx_visible.h"
+#include "fit/visible_moments.h"
 
 namespace facetfit {
 
@@ -160,21 +161,52 @@ class ClosureRowCost final : public ceres::CostFunction {
   bool with_coat_;
 };
 
-// The directional albedo of each lobe and of the coat, at the views of an AlbedoTarget, as a sum over
-// GGX visible normals drawn from a fixed grid of numbers: rho(o) = mean of F(o.h) G2(o, i) / G1(o)
-// (model/ggx_visible.h), smooth in alpha because the grid is fixed. The residuals, one per view and channel,
+// A lobe's directional albedo at one view of a VisibleMoments table, per channel, from its Fresnel's
+// powers of 1 - mu (fit/visible_moments.h), and its derivatives in the lobe's unknowns:
+//   F82-tint, w (f0 (M0 - M5) + M5 - a (M6 - M7)), a = f82_shift (mu (1 - mu)^6 = (1 - mu)^6 - (1 - mu)^7);
+//   generalized Schlick, f0 M0 + (f90 - f0) Me.
+struct LobeAlbedo {
+  double value = 0.0, d_log_alpha = 0.0, d_shape = 0.0, d_f0 = 0.0, d_second = 0.0;
+};
+std::array<LobeAlbedo, 3> lobe_albedo(const VisibleMoments& moments, std::size_t view, ClosureLobe::Fresnel form, const double* shape,
+                                      const double* f0, const double* second) {
+  const auto at = [&](double e) { return moments.at(view, shape[0], e); };
+  std::array<LobeAlbedo, 3> rho;
+  const VisibleMoments::Moment m0 = at(0.0);
+  if (form == ClosureLobe::Fresnel::f82_tint) {
+    const VisibleMoments::Moment m5 = at(5.0), m6 = at(6.0), m7 = at(7.0);
+    const double w = shape[1], s = m0.value - m5.value, b = m6.value - m7.value;
+    const double s_slope = m0.d_log_alpha - m5.d_log_alpha, b_slope = m6.d_log_alpha - m7.d_log_alpha;
+    for (std::size_t e = 0; e < 3; ++e) {
+      const F82Shift a = f82_shift(f0[e], second[e]);
+      const double bracket = f0[e] * s + m5.value - a.value * b;
+      rho[e] = {w * bracket, w * (f0[e] * s_slope + m5.d_log_alpha - a.value * b_slope), bracket, w * (s - a.d_f0 * b), -w * a.d_f82 * b};
+    }
+    return rho;
+  }
+  const VisibleMoments::Moment me = at(shape[1]);
+  for (std::size_t e = 0; e < 3; ++e) {
+    const double rise = second[e] - f0[e];
+    rho[e] = {f0[e] * m0.value + rise * me.value, f0[e] * m0.d_log_alpha + rise * me.d_log_alpha, rise * me.d_exponent,
+              m0.value - me.value, me.value};
+  }
+  return rho;
+}
+
+// The residuals of the closures' directional albedo at the views of an AlbedoTarget, one per view and channel,
 //   sqrt(weight_j) D(L(rho_j) - L(target_j)),  L = metric_transform(rho / pi) (CIE L* of rho, over 116),
-// D(x) = sign(x) max(0, |x| - kAlbedoTolerance), hold what a rendering under an environment shows of every
-// pixel and the bins do not: how much light the material returns from all directions, at the grazing views
-// of a sphere's rim too. The tolerance, 0.5 units of L* (about 1.3% of the albedo), is of the order of the
-// target's and this sum's own errors (0.75% apart at most on a two-lobe mixture): with errors of 1% (a
-// target from a grid's midpoints, this sum on 8 x 8 numbers) a two-lobe GGX mixture written in MERL came
-// back with a weight 5% off (tests/test_refine.cpp, ClosureFit).
+// D(x) = sign(x) max(0, |x| - kAlbedoTolerance), with rho = body + each lobe's and the coat's albedo
+// (lobe_albedo; the coat a generalized Schlick of f90 = 1, e = 5). They hold what a rendering under an
+// environment shows of every pixel and the bins do not: how much light the material returns from all
+// directions, at the grazing views of a sphere's rim too. The tolerance, 0.5 units of L* (about 1.3% of
+// the albedo), is of the order of the target's and the moments' own errors (0.4% and 0.3%): with errors of
+// 1% (a target from a grid's midpoints, visible normals on 8 x 8 numbers) a two-lobe GGX mixture written in
+// MERL came back with a weight 5% off (tests/test_closures.cpp).
 constexpr double kAlbedoTolerance = 0.5 / 116.0;
 class AlbedoCost final : public ceres::CostFunction {
  public:
   AlbedoCost(const AlbedoTarget& target, std::vector<Unknowns::Lobe> forms, bool with_coat)
-      : target_(target), forms_(std::move(forms)), with_coat_(with_coat) {
+      : target_(target), moments_(VisibleMoments::at_views(target.cos_o)), forms_(std::move(forms)), with_coat_(with_coat) {
     set_num_residuals(int(3 * target.cos_o.size()));
     for (int size : {3, 2}) mutable_parameter_block_sizes()->push_back(size);
     for (std::size_t k = 0; k < forms_.size(); ++k)
@@ -186,97 +218,45 @@ class AlbedoCost final : public ceres::CostFunction {
     if (jacobians)
       for (std::size_t b = 0; b < parameter_block_sizes().size(); ++b)
         if (jacobians[b]) std::fill(jacobians[b], jacobians[b] + 3 * views * std::size_t(parameter_block_sizes()[b]), 0.0);
-    constexpr double kStep = 1e-4;  // of log alpha, for the forward differences
     for (std::size_t j = 0; j < views; ++j) {
-      const double c = target_.cos_o[j];
-      const Vec3 o(std::sqrt(std::max(0.0, 1.0 - c * c)), 0.0, c);
-      // Per channel: rho, and its derivatives in each lobe's blocks and the coat's.
-      std::array<double, 3> rho{};
-      std::array<std::array<double, 3 * 3>, Closures::kMaxLobes> d_lobe{};  // log alpha, shape[1], f0, second per channel
-      std::array<std::array<double, 3>, Closures::kMaxLobes> d_f0{}, d_second{};
-      std::array<double, 2> d_coat{};
-      for (int e = 0; e < 3; ++e) rho[e] = p[0][e];
+      std::array<std::array<LobeAlbedo, 3>, Closures::kMaxLobes> lobe{};
+      std::array<double, 3> rho{p[0][0], p[0][1], p[0][2]};
       for (std::size_t l = 0; l < lobes; ++l) {
-        const double *shape = p[2 + 3 * l], *f0 = p[3 + 3 * l], *second = p[4 + 3 * l];
-        const auto fresnel = [&](double mu) { return lobe_fresnel(forms_[l].fresnel, shape[1], f0, second, mu); };
-        const double alpha = std::exp(shape[0]);
-        std::array<double, 3> lobe_rho{};
-        for_each_visible_normal(o, alpha, [&](double mu, double ratio) {
-          const LobeFresnelRgb f = fresnel(mu);
-          for (std::size_t e = 0; e < 3; ++e) {
-            lobe_rho[e] += f[e].value * ratio;
-            d_lobe[l][3 + e] += f[e].d_shape * ratio;
-            d_f0[l][e] += f[e].d_f0 * ratio;
-            d_second[l][e] += f[e].d_second * ratio;
-          }
-        });
-        for (std::size_t e = 0; e < 3; ++e) rho[e] += lobe_rho[e], d_lobe[l][e] -= lobe_rho[e] / kStep;
-        if (jacobians && jacobians[2 + 3 * l])
-          for_each_visible_normal(o, alpha * std::exp(kStep), [&](double mu, double ratio) {
-            const LobeFresnelRgb f = fresnel(mu);
-            for (std::size_t e = 0; e < 3; ++e) d_lobe[l][e] += f[e].value * ratio / kStep;
-          });
+        lobe[l] = lobe_albedo(*moments_, j, forms_[l].fresnel, p[2 + 3 * l], p[3 + 3 * l], p[4 + 3 * l]);
+        for (std::size_t e = 0; e < 3; ++e) rho[e] += lobe[l][e].value;
       }
+      std::array<LobeAlbedo, 3> coat{};
       if (with_coat_) {
-        const double coat_alpha = std::exp(p[1][0]), coat_f0 = p[1][1];
-        const auto schlick = [&](double mu) { const double m = 1.0 - mu, m2 = m * m; return coat_f0 + (1.0 - coat_f0) * m2 * m2 * m; };
-        double coat_rho = 0.0;
-        for_each_visible_normal(o, coat_alpha, [&](double mu, double ratio) {
-          coat_rho += schlick(mu) * ratio;
-          d_coat[1] += schlick_slope(mu) * ratio;
-        });
-        for (int e = 0; e < 3; ++e) rho[e] += coat_rho;
-        d_coat[0] = -coat_rho / kStep;
-        if (jacobians && jacobians[1])
-          for_each_visible_normal(o, coat_alpha * std::exp(kStep), [&](double mu, double ratio) { d_coat[0] += schlick(mu) * ratio / kStep; });
+        const std::array<double, 2> shape{p[1][0], 5.0};
+        const std::array<double, 3> f0{p[1][1], p[1][1], p[1][1]}, f90{1.0, 1.0, 1.0};
+        coat = lobe_albedo(*moments_, j, ClosureLobe::Fresnel::schlick, shape.data(), f0.data(), f90.data());
+        for (std::size_t e = 0; e < 3; ++e) rho[e] += coat[e].value;
       }
       const double w = std::sqrt(target_.weight[j]);
-      for (int e = 0; e < 3; ++e) {
-        const std::size_t r = 3 * j + std::size_t(e);
+      for (std::size_t e = 0; e < 3; ++e) {
+        const std::size_t r = 3 * j + e;
         double slope = 0.0;
-        const double difference = metric_transform(rho[e] * kInvPi, &slope) - target_.lightness[j][e];
+        const double difference = metric_transform(rho[e] * kInvPi, &slope) - target_.lightness[j][int(e)];
         const double beyond = std::max(0.0, std::abs(difference) - kAlbedoTolerance);
         residuals[r] = w * std::copysign(beyond, difference);
         if (!jacobians || beyond <= 0.0) continue;
         const double dm = w * slope * kInvPi;
-        if (jacobians[0]) jacobians[0][3 * r + std::size_t(e)] = dm;
-        if (jacobians[1]) jacobians[1][2 * r] = dm * d_coat[0], jacobians[1][2 * r + 1] = dm * d_coat[1];
+        if (jacobians[0]) jacobians[0][3 * r + e] = dm;
+        if (jacobians[1]) jacobians[1][2 * r] = dm * coat[e].d_log_alpha, jacobians[1][2 * r + 1] = dm * coat[e].d_f0;
         for (std::size_t l = 0; l < lobes; ++l) {
-          if (double* jac = jacobians[2 + 3 * l]) jac[2 * r] = dm * d_lobe[l][e], jac[2 * r + 1] = dm * d_lobe[l][3 + e];
-          if (double* jac = jacobians[3 + 3 * l]) jac[3 * r + std::size_t(e)] = dm * d_f0[l][e];
-          if (double* jac = jacobians[4 + 3 * l]) jac[3 * r + std::size_t(e)] = dm * d_second[l][e];
+          const LobeAlbedo& a = lobe[l][e];
+          if (double* jac = jacobians[2 + 3 * l]) jac[2 * r] = dm * a.d_log_alpha, jac[2 * r + 1] = dm * a.d_shape;
+          if (double* jac = jacobians[3 + 3 * l]) jac[3 * r + e] = dm * a.d_f0;
+          if (double* jac = jacobians[4 + 3 * l]) jac[3 * r + e] = dm * a.d_second;
         }
       }
     }
     return true;
   }
 
-  // Calls visit(o.h, G2(o, i) / G1(o) / N) for the grid's N visible normals of GGX `alpha` seen from o
-  // (G2 height-correlated; 0 where i falls below the horizon): 16 radii, where the horizon cuts the
-  // lobe, by 8 azimuths.
-  static constexpr int kRadii = 16, kAzimuths = 8;
-  template <class Visit>
-  static void for_each_visible_normal(const Vec3& o, double alpha, const Visit& visit) {
-    static const std::array<std::array<double, 2>, kAzimuths> azimuths = [] {
-      std::array<std::array<double, 2>, kAzimuths> a{};
-      for (int b = 0; b < kAzimuths; ++b) a[std::size_t(b)] = {std::cos(2.0 * kPi * (b + 0.5) / kAzimuths), std::sin(2.0 * kPi * (b + 0.5) / kAzimuths)};
-      return a;
-    }();
-    const Ndf ndf = Ndf::isotropic(NdfType::ggx, alpha);
-    const double lambda_o = ndf.lambda(o), g1_o = 1.0 / (1.0 + lambda_o), n = double(kRadii * kAzimuths);
-    for (int a = 0; a < kRadii; ++a) {
-      const double r = std::sqrt((a + 0.5) / kRadii);
-      for (const auto& [cos_phi, sin_phi] : azimuths) {
-        const auto i = ggx_visible_direction_of_disk(o, alpha, r, cos_phi, sin_phi);
-        if (!i) continue;
-        const Vec3 h = glm::normalize(*i + o);
-        visit(clamp(glm::dot(o, h), 0.0, 1.0), smith_g2(Smith::correlated, lambda_o, ndf.lambda(*i)) / g1_o / n);
-      }
-    }
-  }
-
  private:
   const AlbedoTarget& target_;
+  std::shared_ptr<const VisibleMoments> moments_;
   std::vector<Unknowns::Lobe> forms_;
   bool with_coat_;
 };
@@ -345,13 +325,12 @@ Closures with_lobe(const Closures& fit, ClosureLobe::Fresnel form, double scale)
 }  // namespace
 
 Rgb closure_albedo(const Closures& closures, double cos_o) {
-  const Vec3 o(std::sqrt(std::max(0.0, 1.0 - cos_o * cos_o)), 0.0, cos_o);
   Rgb rho = closures.body;
   for (const ClosureLobe& l : closures.lobes)
-    AlbedoCost::for_each_visible_normal(o, l.alpha_x, [&](double mu, double ratio) { rho += l.weight * l.fresnel_at(mu) * ratio; });
+    VisibleMoments::for_each_visible_normal(cos_o, l.alpha_x, [&](double mu, double ratio) { rho += l.weight * l.fresnel_at(mu) * ratio; });
   const Coat& coat = closures.coat;
   if (coat.present())
-    AlbedoCost::for_each_visible_normal(o, coat.alpha, [&](double mu, double ratio) { rho += fresnel_schlick(Rgb(coat.f0), mu) * ratio; });
+    VisibleMoments::for_each_visible_normal(cos_o, coat.alpha, [&](double mu, double ratio) { rho += fresnel_schlick(Rgb(coat.f0), mu) * ratio; });
   return rho;
 }
 
@@ -359,13 +338,15 @@ double closure_error(const MeasuredBins& bins, const Closures& closures) { retur
 
 AlbedoTarget albedo_target(const Brdf& model, const Proposal& proposal, double share) {
   constexpr int kViews = 16, kGrid = 128;
-  std::mt19937_64 rng(1);  // jitter within the strata: a grid's midpoints through the mixture's choice of part alias
-  std::uniform_real_distribution<double> jitter(0.0, 1.0);
   AlbedoTarget t;
-  for (int j = 0; j < kViews; ++j) {
-    // Nodes uniform in r = sin theta_o, a sphere's image radius: each stands for an annulus of its pixels.
-    const double r = (j + 0.5) / kViews, c = std::sqrt(1.0 - r * r);
-    const Vec3 o(r, 0.0, c);
+  t.albedo.resize(kViews);
+  // Views concurrently, each with its own numbers: jitter within the strata (a grid's midpoints, through the
+  // mixture's choice of part, alias).
+  tbb::parallel_for(0, kViews, [&](int j) {
+    std::mt19937_64 rng(std::uint64_t(j) + 1);
+    std::uniform_real_distribution<double> jitter(0.0, 1.0);
+    const double r = (j + 0.5) / kViews;
+    const Vec3 o(r, 0.0, std::sqrt(1.0 - r * r));
     Rgb sum(0.0);
     for (int a = 0; a < kGrid; ++a)
       for (int b = 0; b < kGrid; ++b) {
@@ -374,10 +355,14 @@ AlbedoTarget albedo_target(const Brdf& model, const Proposal& proposal, double s
         const auto f = i && pdf > 0.0 ? model.eval(o, *i) : std::nullopt;
         if (f) sum += *f * (i->z / pdf);
       }
-    const Rgb albedo = sum / double(kGrid * kGrid);
-    t.cos_o.push_back(c);
+    t.albedo[std::size_t(j)] = sum / double(kGrid * kGrid);
+  });
+  for (int j = 0; j < kViews; ++j) {
+    // Nodes uniform in r = sin theta_o, a sphere's image radius: each stands for an annulus of its pixels.
+    const double r = (j + 0.5) / kViews;
+    const Rgb& albedo = t.albedo[std::size_t(j)];
+    t.cos_o.push_back(std::sqrt(1.0 - r * r));
     t.weight.push_back(share * 2.0 * r / kViews);
-    t.albedo.push_back(albedo);
     t.lightness.push_back(Rgb(metric_transform(albedo.r * kInvPi), metric_transform(albedo.g * kInvPi), metric_transform(albedo.b * kInvPi)));
   }
   return t;
@@ -430,10 +415,11 @@ Closures closures_of(const AnisotropicParametricFit& fit) {
   return c;
 }
 
-double closure_jacobian_error(const MeasuredBins& bins, const Closures& at) {
+double closure_jacobian_error(const MeasuredBins& bins, const Closures& at, const AlbedoTarget* albedo) {
   Unknowns u(at);
   double worst = 0.0;
   for (const MeasuredBins::Row& row : bins.rows) worst = std::max(worst, jacobian_error(ClosureRowCost(bins, row, u.lobes, u.with_coat), u.blocks()));
+  if (albedo) worst = std::max(worst, jacobian_error(AlbedoCost(*albedo, u.lobes, u.with_coat), u.blocks()));
   return worst;
 }
 

@@ -78,9 +78,20 @@ inline double f82_basis(double mu) {
   return mu * m3 * m3;
 }
 
-// One channel's Fresnel in the fits' forms and its derivatives in f0 and f82: F82-tint,
-//   F = Schlick(f0, mu) - (Schlick(f0, 1/7) - f82) mu (1 - mu)^6 / b82,
-// or, without `tint`, Schlick alone (f82 unused).
+// F82-tint as Schlick less a multiple of mu (1 - mu)^6,
+//   F = Schlick(f0, mu) - a mu (1 - mu)^6 / b82,  a = Schlick(f0, 1/7) - f82,  b82 = mu (1 - mu)^6 at 1/7,
+// so that F(1/7) = f82: a / b82 and its derivatives in f0 and f82.
+struct F82Shift {
+  double value = 0.0, d_f0 = 0.0, d_f82 = 0.0;
+};
+inline F82Shift f82_shift(double f0, double f82) {
+  constexpr double kMu82 = 1.0 / 7.0;
+  const double b82 = f82_basis(kMu82), schlick82 = 1.0 - schlick_slope(kMu82);
+  return {(f0 * (1.0 - schlick82) + schlick82 - f82) / b82, (1.0 - schlick82) / b82, -1.0 / b82};
+}
+
+// One channel's Fresnel in the fits' forms and its derivatives in f0 and f82: F82-tint (above) or, without
+// `tint`, Schlick alone (f82 unused).
 struct FresnelTerms {
   double value = 0.0, d_f0 = 0.0, d_f82 = 0.0;
 };
@@ -88,12 +99,11 @@ inline FresnelTerms fresnel_terms(double f0, double f82, double mu, bool tint) {
   const double s_mu = schlick_slope(mu);
   FresnelTerms f{f0 * s_mu + (1.0 - s_mu), s_mu, 0.0};
   if (!tint) return f;
-  constexpr double kMu82 = 1.0 / 7.0;
-  const double b82 = f82_basis(kMu82), schlick82 = 1.0 - schlick_slope(kMu82), basis = f82_basis(mu);
-  const double shift = (f0 * (1.0 - schlick82) + schlick82 - f82) / b82;
-  f.value -= shift * basis;
-  f.d_f0 -= (1.0 - schlick82) / b82 * basis;
-  f.d_f82 = basis / b82;
+  const F82Shift a = f82_shift(f0, f82);
+  const double basis = f82_basis(mu);
+  f.value -= a.value * basis;
+  f.d_f0 -= a.d_f0 * basis;
+  f.d_f82 = -a.d_f82 * basis;
   return f;
 }
 
