@@ -129,13 +129,15 @@ TEST(TabulatedAnisotropic, SamplesItsOwnDensity) {
 }
 
 // The artist's stretch on the anisotropic lobe (model/stretch.h): GGX 0.4 x 0.15 with its x axis at 30
-// degrees, its slopes scaled by 0.5 along that axis and 2 across it, is the analytic GGX 0.2 x 0.3 there,
-// in eval, in sampling (chi-square against its own pdf, which the first part ties to the analytic model)
-// and in albedo.
+// degrees (the tables' axis), its slopes scaled by 0.5 along that axis and 2 across it, is the analytic GGX
+// 0.2 x 0.3 there, in eval, in sampling (chi-square against its own pdf, which the first part ties to the
+// analytic model) and in albedo; a rotation turns it, alone or with the scales.
 TEST(TabulatedAnisotropic, StretchedIsTheStretchedAnalyticModel) {
-  const double angle = 30.0 * kPi / 180.0;
-  const TabulatedAnisotropic measured(analytic_tables(Ndf{NdfType::ggx, 0.4, 0.15}, angle, Smith::correlated, 90, 64));
-  const TabulatedAnisotropic lobe = measured.stretched(Stretch(0.5, 2.0, angle));
+  const double angle = 30.0 * kPi / 180.0, turn = 20.0 * kPi / 180.0;
+  AnisotropicTables tables = analytic_tables(Ndf{NdfType::ggx, 0.4, 0.15}, angle, Smith::correlated, 90, 64);
+  tables.axis = angle;
+  const TabulatedAnisotropic measured(tables);
+  const TabulatedAnisotropic lobe = measured.stretched(Stretch(0.5, 2.0));
   const MicrofacetBrdf model(Ndf{NdfType::ggx, 0.2, 0.3}, Smith::correlated, Fresnel::one());
   const RotatedBrdf truth(model, angle);
   const auto [median, p95] = eval_errors(lobe, truth);
@@ -144,6 +146,13 @@ TEST(TabulatedAnisotropic, StretchedIsTheStretchedAnalyticModel) {
   EXPECT_LT(p95, 5e-3);
   // The unstretched lobe is far from it: the comparison sees the stretch.
   EXPECT_GT(eval_errors(measured, truth).first, 0.1);
+  // Turned by 20 degrees: the lobe's axes at 50, with and without the scales; the unturned lobe is far.
+  const MicrofacetBrdf unscaled_model(Ndf{NdfType::ggx, 0.4, 0.15}, Smith::correlated, Fresnel::one());
+  const RotatedBrdf turned(unscaled_model, angle + turn), turned_scaled(model, angle + turn);
+  EXPECT_LT(eval_errors(measured.stretched(Stretch(1.0, 1.0, turn)), turned).first, 1e-3);
+  EXPECT_LT(eval_errors(measured.stretched(Stretch(0.5, 2.0, turn)), turned_scaled).first, 1e-3);
+  EXPECT_GT(eval_errors(measured, turned).first, 0.1);
+  expect_samples_own_density(measured.stretched(Stretch(1.0, 1.0, turn)), {{30, 0}, {55, 95}}, 14);
 
   const std::vector<std::pair<double, double>> views = {{30, 0}, {30, 135}, {70, 260}, {55, 95}};
   expect_samples_own_density(lobe, views, 13);

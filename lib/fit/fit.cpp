@@ -223,6 +223,7 @@ FitResult Fitter::fit(const MerlTable& table) const {
       a.residual = e.residual;
       a.tables = AnisotropicTables{quadrature.grid(), quadrature.phi_count(), e.ndf, e.sigma, options_.smith, paper_fresnel};
       fit_anisotropic_lobes(table, paper_fresnel, result, a);
+      a.tables.axis = a.ggx.alpha.angle;
       result.closures = {closures_of(a.ggx), a.ggx.error};
       result.anisotropic = a;
       // Anisotropic beyond what the 15-degree grid resolves (a 10% ratio): say what an isotropic LUT loses.

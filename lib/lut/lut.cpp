@@ -507,6 +507,7 @@ Lut read_lut(const std::string& path) {
           fail(path, "anisotropic row " + std::to_string(layout.anisotropic_row + 1 + p) + ", column " + std::to_string(x) +
                          ": D must be >= 0 and sigma > 0");
       }
+    a.axis = m.anisotropic_ggx.alpha.angle;
     lut.anisotropic = std::move(a);
   }
   return lut;

@@ -28,8 +28,9 @@ class Stretch {
   double x, y;
   double rotation() const { return rotation_; }
 
-  // An isotropic lobe does not change under rotation alone.
-  bool identity() const { return x == 1.0 && y == 1.0; }
+  // Scales nothing: an isotropic lobe does not change under a rotation alone, an anisotropic one turns.
+  bool unscaled() const { return x == 1.0 && y == 1.0; }
+  bool identity() const { return unscaled() && rotation_ == 0.0; }
 
   // Into and out of the frame whose x axis is the stretch's.
   Vec3 to_frame(const Vec3& v) const { return axes_.to_frame(v); }

@@ -87,7 +87,7 @@ TabulatedMicrofacet TabulatedMicrofacet::stretched(const Stretch& stretch) const
 
 double TabulatedMicrofacet::D(const Vec3& h) const {
   if (h.z <= 0.0) return 0.0;
-  if (stretch_.identity()) return shared_->tables.ndf.D(std::acos(std::min(h.z, 1.0)));
+  if (stretch_.unscaled()) return shared_->tables.ndf.D(std::acos(std::min(h.z, 1.0)));
   // D_s(h) = P(slopes / s) / (s_x s_y cos^4) with P = D cos^4 of the measured normal.
   const Vec3 m = stretch_.measured_normal(stretch_.to_frame(h));
   const double r = m.z / h.z;
@@ -95,7 +95,7 @@ double TabulatedMicrofacet::D(const Vec3& h) const {
 }
 
 double TabulatedMicrofacet::g1(const Vec3& w) const {
-  if (stretch_.identity() || w.z <= 0.0) return (*shared_->g1)(w.z);
+  if (stretch_.unscaled() || w.z <= 0.0) return (*shared_->g1)(w.z);
   return (*shared_->g1)(stretch_.direction(stretch_.to_frame(w)).z);  // Lambda_s(w) = Lambda(w')
 }
 
@@ -128,7 +128,7 @@ GridPosition locate(const ThetaGrid& grid, double cos_theta) {
 }  // namespace
 
 double TabulatedMicrofacet::visible_normal_pdf(const Vec3& o, const Vec3& h) const {
-  if (stretch_.identity()) return measured_visible_normal_pdf(o, h);
+  if (stretch_.unscaled()) return measured_visible_normal_pdf(o, h);
   if (o.z <= 0.0 || h.z <= 0.0 || glm::dot(o, h) <= 0.0) return 0.0;
   // The measured lobe's density at the measured normal, seen from the stretched view, times the Jacobian
   // of the normals (model/stretch.h): exactly the stretched lobe's visible normals.
@@ -181,7 +181,7 @@ std::optional<Vec3> TabulatedMicrofacet::sample_direction(const Vec3& o, double 
 
 std::optional<Vec3> TabulatedMicrofacet::lobe_direction(const Vec3& o, double u1, double u2) const {
   Vec3 h;
-  if (stretch_.identity()) {
+  if (stretch_.unscaled()) {
     h = measured_visible_normal(o, u1, u2);
   } else {  // the measured lobe's visible normals seen from the stretched view, stretched back
     const Vec3 m = measured_visible_normal(stretch_.direction(stretch_.to_frame(o)), u1, u2);

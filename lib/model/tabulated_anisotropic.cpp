@@ -20,7 +20,8 @@ double elevation(const Vec3& w) { return std::acos(clamp(w.z, -1.0, 1.0)); }
 
 }  // namespace
 
-TabulatedAnisotropic::TabulatedAnisotropic(AnisotropicTables tables, Stretch stretch) : stretch_(stretch) {
+TabulatedAnisotropic::TabulatedAnisotropic(AnisotropicTables tables, Stretch stretch)
+    : stretch_(stretch), scale_(stretch.x, stretch.y, tables.axis + stretch.rotation()), axis_(tables.axis) {
   auto shared = std::make_shared<Shared>();
   shared->tables = std::move(tables);
   shared_ = shared;  // lookup() reads the tables through it while the views are built below
@@ -59,6 +60,7 @@ TabulatedAnisotropic::TabulatedAnisotropic(AnisotropicTables tables, Stretch str
 TabulatedAnisotropic TabulatedAnisotropic::stretched(const Stretch& stretch) const {
   TabulatedAnisotropic copy = *this;
   copy.stretch_ = stretch;
+  copy.scale_ = Stretch(stretch.x, stretch.y, shared_->tables.axis + stretch.rotation());
   return copy;
 }
 
@@ -96,9 +98,9 @@ double TabulatedAnisotropic::measured_lambda(const Vec3& w) const {
 double TabulatedAnisotropic::D(const Vec3& h) const {
   if (stretch_.identity() || h.z <= 0.0) return measured_D(h);
   // D_s(h) = P(slopes / s) / (s_x s_y cos^4) with P = D cos^4 of the measured normal (model/stretch.h).
-  const Vec3 m = stretch_.measured_normal(stretch_.to_frame(h));
+  const Vec3 m = measured_normal(h);
   const double r = m.z / h.z;
-  return measured_D(stretch_.from_frame(m)) * r * r * r * r / (stretch_.x * stretch_.y);
+  return measured_D(m) * r * r * r * r / (stretch_.x * stretch_.y);
 }
 
 double TabulatedAnisotropic::lambda(const Vec3& w) const {
@@ -151,8 +153,8 @@ double TabulatedAnisotropic::visible_normal_pdf(const Vec3& o, const Vec3& h) co
   if (o.z <= 0.0 || h.z <= 0.0 || glm::dot(o, h) <= 0.0) return 0.0;
   // The measured lobe's density at the measured normal, seen from the stretched view, times the Jacobian
   // of the normals (model/stretch.h).
-  const Vec3 m = stretch_.measured_normal(stretch_.to_frame(h));
-  return measured_visible_normal_pdf(measured_direction(o), stretch_.from_frame(m)) * stretch_.normal_jacobian(h.z, m.z);
+  const Vec3 m = measured_normal(h);
+  return measured_visible_normal_pdf(measured_direction(o), m) * stretch_.normal_jacobian(h.z, m.z);
 }
 
 double TabulatedAnisotropic::pdf(const Vec3& o, const Vec3& i) const {
@@ -193,7 +195,7 @@ std::optional<Vec3> TabulatedAnisotropic::sample_direction(const Vec3& o, double
     h = measured_visible_normal(o, u1, u2);
   } else {  // the measured lobe's visible normals seen from the stretched view, stretched back
     const Vec3 m = measured_visible_normal(measured_direction(o), u1, u2);
-    h = stretch_.from_frame(stretch_.stretched_normal(stretch_.to_frame(m)));
+    h = stretched_normal(m);
   }
   const Vec3 i = reflect_about(o, h);
   if (i.z <= 0.0) return std::nullopt;

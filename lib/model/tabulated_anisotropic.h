@@ -14,8 +14,9 @@
 // from the mixture of its four bracketing nodes, bilinear weights, and pdf() is that mixture's density,
 // so sampling and pdf agree exactly while the mixture only approximates the view's own distribution.
 //
-// A stretch (model/stretch.h) reshapes the lobe as it does the isotropic one: the measured lobe is read
-// at transformed directions and normals, in the tangent frame its tables are in.
+// A stretch (model/stretch.h) scales the lobe's slopes along its own axes (the tables' `axis`) and turns
+// it by the stretch's rotation, as Closures::stretched does a closure lobe (model/closures.h) and the
+// material shader its lobes (osl/facetfit_material.osl): a rotation alone turns the lobe.
 #pragma once
 
 #include <memory>
@@ -39,6 +40,7 @@ struct AnisotropicTables {
   std::vector<double> sigma;  // sigma at the direction (theta_j, phi_m)
   Smith smith = Smith::correlated;
   FresnelCurve fresnel;
+  double axis = 0.0;  // the lobe's x axis, radians from the tangent (its anisotropic GGX fit's): a stretch scales along it
 };
 
 class TabulatedAnisotropic final : public Brdf, public Proposal {
@@ -80,6 +82,8 @@ class TabulatedAnisotropic final : public Brdf, public Proposal {
   };
   std::shared_ptr<const Shared> shared_;
   Stretch stretch_;
+  Stretch scale_;     // the stretch's scales along the lobe's axes turned by its rotation
+  TurnedFrame axis_;  // the measured lobe's axes
 
   // The measured (unstretched) lobe, in the tangent frame.
   double lookup(const std::vector<double>& table, const Vec3& w) const;  // spline in u and, periodic, phi
@@ -87,8 +91,11 @@ class TabulatedAnisotropic final : public Brdf, public Proposal {
   double measured_lambda(const Vec3& w) const;
   double measured_visible_normal_pdf(const Vec3& o, const Vec3& h) const;
   Vec3 measured_visible_normal(const Vec3& o, double u1, double u2) const;
-  // A direction of the stretched lobe as the measured lobe sees it, tangent frame to tangent frame.
-  Vec3 measured_direction(const Vec3& w) const { return stretch_.from_frame(stretch_.direction(stretch_.to_frame(w))); }
+  // A direction or normal of the stretched lobe as the measured lobe sees it, tangent frame to tangent
+  // frame: into the turned lobe's axes (the frame of `scale_`), scaled back, out of the measured lobe's.
+  Vec3 measured_direction(const Vec3& w) const { return axis_.from_frame(scale_.direction(scale_.to_frame(w))); }
+  Vec3 measured_normal(const Vec3& h) const { return axis_.from_frame(scale_.measured_normal(scale_.to_frame(h))); }
+  Vec3 stretched_normal(const Vec3& m) const { return scale_.from_frame(scale_.stretched_normal(axis_.to_frame(m))); }
   // The (up to four) view nodes bracketing o and their weights.
   struct ViewBlend {
     int view[4];

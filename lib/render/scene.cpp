@@ -445,7 +445,7 @@ std::shared_ptr<const ShadingModel> load_material(const SceneDesc& scene, const 
       const auto lobe = std::make_shared<TabulatedAnisotropic>(std::move(*lut.anisotropic), m.stretch);
       return std::make_shared<ShadingModel>(lobe, lobe);
     }
-    if (!m.stretch.identity()) {  // a stretch reshapes the lobe, not the slopes' tables: its own visible normals
+    if (!m.stretch.unscaled()) {  // a stretch reshapes the lobe, not the slopes' tables: its own visible normals
       const auto model = std::make_shared<TabulatedMicrofacet>(sampled_lut_model(std::move(lut))->stretched(m.stretch));
       return std::make_shared<ShadingModel>(model, model);
     }
@@ -463,7 +463,7 @@ std::shared_ptr<const ShadingModel> load_material(const SceneDesc& scene, const 
     Lut lut = read_lut(resolve(scene, m.file));
     const Closures closures = lut.closures().stretched(m.stretch.x, m.stretch.y, m.stretch.rotation());
     const auto brdf = std::make_shared<ClosureBrdf>(closures);
-    if (!m.stretch.identity()) return std::make_shared<ShadingModel>(brdf, std::make_shared<ClosureProposal>(closures));
+    if (!m.stretch.unscaled()) return std::make_shared<ShadingModel>(brdf, std::make_shared<ClosureProposal>(closures));
     return std::make_shared<ShadingModel>(brdf, VisibleSlopeProposal::of(*sampled_lut_model(std::move(lut))));
   }
   // ggx | beckmann | lsq (the LUT's classical baseline: Lambert + GGX + Schlick); nothing else renders as them

@@ -50,7 +50,8 @@ struct MaterialDesc {
   Smith smith = Smith::correlated;
   Rgb albedo{0.8};
   // lut: the artist's stretch of the tabulated lobe (model/stretch.h): "stretch": [x, y] (roughness
-  // grows with it), "rotation" of its x axis in degrees from the tangent; "tangent": a world direction
+  // grows with it), "rotation" of its x axis in degrees from the tangent (an anisotropic lobe: scaled along
+  // its own axes and turned by the rotation, model/tabulated_anisotropic.h); "tangent": a world direction
   // whose projection on the surface is the tangent (else any tangent: fine for an isotropic lobe).
   Stretch stretch;
   std::optional<Vec3> tangent;

@@ -287,7 +287,7 @@ TabulatedBatchModel TabulatedBatchModel::of(const VisibleSlopeProposal& proposal
   m.scale = slopes.scale();
   m.coat = parts.coat;
   m.weights = {lobe_weight, parts.lobe, parts.body, parts.coat.present() ? parts.coat_weight() : 0.0};
-  const MicrofacetTables* tables = lobe && lobe->stretch().identity() ? &lobe->tables() : nullptr;
+  const MicrofacetTables* tables = lobe && lobe->stretch().unscaled() ? &lobe->tables() : nullptr;
   if (tables && (tables->fresnel.value.size() != std::size_t(FresnelCurve::kSize) || tables->coat.alpha != parts.coat.alpha ||
                  tables->coat.f0 != parts.coat.f0))
     tables = nullptr;
