@@ -29,6 +29,7 @@ NOTES = {
     "BM_VisibleSlopes": "the renderer's visible-slope tables of one material (once per render)",
     "BM_WriteLut": "write one LUT EXR (float32, zip)",
     "BM_BakeBatch": "8 materials baked at once, as `bake --jobs` (the paper's method: the pipeline's overhead)",
+    "BM_ParseScene": "parse and check a 3.9 MB scene of 100k Lambert materials (issue 47's bar: 2 MB under 1 s)",
 }
 
 

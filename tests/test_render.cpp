@@ -942,6 +942,24 @@ TEST(Shading, MerlTableInSimdLanesEqualsOnePairAtATime) {
   EXPECT_GT(zero, 1000);  // below the horizon, or a channel without a measured neighbour
 }
 
+// A scene of 100k materials (2.7 MB) is read whole: the depth-limiting callback parser took minutes on it
+// (issue 47; BM_ParseScene times it). Brackets inside names are not nesting, and a string's escaped quote
+// does not end it.
+TEST(Render, LargeScenesParseWhole) {
+  constexpr int kMaterials = 100000;
+  std::string text = R"({"materials": {)";
+  for (int k = 0; k < kMaterials; ++k) text += "\"m" + std::to_string(k) + "\": {\"type\": \"lambert\"}, ";
+  text += std::string(R"("[[[[\"{{{{": {"type": "lambert"}}, "objects": [{"type": "sphere", "material": "[[[[\"{{{{"}]})");
+  const SceneDesc s = parse_scene_text(text, "large.json", ".");
+  EXPECT_EQ(s.materials.size(), std::size_t(kMaterials) + 1);
+  EXPECT_EQ(s.materials.count("[[[[\"{{{{"), 1u);
+  // 33 levels is refused, 32 is not a nesting error.
+  const auto nested = [](int levels) { return std::string(std::size_t(levels), '[') + std::string(std::size_t(levels), ']'); };
+  EXPECT_NE(test::error_of([&] { parse_scene_text(nested(33), "deep.json", "."); }).find("deep.json: nested more than 32 levels deep"),
+            std::string::npos);
+  EXPECT_NE(test::error_of([&] { parse_scene_text(nested(32), "deep.json", "."); }).find("deep.json: not a JSON object"), std::string::npos);
+}
+
 TEST(Render, BadScenesGetOneClearLine) {
   test::TempDir dir;
   test::write_bytes(dir.file("a.json"), R"({"objects": [{"type": "sphere", "material": "nope"}]})");

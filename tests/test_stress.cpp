@@ -4,11 +4,13 @@
 
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <random>
 
 #include "fit/fit.h"
 #include "io/input.h"
 #include "io/utia.h"
+#include "lut/lut.h"
 #include "model/analytic.h"
 #include "model/parametric.h"
 #include "model/proposal.h"
@@ -18,6 +20,7 @@
 #include "render/ggx_batch.h"
 #include "render/merl_batch.h"
 #include "render/shading.h"
+#include "render/scene.h"
 #include "render/tabulated_batch.h"
 #include "test_util.h"
 
@@ -269,6 +272,37 @@ TEST(TabulatedLanes, EveryBatchLengthAndDegenerateDirectionStayFiniteAndInBounds
               }
           }
     }
+}
+
+// Directions no caller should pass (NaN, infinite, 1e300, zero) give a defined result from every material
+// of a scene, never a table indexed by NaN (issue 47: the Python module crashed on them; under ASan here).
+TEST(Stress, NonFiniteAndHugeDirectionsGiveZero) {
+  test::TempDir dir;
+  const Fitter fitter{FitOptions::paper()};
+  write_lut(dir.file("gold.exr"),
+            make_lut(fitter.fit(load_table("builtin:gold-ggx-0.15")), fitter.quadrature(), "builtin:gold-ggx-0.15", "x", 0.02, true));
+  const SceneDesc scene = parse_scene_text(R"({"materials": {
+      "merl": {"type": "measured", "file": "builtin:gold-ggx-0.15", "proposal": "gold.exr"},
+      "lut": {"type": "lut", "file": "gold.exr"}, "stretched": {"type": "lut", "file": "gold.exr", "stretch": [2, 0.5], "rotation": 30},
+      "closures": {"type": "closures", "file": "gold.exr"}, "ggx": {"type": "ggx", "file": "gold.exr"},
+      "analytic": {"type": "analytic", "file": "builtin:gold-ggx-0.15"}},
+    "objects": [{"type": "sphere", "material": "lut"}]})", dir.file("scene.json"), dir.path().string());
+  const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
+  const Vec3 good = glm::normalize(Vec3(0.3, 0.2, 0.9));
+  const Vec3 bad[] = {Vec3(nan), Vec3(nan, 0.0, 1.0), Vec3(0.0, 0.0, inf), Vec3(0.0, inf, 1.0), Vec3(1e300, 0.0, 1e300), Vec3(0.0)};
+  for (const auto& [name, desc] : scene.materials) {
+    const auto model = load_material(scene, desc);
+    for (const Vec3& b : bad) {
+      for (const auto& [o, i] : {std::pair{good, b}, std::pair{b, good}, std::pair{b, b}}) {
+        const Rgb f = model->f(o, i);
+        EXPECT_TRUE(finite(f) && f.r == 0.0 && f.g == 0.0 && f.b == 0.0) << name << ": f " << f.r;
+        const double pdf = model->pdf(o, i);
+        EXPECT_TRUE(finite(pdf) && pdf >= 0.0) << name << ": pdf " << pdf;
+      }
+      const auto s = model->sample(b, 0.3, 0.6, 0.5);
+      EXPECT_TRUE(!s || (finite(s->weight) && finite(s->pdf))) << name;
+    }
+  }
 }
 
 TEST(MerlLanes, EveryBatchLengthAndDegenerateDirectionStayFiniteAndInBounds) {

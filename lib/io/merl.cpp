@@ -240,8 +240,10 @@ void MerlTable::write(const std::string& path) const {
 }
 
 std::optional<Rgb> MerlTable::eval(const Vec3& o, const Vec3& i) const {
-  if (i.z <= 0.0 || o.z <= 0.0) return Rgb(0.0);
+  // No cosine divides here: a pair whose product of cosines underflows is still looked up (as the lanes do).
+  if (!(i.z > 0.0 && o.z > 0.0) || !finite_direction(o) || !finite_direction(i)) return Rgb(0.0);
   const BinCoords x = bin_coords(o, i);
+  if (!(std::isfinite(x.h) && std::isfinite(x.d) && std::isfinite(x.p))) return Rgb(0.0);  // a zero vector
   return lookup_ == Lookup::nearest ? eval_nearest(x.h, x.d, x.p) : eval_linear(x.h, x.d, x.p);
 }
 

@@ -48,7 +48,7 @@ class G1Table {
   }
   double operator()(double cos_theta) const {
     if (!(cos_theta > 0.0)) return 0.0;
-    const double x = std::sqrt(cos_theta) * scale_;
+    const double x = std::sqrt(std::min(cos_theta, 1.0)) * scale_;
     const int m = int(x);
     if (m >= int(scale_)) return std::min(1.0, cos_theta * ratio_.back());
     const double t = x - m;

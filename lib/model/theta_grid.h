@@ -52,9 +52,10 @@ struct ThetaGrid {
     return s;
   }
 
-  // Interval and fraction of theta (clamped to [0, pi/2]).
+  // Interval and fraction of theta (clamped to [0, pi/2]; NaN reads as 0, never as an index).
   void locate(double theta, int* j, double* t) const {
-    const double x = std::min(u_of_theta(theta), 1.0) * resolution;
+    const double u = u_of_theta(theta);
+    const double x = (u > 0.0 ? std::min(u, 1.0) : 0.0) * resolution;
     *j = std::min(int(x), resolution - 1);
     *t = x - *j;
   }

@@ -93,7 +93,7 @@ VisibleSlopes::VisibleSlopes(const TabulatedNdf& ndf) {
 }
 
 Vec3 VisibleSlopes::sample(const Vec3& o, double u1, double u2) const {
-  if (!(o.z > 0.0)) return {0.0, 0.0, 1.0};  // no view slice (callers draw for o above the horizon)
+  if (!(o.z > 0.0) || !finite_direction(o)) return {0.0, 0.0, 1.0};  // no view slice (callers draw for o above the horizon)
   // One of the two view slices around o with the weights of the mixture, reusing u1.
   const ViewSlice view = view_slice(o, scale_);
   const int s = view.s + pick_of_two(view.t, &u1);
@@ -113,7 +113,7 @@ Vec3 VisibleSlopes::sample(const Vec3& o, double u1, double u2) const {
 }
 
 double VisibleSlopes::pdf(const Vec3& o, const Vec3& h) const {
-  if (o.z <= 0.0 || h.z <= 0.0 || glm::dot(o, h) <= 0.0) return 0.0;
+  if (!above_horizon(o, h) || glm::dot(o, h) <= 0.0) return 0.0;
   // h in o's azimuth frame; with A = c cos(theta_h) + |h_x| (and B for y), v = x~ / (c + |x~|) = -h_x / A,
   // w = |h_y| / B, and dv/dx~ dw/dy~ / cos^3(theta_h) = c^2 cos(theta_h) / (A B)^2: no slope, so no
   // overflow, at a grazing h.
@@ -130,7 +130,7 @@ double VisibleSlopes::pdf(const Vec3& o, const Vec3& h) const {
 }
 
 std::optional<Vec3> VisibleSlopeProposal::sample_direction(const Vec3& o, double u1, double u2) const {
-  if (o.z <= 0.0) return std::nullopt;
+  if (!(o.z > 0.0) || !finite_direction(o)) return std::nullopt;
   return parts_.sample(o, u1, u2, [&](double a, double b) -> std::optional<Vec3> {
     const Vec3 h = slopes_.sample(o, a, b);
     const Vec3 i = reflect_about(o, h);

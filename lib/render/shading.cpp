@@ -55,7 +55,7 @@ double ShadingModel::mixture(const Vec3& i, double proposal_pdf) const {
 }
 
 double ShadingModel::pdf(const Vec3& o, const Vec3& i) const {
-  if (i.z <= 0.0 || o.z <= 0.0) return 0.0;
+  if (!above_horizon(o, i)) return 0.0;
   return mixture(i, lobe_weight_ > 0.0 ? proposal_->pdf(o, i) : 0.0);
 }
 
@@ -106,7 +106,7 @@ std::optional<ShadingModel::Sample> ShadingModel::sample(const Vec3& o, double u
 }
 
 std::optional<Vec3> ShadingModel::sample_direction(const Vec3& o, double u1, double u2, double u3) const {
-  if (o.z <= 0.0) return std::nullopt;
+  if (!(o.z > 0.0) || !finite_direction(o)) return std::nullopt;
   if (u3 < lobe_weight_) return proposal_->sample_direction(o, u1, u2);
   // cosine-weighted hemisphere (concentric disc)
   const double a = 2.0 * u1 - 1.0, b = 2.0 * u2 - 1.0;

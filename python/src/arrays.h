@@ -7,6 +7,7 @@
 
 #include <tbb/parallel_for.h>
 
+#include <cmath>
 #include <cstddef>
 #include <stdexcept>
 #include <string>
@@ -19,17 +20,28 @@ namespace facetfit::python {
 namespace py = pybind11;
 using Array = py::array_t<double, py::array::c_style | py::array::forcecast>;
 
-// A stack of 3-vectors: shape (..., 3). `name` is the argument's, for the one-line error.
+// A stack of 3-vectors: shape (..., 3), each checked before any model sees it: a direction is finite and of
+// unit length (within 1e-3: NaN, 1e300 and denormal vectors indexed tables out of range), a triple of
+// uniform numbers (sample's u) is in [0, 1]. `name` is the argument's, for the one-line error.
 struct Vectors {
+  enum class Kind { direction, uniform };
   Array array;
   std::vector<py::ssize_t> shape;  // without the last axis
   std::size_t count = 0;
 
-  Vectors(py::handle h, const char* name) : array(Array::ensure(h)) {
+  Vectors(py::handle h, const char* name, Kind kind = Kind::direction) : array(Array::ensure(h)) {
     if (!array || array.ndim() < 1 || array.shape(array.ndim() - 1) != 3)
       throw py::value_error(std::string(name) + ": must be an array of 3-vectors, shape (..., 3)");
     shape.assign(array.shape(), array.shape() + array.ndim() - 1);
     count = std::size_t(array.size() / 3);
+    for (std::size_t k = 0; k < count; ++k) {
+      const Vec3 v = at(k);
+      const bool ok = kind == Kind::direction ? std::abs(glm::dot(v, v) - 1.0) <= 2e-3
+                                              : v.x >= 0.0 && v.x <= 1.0 && v.y >= 0.0 && v.y <= 1.0 && v.z >= 0.0 && v.z <= 1.0;
+      if (!ok)
+        throw py::value_error(std::string(name) + "[" + std::to_string(k) + "]: " +
+                              (kind == Kind::direction ? "must be a finite unit vector" : "must be three numbers in [0, 1]"));
+    }
   }
   Vec3 at(std::size_t k) const {
     const double* p = array.data() + 3 * k;

@@ -112,7 +112,7 @@ py::array_t<double> eval_rgb(const py::handle& o, const py::handle& i, const std
 }
 
 py::dict sample(const Model& m, const py::handle& o, const py::handle& u) {
-  const Vectors vo(o, "o"), vu(u, "u");
+  const Vectors vo(o, "o"), vu(u, "u", Vectors::Kind::uniform);
   const auto shape = broadcast(vo, vu, "sample");
   const std::size_t n = count_of(shape);
   py::array_t<double> dir(with_axis(shape, 3)), weight(with_axis(shape, 3)), pdf(shape);

@@ -158,6 +158,32 @@ def test_closures_in_fit_lut_and_record(tmp_path, gold_fit):
     assert doc.validate()[0] and [m.getName() for m in doc.getMaterialNodes()] == ["gold_0_15"]
 
 
+def test_hostile_directions_raise_value_error(tmp_path, gold_fit):
+    """Issue 47: NaN, infinite, huge, denormal and None directions crashed the LUT, MERL and RGL models;
+    each is a ValueError naming the argument and the index, before any model sees it."""
+    path = str(tmp_path / "gold.exr")
+    gold_fit.write_lut(path)
+    models = [gold_fit.model(), facetfit.read_lut(path).model(), facetfit.material({"type": "measured", "file": GOLD})]
+    rgl = os.path.join(RGL_DIR, "paper_white_rgb.bsdf")
+    if os.path.exists(rgl):
+        models.append(facetfit.material({"type": "measured", "file": rgl, "proposal": path}))
+    good = np.array([0.0, 0.0, 1.0])
+    bad = [np.array([np.nan] * 3), np.array([0.0, np.inf, 1.0]), np.array([0.0, 0.0, 1e300]),
+           np.array([1e-310, 0.0, 0.0]), np.array([None, None, None], dtype=object), np.zeros(3)]
+    for model in models:
+        for b in bad:
+            for call in (lambda: model.eval(good, b), lambda: model.eval(b, good), lambda: model.pdf(good, b),
+                         lambda: model.sample(b, np.array([0.5, 0.5, 0.5]))):
+                with pytest.raises(ValueError, match=r"\[0\]: must be a finite unit vector"):
+                    call()
+        with pytest.raises(ValueError, match=r"u\[1\]: must be three numbers in \[0, 1\]"):
+            model.sample(good, np.array([[0.5, 0.5, 0.5], [0.5, np.nan, 0.5]]))
+    with pytest.raises(ValueError, match="finite unit vector"):
+        facetfit.load(GOLD).eval(good, np.array([np.nan] * 3))
+    # A direction within float32's rounding of unit length is taken.
+    assert np.isfinite(models[0].eval(good, np.array([0.6, 0.0, 0.8], dtype=np.float32))).all()
+
+
 def test_bake_caches(tmp_path):
     first = facetfit.bake(GOLD, str(tmp_path), refine="none")
     again = facetfit.bake(GOLD, str(tmp_path), refine="none")
