@@ -1,6 +1,5 @@
 // facetfit info LUT.exr : the metadata and the tables of a LUT, to read or to plot.
 #include <cstdio>
-#include <filesystem>
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
@@ -120,8 +119,7 @@ void add_info_command(CLI::App& app, Context& ctx) {
   cmd->callback([path, json, &ctx] {
     try {
       // A measurement named where a LUT is expected: say what to run instead of the image reader's complaint.
-      const std::string ext = std::filesystem::path(*path).extension().string();
-      if (is_builtin(*path) || ext == ".binary" || ext == ".bsdf")
+      if (is_measurement(*path))
         throw Error(*path + ": a measurement, not a LUT: `facetfit fit` it, or `facetfit bake` it and run info on the LUT");
       const Lut lut = read_lut(*path);
       if (*json) std::printf("%s\n", json_text(info_json(lut)).c_str());

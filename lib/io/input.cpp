@@ -20,9 +20,28 @@ namespace fs = std::filesystem;
 
 namespace {
 
-bool is_supported_file(const fs::path& p) { return p.extension() == ".binary" || p.extension() == ".bsdf" || p.extension() == ".bin"; }
+// The input formats, each by its extension with its reader: the one list every command consults.
+struct InputFormat {
+  const char* extension;
+  std::shared_ptr<const Brdf> (*read)(const std::string& path, MerlTable::BinPoint merl_bins);
+};
+constexpr InputFormat kInputFormats[] = {
+    {".binary", [](const std::string& p, MerlTable::BinPoint b) -> std::shared_ptr<const Brdf> { return std::make_shared<MerlTable>(MerlTable::read(p, b)); }},
+    {".bsdf", [](const std::string& p, MerlTable::BinPoint) -> std::shared_ptr<const Brdf> { return std::make_shared<RglBsdf>(RglBsdf::read(p)); }},
+    {".bin", [](const std::string& p, MerlTable::BinPoint) -> std::shared_ptr<const Brdf> { return std::make_shared<UtiaBrdf>(UtiaBrdf::read(p)); }},
+};
+
+const InputFormat* input_format(const fs::path& p) {
+  for (const InputFormat& f : kInputFormats)
+    if (p.extension() == f.extension) return &f;
+  return nullptr;
+}
+
+bool is_supported_file(const fs::path& p) { return input_format(p) != nullptr; }
 
 }  // namespace
+
+bool is_measurement(const std::string& source) { return is_builtin(source) || is_supported_file(source); }
 
 bool is_builtin(const std::string& source) { return source.compare(0, std::string(kBuiltinPrefix).size(), kBuiltinPrefix) == 0; }
 
@@ -47,13 +66,13 @@ std::shared_ptr<const Brdf> load_brdf(const std::string& source, MerlTable::BinP
     return material->brdf;
   }
   const fs::path path(source);
-  if (path.extension() == ".binary") return std::make_shared<MerlTable>(MerlTable::read(source, merl_bins));
-  if (path.extension() == ".bsdf") return std::make_shared<RglBsdf>(RglBsdf::read(source));
-  if (path.extension() == ".bin") return std::make_shared<UtiaBrdf>(UtiaBrdf::read(source));
+  if (const InputFormat* format = input_format(path)) return format->read(source, merl_bins);
   std::error_code ec;
   if (fs::is_directory(path, ec)) fail(source, "is a folder with no supported material file");
   if (!fs::exists(path, ec)) fail(source, "cannot open: no such file");
-  fail(source, "unsupported format '" + path.extension().string() + "' (supported: .binary, .bsdf, .bin, builtin:NAME)");
+  std::string supported;
+  for (const InputFormat& f : kInputFormats) supported += std::string(f.extension) + ", ";
+  fail(source, "unsupported format '" + path.extension().string() + "' (supported: " + supported + "builtin:NAME)");
 }
 
 namespace {

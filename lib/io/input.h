@@ -17,6 +17,10 @@ namespace facetfit {
 
 constexpr const char* kBuiltinPrefix = "builtin:";
 
+// Whether `source` names a measurement: builtin:NAME, or a file of an input format by its extension
+// (.binary, .bsdf, .bin).
+bool is_measurement(const std::string& source);
+
 // Loads one source. Throws Error("<source>: <problem>"). `merl_bins`: which point of its bins a MERL
 // file's values stand for (io/merl.h).
 MerlTable load_table(const std::string& source, MerlTable::BinPoint merl_bins = MerlTable::BinPoint::start);
