@@ -19,8 +19,8 @@ void report_error(const std::string& message) { std::fprintf(stderr, "facetfit: 
 
 void report_settings(const Context& ctx, const std::string& command, const FitOptions& o) {
   if (!ctx.verbose()) return;
-  std::fprintf(stderr, "facetfit: %s: refine %s, resolution %d, smith %s, merl-bins %s, threads %zu\n", command.c_str(),
-               to_string(o.refine), o.resolution, to_string(o.smith), to_string(o.merl_bins),
+  std::fprintf(stderr, "facetfit: %s: refine %s, resolution %d, smith %s, merl-bins %s, closure-fresnel %s, threads %zu\n",
+               command.c_str(), to_string(o.refine), o.resolution, to_string(o.smith), to_string(o.merl_bins), to_string(o.closure_fresnel),
                tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
 }
 
@@ -75,6 +75,10 @@ void add_fit_settings(CLI::App* cmd, FitSettings& s) {
                   "Which point of its bin a MERL file's value stands for: start (the lower edge, what facetfit "
                   "writes) or center")
       ->capture_default_str();
+  cmd->add_option("--closure-fresnel", s.closure_fresnel,
+                  "The closure representation's first lobe: f82 (F82-tint, as Cycles' microfacet_f82_tint) or "
+                  "schlick (generalized Schlick like the other lobes: what MaterialX's OSL generator renders exactly)")
+      ->capture_default_str();
 }
 
 // A flag's parsed value; nullopt after a usage error (status 2) naming the flag, its value and what it takes.
@@ -92,7 +96,9 @@ std::optional<FitOptions> fit_options(const FitSettings& s, int& status) {
   const auto smith = flag_value(parse_smith(s.smith), "--smith", s.smith, "masking, correlated or separable", status);
   const auto merl_bins = flag_value(parse_bin_point(s.merl_bins), "--merl-bins", s.merl_bins, "start or center", status);
   const auto refine = flag_value(parse_refine(s.refine), "--refine", s.refine, "none or full", status);
-  if (!smith || !merl_bins || !refine) return std::nullopt;
+  const auto closure_fresnel =
+      flag_value(parse_closure_fresnel(s.closure_fresnel), "--closure-fresnel", s.closure_fresnel, "f82 or schlick", status);
+  if (!smith || !merl_bins || !refine || !closure_fresnel) return std::nullopt;
   FitOptions options;
   options.smith = *smith;
   options.resolution = s.resolution;
@@ -100,6 +106,7 @@ std::optional<FitOptions> fit_options(const FitSettings& s, int& status) {
   options.max_iterations = s.max_iterations;
   options.merl_bins = *merl_bins;
   options.refine = *refine;
+  options.closure_fresnel = *closure_fresnel;
   return options;
 }
 

@@ -32,6 +32,7 @@ struct FitSettings {
   int max_iterations = 1000;
   std::string refine = "full";
   std::string merl_bins = "start";
+  std::string closure_fresnel = "f82";
 };
 void add_fit_settings(CLI::App* cmd, FitSettings& settings);
 // The FitOptions they name, or nullopt after reporting a usage error (status 2).

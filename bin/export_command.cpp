@@ -14,10 +14,15 @@ namespace facetfit::cli {
 void add_export_command(CLI::App& app, Context& ctx) {
   auto luts = std::make_shared<std::vector<std::string>>();
   auto out_dir = std::make_shared<std::string>();
+  auto color82 = std::make_shared<bool>(false);
   CLI::App* cmd = app.add_subcommand("export", "Write each LUT's closures as a MaterialX document (pbrlib nodes), OUT/NAME.mtlx");
   cmd->add_option("luts", *luts, "LUT files (.exr, from bake)")->required();
   cmd->add_option("-o,--output", *out_dir, "Output folder (created if missing)")->required();
-  cmd->callback([luts, out_dir, &ctx] {
+  cmd->add_flag("--color82", *color82,
+                "Write F82-tint lobes exactly (color82), for a MaterialX implementation that honours it; by default "
+                "each is the nearest generalized Schlick lobe, which every implementation renders alike (a LUT "
+                "baked with --closure-fresnel schlick has no F82-tint lobe: its document is exact everywhere)");
+  cmd->callback([luts, out_dir, color82, &ctx] {
     namespace fs = std::filesystem;
     std::error_code ec;
     fs::create_directories(*out_dir, ec);
@@ -31,7 +36,7 @@ void add_export_command(CLI::App& app, Context& ctx) {
       try {
         const std::string name = materialx_name(fs::path(path).stem().string());
         const std::string target = (fs::path(*out_dir) / (name + ".mtlx")).string();
-        write_file_atomic(target, materialx_document(name, read_lut(path)));
+        write_file_atomic(target, materialx_document(name, read_lut(path), *color82));
         if (!ctx.quiet()) std::printf("%s\n", target.c_str());
       } catch (const Error& e) {
         report_error(e.what());

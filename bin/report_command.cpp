@@ -48,6 +48,7 @@ std::vector<std::string> shard_settings(const ReportArgs& a) {
   std::vector<std::string> s = {"--size", std::to_string(a.size), "--spp", std::to_string(a.spp), "--tolerance", exact(a.tolerance),
                                 "--smith", a.settings.smith, "--resolution", std::to_string(a.settings.resolution),
                                 "--refine", a.settings.refine, "--merl-bins", a.settings.merl_bins,
+                                "--closure-fresnel", a.settings.closure_fresnel,
                                 "--max-iterations", std::to_string(a.settings.max_iterations),
                                 "--iteration-tolerance", exact(a.settings.iteration_tolerance)};
   if (a.max_memory > 0) s.insert(s.end(), {"--max-memory", std::to_string(a.max_memory)});

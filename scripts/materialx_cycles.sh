@@ -5,15 +5,17 @@
 # scene of realref (BPY_PYTHON: build/bpy-venv, make osl-host) beside osl/facetfit_material.osl of the same
 # LUT. Prints a Markdown table: mean Delta E 2000 of the generated shader's render against the material
 # shader's, and of each against Mitsuba's render of the measurement.
-# Usage: scripts/materialx_cycles.sh FACETFIT [SHARED_DATA] [SPP]
+# Usage: scripts/materialx_cycles.sh FACETFIT [SHARED_DATA] [SPP] [BAKE FLAGS...]
+#   e.g. scripts/materialx_cycles.sh build/release/bin/facetfit ../shared/data 64 --closure-fresnel schlick
 set -euo pipefail
 facetfit=$1 data=${2:-../shared/data} spp=${3:-64}
+bake_flags=("${@:4}")
 bpy_python=${BPY_PYTHON:-build/bpy-venv/bin/python}
 py_python=${PY_PYTHON:-build/py-venv/bin/python}
 here=$(cd "$(dirname "$0")/.." && pwd)
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
-"$facetfit" bake "$data/rgl" -o "$work/luts" >/dev/null 2>&1
+"$facetfit" bake "$data/rgl" -o "$work/luts" "${bake_flags[@]}" >/dev/null 2>&1
 diff_mean() {
   "$facetfit" diff "$1" "$2" --mask "$data/realref/mask.exr" --json | python3 -c 'import json, sys; print("%.2f" % json.load(sys.stdin)["mean"])'
 }
@@ -32,4 +34,4 @@ for lut in "$work"/luts/*.exr; do
   echo "| $name | $(diff_mean "$work/mx.exr" "$work/material.exr") | $(diff_mean "$work/mx.exr" "$data/realref/$name.exr") | $(diff_mean "$work/material.exr" "$data/realref/$name.exr") |"
 done
 echo
-echo "Cycles at $spp samples per pixel, 128 x 128, over realref/mask.exr (scripts/materialx_cycles.sh)."
+echo "Cycles at $spp samples per pixel, 128 x 128, over realref/mask.exr (scripts/materialx_cycles.sh${bake_flags[*]:+, bake ${bake_flags[*]}})."

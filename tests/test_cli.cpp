@@ -231,6 +231,9 @@ TEST(Cli, UsageErrors) {
   EXPECT_EQ(facetfit("fit builtin:gold-ggx-0.15 --smith wrong").status, 2);
   EXPECT_NE(facetfit("fit").status, 0);
   EXPECT_EQ(facetfit("fit builtin:gold-ggx-0.15 --resolution 1").status, 2);
+  const RunResult fresnel = facetfit("bake builtin:gold-ggx-0.15 -o out --closure-fresnel f83");
+  EXPECT_EQ(fresnel.status, 2);
+  EXPECT_NE(fresnel.err.find("--closure-fresnel f83: must be f82 or schlick"), std::string::npos) << fresnel.err;
   // Parser errors are usage errors too: exit 2, not the parser library's own codes (104-109).
   for (const char* args : {"fit --no-such-flag builtin:gold-ggx-0.15", "no-such-command", "", "--threads 0 fit builtin:gold-ggx-0.15",
                            "bake builtin:gold-ggx-0.15", "render --spp abc -o x.exr",

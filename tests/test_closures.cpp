@@ -118,6 +118,50 @@ TEST(Closures, ProposalSamplesItsDensity) {
   EXPECT_LT(r.p_value, 1e-6);
 }
 
+
+// The mean squared distance of two lobes' Fresnel curves over mu uniform on [0, 1], summed over channels.
+double fresnel_distance(const ClosureLobe& a, const ClosureLobe& b) {
+  double sum = 0.0;
+  for (int j = 0; j < 1000; ++j) {
+    const Rgb d = a.fresnel_at((j + 0.5) / 1000.0) - b.fresnel_at((j + 0.5) / 1000.0);
+    sum += glm::dot(d, d) / 1000.0;
+  }
+  return sum;
+}
+
+TEST(Closures, WithoutF82IsTheNearestGeneralizedSchlick) {
+  ClosureLobe plain;  // a tint of 1: the curve is Schlick's, which the search must find
+  plain.f0 = Rgb(0.3, 0.5, 0.7);
+  plain.f82 = fresnel_schlick(plain.f0, 1.0 / 7.0);
+  const ClosureLobe schlick = without_f82(plain);
+  EXPECT_EQ(schlick.fresnel, ClosureLobe::Fresnel::schlick);
+  EXPECT_NEAR(schlick.exponent, 5.0, 0.02);
+  for (double f90 : {schlick.f90.r, schlick.f90.g, schlick.f90.b}) EXPECT_NEAR(f90, 1.0, 2e-3);
+
+  ClosureLobe tinted = two_lobes().lobes[0];  // a gold-like tint that bends the curve down near grazing
+  tinted.f82 = Rgb(0.6, 0.45, 0.3);
+  const ClosureLobe near = without_f82(tinted);
+  EXPECT_EQ(near.f0, tinted.f0);
+  const double distance = fresnel_distance(near, tinted);
+  // Dropping color82 (what MaterialX's OSL generator does) is the negative control; a nudged exponent or
+  // f90 must not do better than the search.
+  ClosureLobe dropped = tinted;
+  dropped.f82 = fresnel_schlick(tinted.f0, 1.0 / 7.0);
+  EXPECT_LT(distance, 0.3 * fresnel_distance(dropped, tinted)) << distance;  // 0.25 measured
+  for (double de : {-0.1, 0.1}) {
+    ClosureLobe nudged = near;
+    nudged.exponent += de;
+    EXPECT_GE(fresnel_distance(nudged, tinted), distance);
+  }
+  ClosureLobe nudged = near;
+  nudged.f90 += Rgb(0.0, 0.01, 0.0);
+  EXPECT_GE(fresnel_distance(nudged, tinted), distance);
+
+  const ClosureLobe broad = two_lobes().lobes[1];  // a generalized Schlick lobe stays as it is
+  EXPECT_EQ(without_f82(broad).exponent, broad.exponent);
+  EXPECT_EQ(without_f82(broad).f90, broad.f90);
+}
+
 TEST(ClosureFit, AlbedoSumAgreesWithTheBrdf) {
   // The fit's albedo (visible normals on a fixed grid) against the BRDF's as albedo_target draws it: within
   // 1% at every view (0.75% at most when written), under the fit's tolerance of 0.5 L* (about 1.3%).
@@ -202,6 +246,33 @@ TEST(ClosureFit, OneLobeStaysOneLobe) {
   ASSERT_TRUE(fit.ok()) << fit.problem;
   ASSERT_EQ(fit.closures.closures.lobes.size(), 1u);
   EXPECT_NEAR(fit.closures.closures.lobes[0].alpha_x, 0.2, 0.006);
+}
+
+// closure_fresnel = schlick: the closures a renderer without the F82 term (MaterialX's OSL) renders exactly.
+// On one F82-tint lobe whose tint dips below Schlick's curve, the fit's lobes are all generalized Schlick and
+// no farther than the truth's own nearest Schlick curve (without_f82) is; the default fit, which may keep
+// the F82 term, is nearer still (the control: the option changes the fit).
+TEST(ClosureFit, SchlickOnlyClosuresHaveNoF82Term) {
+  Closures truth;
+  truth.body = Rgb(0.05);
+  ClosureLobe lobe;
+  lobe.alpha_x = lobe.alpha_y = 0.15;
+  lobe.f0 = Rgb(0.9, 0.6, 0.3);
+  lobe.f82 = Rgb(0.5, 0.5, 0.5);
+  truth.lobes = {lobe};
+  const MerlTable table = MerlTable::tabulate(ClosureBrdf(truth));
+  FitOptions options;
+  options.closure_fresnel = ClosureLobe::Fresnel::schlick;
+  const FitResult schlick = Fitter(options).fit(table), f82 = Fitter(FitOptions{}).fit(table);
+  ASSERT_TRUE(schlick.ok() && f82.ok()) << schlick.problem << f82.problem;
+  for (const ClosureLobe& l : schlick.closures.closures.lobes) EXPECT_EQ(l.fresnel, ClosureLobe::Fresnel::schlick);
+  Closures nearest = truth;
+  nearest.lobes = {without_f82(lobe)};
+  const double nearest_error = closure_error(error_bins(table), nearest);
+  EXPECT_LE(schlick.closures.error, nearest_error) << nearest_error;
+  EXPECT_LT(f82.closures.error, 0.5 * schlick.closures.error);
+  std::printf("schlick %.5f nearest %.5f f82 %.5f lobes %zu\n", schlick.closures.error, nearest_error, f82.closures.error,
+              schlick.closures.closures.lobes.size());
 }
 
 }  // namespace

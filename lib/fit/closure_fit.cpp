@@ -377,7 +377,10 @@ ClosureFit fit_closures(const MeasuredBins& bins, const AlbedoTarget* albedo, co
                         const Closures& start, const ClosureFitOptions& options) {
   // Lobes are chosen on a third of the rows; the choice is solved on all of them.
   const MeasuredBins screen = every_nth_row(bins, 3);
-  Solved current = solve(screen, albedo, start, options.max_iterations);
+  Closures first = start;
+  if (options.fresnel == ClosureLobe::Fresnel::schlick)
+    for (ClosureLobe& l : first.lobes) l = without_f82(l);
+  Solved current = solve(screen, albedo, first, options.max_iterations);
   while (int(current.closures.lobes.size()) < options.max_lobes) {
     // A sharper and a broader generalized-Schlick lobe, solved concurrently. (On the six RGL materials the
     // Schlick candidates were taken over F82-tint ones of the same alpha, or within 0.1% of them: their

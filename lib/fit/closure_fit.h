@@ -43,7 +43,11 @@ struct ClosureFitOptions {
   double min_gain = 2e-4;   // and the least (0.02 units of L*)
   int max_iterations = 15;     // Levenberg-Marquardt steps per solve while lobes are chosen
   int polish_iterations = 25;  // and of the solve of the lobes chosen (the six RGL materials' distances within 1% of 200 steps')
+  // f82_tint: the start's lobe keeps its F82-tint Fresnel; schlick: it starts as the nearest generalized
+  // Schlick (model/closures.h, without_f82), so that every lobe is one (what MaterialX's OSL renders exactly).
+  ClosureLobe::Fresnel fresnel = ClosureLobe::Fresnel::f82_tint;
 };
+
 
 struct ClosureFit {
   Closures closures;

@@ -74,6 +74,14 @@ std::optional<FitOptions::Refine> parse_refine(const std::string& name) {
   return std::nullopt;
 }
 
+const char* to_string(ClosureLobe::Fresnel f) { return f == ClosureLobe::Fresnel::schlick ? "schlick" : "f82"; }
+
+std::optional<ClosureLobe::Fresnel> parse_closure_fresnel(const std::string& name) {
+  if (name == "f82") return ClosureLobe::Fresnel::f82_tint;
+  if (name == "schlick") return ClosureLobe::Fresnel::schlick;
+  return std::nullopt;
+}
+
 void Fitter::refine_on_measurement(const MerlTable& table, FitResult& result) const {
   const MeasuredBins fit_bins = solve_bins(table), parametric = parametric_bins(table), bins = error_bins(table);
   const Smith smith = options_.smith;
@@ -127,7 +135,9 @@ void Fitter::refine_on_measurement(const MerlTable& table, FitResult& result) co
   // The closures, from the GGX fit, matching the measurement's albedo too, drawn by the tabulated lobe's
   // proposal (fit/closure_fit.h).
   const AlbedoTarget albedo = albedo_target(table, VisibleSlopeProposal(result.lobe.tables(smith)));
-  result.closures = fit_closures(closure_bins(table), &albedo, bins, result.ggx);
+  ClosureFitOptions closure_options;
+  closure_options.fresnel = options_.closure_fresnel;
+  result.closures = fit_closures(closure_bins(table), &albedo, bins, result.ggx, closure_options);
   result.alpha_ggx = alpha_ggx_from_moments(result.ndf(), quadrature_);
   result.alpha_beckmann = alpha_beckmann_from_moments(result.ndf(), quadrature_);
 }

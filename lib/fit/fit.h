@@ -42,6 +42,8 @@ struct FitOptions {
   Refine refine = Refine::full;
   // Which point of its bins a MERL file's values stand for, when the input is read (io/merl.h).
   MerlTable::BinPoint merl_bins = MerlTable::BinPoint::start;
+  // The closure representation's first lobe: F82-tint, or generalized Schlick like the rest (fit/closure_fit.h).
+  ClosureLobe::Fresnel closure_fresnel = ClosureLobe::Fresnel::f82_tint;
 
   // The paper's method alone (Refine::none), otherwise the defaults.
   static FitOptions paper() {
@@ -53,6 +55,8 @@ struct FitOptions {
 
 const char* to_string(FitOptions::Refine r);
 std::optional<FitOptions::Refine> parse_refine(const std::string& name);
+const char* to_string(ClosureLobe::Fresnel f);  // f82, schlick
+std::optional<ClosureLobe::Fresnel> parse_closure_fresnel(const std::string& name);
 
 // The 2D extraction (fit/extract_2d.h) of a source that measured back-scattering along azimuths (a
 // UTIA file, an anisotropic RGL file): its principal roughness in each family, and its tables, which

@@ -38,6 +38,7 @@ std::string bake_cache_key(const std::string& sha256, const BakeOptions& o) {
   k["max_iterations"] = o.fit.max_iterations;
   k["refine"] = to_string(o.fit.refine);
   k["merl_bins"] = to_string(o.fit.merl_bins);
+  k["closure_fresnel"] = to_string(o.fit.closure_fresnel);
   k["tolerance"] = o.tolerance;
   k["sampling"] = o.with_sampling;
   const std::string text = json_text(k);

@@ -40,7 +40,8 @@ struct Node {
 };
 
 // The generalized_schlick_bsdf of a lobe (its tangent node when it is anisotropic, added to `nodes`).
-Node lobe_node(const std::string& name, const ClosureLobe& l, std::vector<Node>& nodes) {
+Node lobe_node(const std::string& name, const ClosureLobe& lobe, bool color82, std::vector<Node>& nodes) {
+  const ClosureLobe l = color82 ? lobe : without_f82(lobe);
   Node n{"generalized_schlick_bsdf", name, "BSDF", {}};
   const bool tint = l.fresnel == ClosureLobe::Fresnel::f82_tint;
   n.inputs.push_back({"weight", "float", number(l.weight)});
@@ -71,7 +72,7 @@ std::string materialx_name(const std::string& stem) {
   return out;
 }
 
-std::string materialx_document(const std::string& name, const Lut& lut) {
+std::string materialx_document(const std::string& name, const Lut& lut, bool color82) {
   const Closures c = lut.closures();
   std::vector<Node> nodes;
   std::vector<std::string> parts;
@@ -80,7 +81,7 @@ std::string materialx_document(const std::string& name, const Lut& lut) {
     parts.push_back(name + "_body");
   }
   for (std::size_t k = 0; k < c.lobes.size(); ++k) {
-    const Node lobe = lobe_node(name + "_lobe" + std::to_string(k), c.lobes[k], nodes);
+    const Node lobe = lobe_node(name + "_lobe" + std::to_string(k), c.lobes[k], color82, nodes);
     nodes.push_back(lobe);
     parts.push_back(lobe.name);
   }
@@ -91,7 +92,7 @@ std::string materialx_document(const std::string& name, const Lut& lut) {
     coat.f0 = Rgb(c.coat.f0);
     coat.f90 = Rgb(1.0);
     coat.exponent = 5.0;
-    nodes.push_back(lobe_node(name + "_coat", coat, nodes));
+    nodes.push_back(lobe_node(name + "_coat", coat, color82, nodes));
     parts.push_back(name + "_coat");
   }
   // The sum, a chain of adds.

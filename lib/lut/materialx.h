@@ -2,12 +2,13 @@
 // renderer that takes MaterialX or USD shades with (docs/osl.md).
 //
 // The body is `oren_nayar_diffuse_bsdf` at roughness 0 (Lambert); each lobe a `generalized_schlick_bsdf`
-// with the lobe's alphas as its roughness: an F82-tint lobe with color0 = f0, color82 = the closure's tint
-// (f82 over Schlick's value at acos(1/7)), color90 = 1 and exponent 5, its weight the lobe's; a generalized
-// Schlick lobe with color0 = f0, color90 = f90 and its exponent. An anisotropic lobe's tangent is the
-// surface tangent turned about the normal by the lobe's angle (`rotate3d`). The coat is one more
-// generalized_schlick_bsdf (grey f0, Schlick). All summed by `add` into a `surface` and a
-// `surfacematerial` named after the material.
+// with the lobe's alphas as its roughness and its weight: a generalized Schlick lobe with color0 = f0,
+// color90 = f90 and its exponent; an F82-tint lobe as the generalized Schlick lobe nearest it
+// (without_f82, model/closures.h), since MaterialX's OSL generator drops color82, or, with `color82`,
+// exactly: color0 = f0, color82 = the closure's tint (f82 over Schlick's value at acos(1/7)), color90 = 1,
+// exponent 5. An anisotropic lobe's tangent is the surface tangent turned about the normal by the lobe's
+// angle (`rotate3d`). The coat is one more generalized_schlick_bsdf (grey f0, Schlick). All summed by `add`
+// into a `surface` and a `surfacematerial` named after the material.
 #pragma once
 
 #include <string>
@@ -18,7 +19,7 @@ namespace facetfit {
 
 // The document's text. `name` must be a valid MaterialX name (letters, digits, underscores; not starting
 // with a digit): materialx_name() makes one.
-std::string materialx_document(const std::string& name, const Lut& lut);
+std::string materialx_document(const std::string& name, const Lut& lut, bool color82 = false);
 
 // `stem` as a MaterialX element name: other characters become underscores, a leading digit gets one before it.
 std::string materialx_name(const std::string& stem);

@@ -15,6 +15,56 @@ Rgb ClosureLobe::fresnel_at(double cos_d) const {
   return f0 + (f90 - f0) * std::pow(1.0 - mu, exponent);
 }
 
+namespace {
+
+// The least-squares f90 of f0 + (f90 - f0) (1 - mu)^e against `lobe`'s curve at the nodes, clamped to
+// [0, 1], and the squared error summed over channels and nodes.
+std::pair<Rgb, double> schlick_f90(const ClosureLobe& lobe, double e, const std::vector<double>& mus) {
+  Rgb cross(0.0);
+  double square = 0.0;
+  for (double mu : mus) {
+    const double p = std::pow(1.0 - mu, e);
+    cross += p * (lobe.fresnel_at(mu) - lobe.f0);
+    square += p * p;
+  }
+  const Rgb f90 = glm::clamp(lobe.f0 + cross / square, Rgb(0.0), Rgb(1.0));
+  double error = 0.0;
+  for (double mu : mus) {
+    const Rgb r = lobe.fresnel_at(mu) - (lobe.f0 + (f90 - lobe.f0) * std::pow(1.0 - mu, e));
+    error += glm::dot(r, r);
+  }
+  return {f90, error};
+}
+
+}  // namespace
+
+ClosureLobe without_f82(const ClosureLobe& lobe) {
+  if (lobe.fresnel != ClosureLobe::Fresnel::f82_tint) return lobe;
+  std::vector<double> mus;
+  for (int j = 0; j < 256; ++j) mus.push_back((j + 0.5) / 256.0);
+  // A scan of 31 exponents, log-spaced over [1, 16], then golden-section search between the best one's
+  // neighbours.
+  const auto error = [&](double e) { return schlick_f90(lobe, e, mus).second; };
+  const auto exponent = [](int k) { return std::pow(16.0, k / 30.0); };
+  int best = 0;
+  for (int k = 1; k <= 30; ++k)
+    if (error(exponent(k)) < error(exponent(best))) best = k;
+  double lo = exponent(std::max(best - 1, 0)), hi = exponent(std::min(best + 1, 30));
+  const double golden = 0.5 * (std::sqrt(5.0) - 1.0);
+  for (int step = 0; step < 40; ++step) {
+    const double a = hi - golden * (hi - lo), b = lo + golden * (hi - lo);
+    if (error(a) < error(b))
+      hi = b;
+    else
+      lo = a;
+  }
+  ClosureLobe out = lobe;
+  out.fresnel = ClosureLobe::Fresnel::schlick;
+  out.exponent = 0.5 * (lo + hi);
+  out.f90 = schlick_f90(lobe, out.exponent, mus).first;
+  return out;
+}
+
 ClosureBrdf::ClosureBrdf(Closures closures) : closures_(std::move(closures)) {
   for (const ClosureLobe& l : closures_.lobes) lobes_.push_back({l.ndf(), TurnedFrame(l.angle)});
 }

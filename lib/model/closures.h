@@ -43,6 +43,12 @@ struct ClosureLobe {
   Rgb fresnel_at(double cos_d) const;
 };
 
+// The lobe for a renderer without the F82 term (MaterialX's OSL generator drops color82): an F82-tint lobe
+// becomes the generalized Schlick lobe whose curve is nearest, f0 kept, f90 per channel in [0, 1] and one
+// exponent in [1, 16] by least squares over mu = cos theta_d uniform on [0, 1]. Other lobes are returned as
+// they are.
+ClosureLobe without_f82(const ClosureLobe& lobe);
+
 struct Closures {
   static constexpr int kMaxLobes = 3;
   Rgb body{0.0};

@@ -67,7 +67,8 @@ struct Fit {
   std::shared_ptr<const Fitter> fitter;  // its quadrature bakes the LUT
 };
 
-FitOptions fit_options(const std::string& refine, int resolution, const std::string& smith, const std::string& merl_bins) {
+FitOptions fit_options(const std::string& refine, int resolution, const std::string& smith, const std::string& merl_bins,
+                       const std::string& closure_fresnel) {
   FitOptions o;
   const auto r = parse_refine(refine);
   if (!r) throw py::value_error("refine: must be full or none, not '" + refine + "'");
@@ -75,11 +76,14 @@ FitOptions fit_options(const std::string& refine, int resolution, const std::str
   if (!s) throw py::value_error("smith: must be masking, correlated or separable, not '" + smith + "'");
   const auto b = parse_bin_point(merl_bins);
   if (!b) throw py::value_error("merl_bins: must be start or center, not '" + merl_bins + "'");
+  const auto c = parse_closure_fresnel(closure_fresnel);
+  if (!c) throw py::value_error("closure_fresnel: must be f82 or schlick, not '" + closure_fresnel + "'");
   if (resolution < 8 || resolution > 1024) throw py::value_error("resolution: must be in [8, 1024]");
   o.refine = *r;
   o.resolution = resolution;
   o.smith = *s;
   o.merl_bins = *b;
+  o.closure_fresnel = *c;
   return o;
 }
 
@@ -337,13 +341,16 @@ PYBIND11_MODULE(_facetfit, m) {
 
   m.def(
       "fit",
-      [](const py::object& what, const std::string& refine, int resolution, const std::string& smith, const std::string& merl_bins) {
-        const FitOptions o = fit_options(refine, resolution, smith, merl_bins);
+      [](const py::object& what, const std::string& refine, int resolution, const std::string& smith, const std::string& merl_bins,
+         const std::string& closure_fresnel) {
+        const FitOptions o = fit_options(refine, resolution, smith, merl_bins, closure_fresnel);
         if (py::isinstance<Measurement>(what)) return fit(what.cast<const Measurement&>(), o);
         return fit(load(py::str(py::module_::import("os").attr("fspath")(what)).cast<std::string>(), merl_bins), o);
       },
       py::arg("measurement"), py::arg("refine") = "full", py::arg("resolution") = 90, py::arg("smith") = "correlated",
-      py::arg("merl_bins") = "start", "Fits a Measurement or a source path (refine='none': the paper's method alone).");
+      py::arg("merl_bins") = "start", py::arg("closure_fresnel") = "f82",
+      "Fits a Measurement or a source path (refine='none': the paper's method alone; closure_fresnel='schlick': "
+      "closures of generalized-Schlick lobes only).");
 
   py::class_<Lut>(m, "Lut", "A baked LUT texture.")
       .def_property_readonly("theta", [](const Lut& l) { return theta_array(l.tables.ndf.grid); })
@@ -361,8 +368,12 @@ PYBIND11_MODULE(_facetfit, m) {
       .def_property_readonly("closures", [](const Lut& l) { return to_python(closures_json(l.closures(), l.meta.error_closures)); },
                              "the closures the material shader emits (format 5; an older LUT's one lobe), as Fit.closures")
       .def("closures_model", [](const Lut& l) { return closures_model(l.closures()); }, "The closure representation as a model.")
-      .def("materialx", [](const Lut& l, const std::string& name) { return materialx_document(materialx_name(name), l); }, py::arg("name"),
-           "The closures as a MaterialX document's text (as `facetfit export` writes it; the name made a valid MaterialX name).")
+      .def(
+          "materialx",
+          [](const Lut& l, const std::string& name, bool color82) { return materialx_document(materialx_name(name), l, color82); },
+          py::arg("name"), py::arg("color82") = false,
+          "The closures as a MaterialX document's text (as `facetfit export` writes it, `color82` as its --color82; the "
+          "name made a valid MaterialX name).")
       .def(
           "parametric",
           [](const Lut& l, const std::string& family) {
@@ -380,9 +391,10 @@ PYBIND11_MODULE(_facetfit, m) {
   m.def(
       "bake",
       [](const std::string& source, const std::string& out_dir, std::string name, bool force, double tolerance, bool sampling,
-         const std::string& refine, int resolution, const std::string& smith, const std::string& merl_bins) {
+         const std::string& refine, int resolution, const std::string& smith, const std::string& merl_bins,
+         const std::string& closure_fresnel) {
         BakeOptions o;
-        o.fit = fit_options(refine, resolution, smith, merl_bins);
+        o.fit = fit_options(refine, resolution, smith, merl_bins, closure_fresnel);
         o.force = force;
         o.tolerance = tolerance;
         o.with_sampling = sampling;
@@ -399,7 +411,7 @@ PYBIND11_MODULE(_facetfit, m) {
       },
       py::arg("source"), py::arg("out_dir"), py::arg("name") = "", py::arg("force") = false, py::arg("tolerance") = 0.02,
       py::arg("sampling") = true, py::arg("refine") = "full", py::arg("resolution") = 90, py::arg("smith") = "correlated",
-      py::arg("merl_bins") = "start",
+      py::arg("merl_bins") = "start", py::arg("closure_fresnel") = "f82",
       "Bakes OUT_DIR/NAME.exr and its JSON sidecar as `facetfit bake` does (cached by content); returns the sidecar.");
 
   m.def("render", &render_scene, py::arg("scene"), py::arg("spp") = 0, py::arg("seed") = 0, py::arg("max_memory") = "",

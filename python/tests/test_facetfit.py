@@ -184,6 +184,16 @@ def test_hostile_directions_raise_value_error(tmp_path, gold_fit):
     assert np.isfinite(models[0].eval(good, np.array([0.6, 0.0, 0.8], dtype=np.float32))).all()
 
 
+def test_schlick_only_closures(tmp_path):
+    """closure_fresnel='schlick': every lobe a generalized Schlick (what MaterialX's OSL renders exactly)."""
+    record = facetfit.bake(GOLD, str(tmp_path), closure_fresnel="schlick")
+    lut = facetfit.read_lut(str(tmp_path / "gold-ggx-0.15.exr"))
+    assert record["status"] == "baked" and all(l["fresnel"] == "schlick" for l in lut.closures["lobes"])
+    assert lut.materialx("gold", color82=True) == lut.materialx("gold")  # nothing for color82 to keep
+    with pytest.raises(ValueError, match="closure_fresnel"):
+        facetfit.fit(GOLD, closure_fresnel="f83")
+
+
 def test_bake_caches(tmp_path):
     first = facetfit.bake(GOLD, str(tmp_path), refine="none")
     again = facetfit.bake(GOLD, str(tmp_path), refine="none")
