@@ -10,6 +10,7 @@
 #include <iterator>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include "io/atomic_file.h"
 #include "lut/bake.h"
@@ -35,6 +36,16 @@ void killed_half_way(const std::string& target, const std::string& bytes) {
   int status = 0;
   ::waitpid(pid, &status, 0);
   ASSERT_TRUE(WIFSIGNALED(status));
+}
+
+TEST(AtomicFile, OutputNamesAreFileNames) {
+  for (const std::string& good : std::vector<std::string>{"gold-ggx-0.15", "x' onerror='y", "a b", std::string(kMaxOutputName, 'n')})
+    EXPECT_EQ(output_name_problem(good), "") << good;
+  const std::pair<std::string, std::string> bad[] = {{"", "is not a file name"}, {"..", "is not a file name"}, {".", "is not a file name"},
+                                                     {"../x", "holds a '/'"}, {"/tmp/x", "holds a '/'"},
+                                                     {std::string("x\0y", 3), "control character"}, {"x\ny", "control character"},
+                                                     {std::string(kMaxOutputName + 1, 'n'), "bytes long; the limit is 200"}};
+  for (const auto& [name, problem] : bad) EXPECT_NE(output_name_problem(name).find(problem), std::string::npos) << name;
 }
 
 TEST(AtomicFile, KilledWriterLeavesThePreviousFileWhole) {

@@ -5,6 +5,7 @@
 #include <fstream>
 #include <map>
 
+#include "io/atomic_file.h"
 #include "io/merl.h"
 #include "model/analytic.h"
 #include "report/report.h"
@@ -37,6 +38,24 @@ TEST(Report, AMaterialNameCannotWriteHtml) {
   const std::string html = test::read_bytes(dir.file("out/index.html"));
   EXPECT_EQ(html.find("onerror='"), std::string::npos);
   EXPECT_NE(html.find("x&#39; onerror=&#39;alert(1)"), std::string::npos);
+}
+
+// Two inputs of one stem: the second is a failure naming the first, not a second row over its images and
+// LUT (issue 47).
+TEST(Report, TwoInputsOfOneNameAreNotTwoRows) {
+  TempDir dir;
+  std::filesystem::create_directories(dir.path() / "d1");
+  std::filesystem::create_directories(dir.path() / "d2");
+  MerlTable::tabulate(LambertBrdf(Rgb(0.5))).write(dir.file("d1/mat.binary"));
+  MerlTable::tabulate(LambertBrdf(Rgb(0.2))).write(dir.file("d2/mat.binary"));
+  ReportOptions o = small(dir.file("out"));
+  o.inputs = {dir.file("d1/mat.binary"), dir.file("d2/mat.binary")};
+  const json r = run_report(o);
+  ASSERT_EQ(r["materials"].size(), 1u);
+  EXPECT_EQ(r["materials"][0]["source"], dir.file("d1/mat.binary"));
+  ASSERT_EQ(r["failures"].size(), 1u);
+  EXPECT_NE(r["failures"][0]["error"].get<std::string>().find("output name mat is already taken by " + dir.file("d1/mat.binary")),
+            std::string::npos);
 }
 
 json read_json(const std::string& path) {
@@ -144,7 +163,21 @@ TEST(Report, ShardsMergeIntoTheWholeReport) {
             std::string::npos);
   EXPECT_NE(test::error_of([&] { merge_reports({part1.path().string(), merged.path().string()}, out); }).find("is also in"),
             std::string::npos);
+  // A part's material names are file names, never paths (issue 47: "../../p1" copied its images beside the
+  // output), and strings (a number ended in an internal JSON error).
+  TempDir hostile;
+  json forged = ra;
+  forged["shard"] = "1/1";
+  forged["materials"][0]["name"] = "../../p1";
+  write_file_atomic((hostile.path() / "report.json").string(), forged.dump());
+  EXPECT_NE(test::error_of([&] { merge_reports({hostile.path().string()}, out); }).find("material name \"../../p1\" holds a '/'"),
+            std::string::npos);
+  forged["materials"][0]["name"] = 7;
+  write_file_atomic((hostile.path() / "report.json").string(), forged.dump());
+  EXPECT_NE(test::error_of([&] { merge_reports({hostile.path().string()}, out); }).find("a material without a \"name\" string"),
+            std::string::npos);
   EXPECT_FALSE(std::filesystem::exists(out));
+  EXPECT_FALSE(std::filesystem::exists(refused.path() / "p1"));
 }
 
 }  // namespace

@@ -94,6 +94,16 @@ bool is_running(long pid) {
 
 }  // namespace
 
+std::string output_name_problem(const std::string& name) {
+  if (name.empty() || name == "." || name == "..") return "is not a file name";
+  if (name.size() > kMaxOutputName) return "is " + std::to_string(name.size()) + " bytes long; the limit is " + std::to_string(kMaxOutputName);
+  for (const char c : name) {
+    if (c == '/') return "holds a '/': it must be a file name, not a path";
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) return "holds a control character";
+  }
+  return "";
+}
+
 int remove_stale_temporaries(const std::string& dir) {
   int removed = 0;
   std::error_code ec;

@@ -3,6 +3,7 @@
 // file under the target's name.
 #pragma once
 
+#include <cstddef>
 #include <string>
 
 namespace facetfit {
@@ -33,5 +34,12 @@ int remove_stale_temporaries(const std::string& dir);
 
 // Writes `content` to `path` through an AtomicFile.
 void write_file_atomic(const std::string& path, const std::string& content);
+
+// What is wrong with `name` as the base of an output's name inside its folder (a material's LUT, sidecar
+// and image folder), or "" when nothing is: it must be a plain file name, so that no write leaves the
+// folder and none is cut short: not empty, "." or "..", no '/' and no control character (NUL ends a path),
+// at most kMaxOutputName bytes (a file system's 255, less the temporary's 24 and an extension).
+constexpr std::size_t kMaxOutputName = 200;
+std::string output_name_problem(const std::string& name);
 
 }  // namespace facetfit

@@ -66,6 +66,8 @@ BakeOutcome bake_material(const std::string& source, const std::string& name, co
   const auto start = std::chrono::steady_clock::now();
   const fs::path lut_path = fs::path(out_dir) / (name + ".exr"), json_path = fs::path(out_dir) / (name + ".json");
   try {
+    if (const std::string problem = output_name_problem(name); !problem.empty())
+      fail(source, "output name \"" + excerpt(name, 60) + "\" " + problem);
     // The SHA-256 of a 35 MB table costs as much CPU as reading and fitting it: hash on one core while
     // the other reads. A cache hit then costs the hash plus a read it did not need (6 ms).
     std::string sha, hash_error;

@@ -274,6 +274,10 @@ json run_report(const ReportOptions& o) {
   std::vector<std::string> mine;  // this shard's, a deterministic subset
   for (std::size_t k = 0; k < inputs.size(); ++k)
     if (int(k % std::size_t(o.shards)) == o.shard - 1) mine.push_back(inputs[k]);
+  // Names must be unique over all the inputs (every shard sees the same owner): a second input of the same
+  // stem is a failure, not a second row over the first one's images and LUT.
+  std::map<std::string, std::string> owner;
+  for (const std::string& source : inputs) owner.emplace(source_name(source), source);
 
   json report;
   report["facetfit_version"] = FACETFIT_VERSION;
@@ -289,6 +293,7 @@ json run_report(const ReportOptions& o) {
     const std::string name = source_name(source);
     const fs::path images = fs::path(o.out_dir) / "images" / name;
     try {
+      if (owner.at(name) != source) fail(source, "output name " + name + " is already taken by " + owner.at(name));
       const auto bake_start = std::chrono::steady_clock::now();
       const BakeOutcome baked = bake_material(source, name, luts.string(), o.bake, fitter);
       if (baked.status == BakeOutcome::Status::failed) throw Error(baked.error);
@@ -368,7 +373,11 @@ json merge_reports(const std::vector<std::string>& parts, const std::string& out
     if (!reports.empty() && reports.front()["settings"] != r["settings"])
       fail(file.string(), "rendered with other settings than " + parts.front());
     for (const json& m : r["materials"]) {
-      const std::string name = m.value("name", std::string());
+      if (!m.is_object() || !m.contains("name") || !m["name"].is_string()) fail(file.string(), "a material without a \"name\" string");
+      const std::string name = m["name"].get<std::string>();
+      // A name becomes a folder of the merged report: a path would write outside it.
+      if (const std::string problem = output_name_problem(name); !problem.empty())
+        fail(file.string(), "material name \"" + excerpt(name, 60) + "\" " + problem);
       if (const auto [at, added] = from_part.emplace(name, part); !added)
         fail(part, "material " + name + " is also in " + at->second + " (a part given twice?)");
     }

@@ -211,6 +211,12 @@ def test_bad_inputs_raise_one_line(tmp_path):
         facetfit.fit(GOLD, refine="some")
     with pytest.raises(facetfit.Error, match="type must be"):
         facetfit.material({"type": "phong"})
+    # Output names are file names (issue 47: "../x" and absolute names wrote outside out_dir, NUL lost the LUT).
+    (tmp_path / "out").mkdir()
+    for name, problem in [("../x", "holds a '/'"), (str(tmp_path / "abs"), "holds a '/'"), ("x\x00y", "control character")]:
+        with pytest.raises(facetfit.Error, match=problem):
+            facetfit.bake(GOLD, str(tmp_path / "out"), name=name, refine="none")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["bad.binary", "out"] and not any((tmp_path / "out").iterdir())
 
 
 def test_render_and_delta_e(gold_fit, tmp_path):
