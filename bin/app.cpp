@@ -41,6 +41,20 @@ CLI::Validator finite_in(double lo, double hi) {
       "FINITE in [" + CLI::detail::to_string(lo) + " - " + CLI::detail::to_string(hi) + "]");
 }
 
+CLI::Validator uint64_text() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        bool ok = !text.empty() && text.size() <= 20 && text.find_first_not_of("0123456789") == std::string::npos;
+        if (ok) {
+          errno = 0;
+          std::strtoull(text.c_str(), nullptr, 10);
+          ok = errno != ERANGE;
+        }
+        return ok ? "" : "'" + text + "' is not an integer in [0, 18446744073709551615]";
+      },
+      "UINT64");
+}
+
 void add_max_memory_option(CLI::App* cmd, std::uint64_t& bytes, const std::string& what) {
   cmd->add_option_function<std::string>(
          "--max-memory",

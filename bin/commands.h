@@ -41,6 +41,9 @@ std::optional<FitOptions> fit_options(const FitSettings& settings, int& status);
 // A check for a real-valued option: a finite number in [lo, hi] (CLI::Range lets NaN through: every
 // comparison with it is false).
 CLI::Validator finite_in(double lo, double hi);
+// A check for an unsigned 64-bit option: decimal digits only, within range (CLI11 takes "-1" and 2^64 and
+// wraps them).
+CLI::Validator uint64_text();
 
 // --max-memory SIZE ("4G", "512M"): what `what` may take (default half of the machine's memory); a bad size
 // is a usage error.

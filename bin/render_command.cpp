@@ -160,7 +160,7 @@ void add_render_command(CLI::App& app, Context& ctx) {
   cmd->add_option("--png", args->png, "Also write a display-referred sRGB PNG (OpenColorIO display transform)");
   cmd->add_option("--save-sky", args->save_sky, "Also write the built-in sky as a lat-long EXR (for other renderers)");
   cmd->add_option("--spp", args->spp, "Samples per pixel (default: the scene's)")->check(CLI::Range(1, 1 << 20));
-  cmd->add_option("--seed", args->seed, "Random seed (default: the scene's)");
+  cmd->add_option("--seed", args->seed, "Random seed (default: the scene's)")->check(uint64_text());
   cmd->add_option("--width", args->width, "Image width (default: the scene's)")->check(CLI::Range(1, 16384));
   cmd->add_option("--height", args->height, "Image height (default: the scene's)")->check(CLI::Range(1, 16384));
   add_max_memory_option(cmd, args->max_memory);

@@ -129,13 +129,15 @@ void run_report_command(const ReportArgs& args, Context& ctx) {
   o.force = args.force;
   o.bake.fit = *fit;
   o.bake.tolerance = args.tolerance;
-  if (std::sscanf(args.shard.c_str(), "%d/%d", &o.shard, &o.shards) != 2 || o.shards < 1 || o.shard < 1 || o.shard > o.shards) {
+  int used = 0;  // the whole text is K/N: "1/2/3" is not 1/2
+  if (std::sscanf(args.shard.c_str(), "%d/%d%n", &o.shard, &o.shards, &used) != 2 || used != int(args.shard.size()) || o.shards < 1 ||
+      o.shard < 1 || o.shard > o.shards) {
     report_error("--shard " + args.shard + ": must be K/N with 1 <= K <= N");
     status = 2;
     return;
   }
-  if (o.size < 8 || o.size > 4096 || o.spp < 1) {
-    report_error("--size must be in [8, 4096] and --spp at least 1");
+  if (o.size < 8 || o.size > 4096 || o.spp < 1 || o.spp > (1 << 20)) {
+    report_error("--size must be in [8, 4096] and --spp in [1, 1048576]");
     status = 2;
     return;
   }

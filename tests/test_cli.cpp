@@ -231,6 +231,14 @@ TEST(Cli, UsageErrors) {
   EXPECT_EQ(facetfit("fit builtin:gold-ggx-0.15 --smith wrong").status, 2);
   EXPECT_NE(facetfit("fit").status, 0);
   EXPECT_EQ(facetfit("fit builtin:gold-ggx-0.15 --resolution 1").status, 2);
+  // Values CLI11 or sscanf would have wrapped or cut short (issue 47).
+  for (const char* args : {"render --seed -1 -o x.exr", "render --seed 18446744073709551616 -o x.exr", "render --seed 1e3 -o x.exr",
+                           "render --max-memory 0x10G -o x.exr", "report builtin:gold-ggx-0.15 -o r --shard 1/2/3",
+                           "report builtin:gold-ggx-0.15 -o r --spp 2000000"}) {
+    const RunResult r = facetfit(args);
+    EXPECT_EQ(r.status, 2) << args << ": " << r.err;
+    EXPECT_EQ(lines(r.err), 1) << args << ": " << r.err;
+  }
   const RunResult fresnel = facetfit("bake builtin:gold-ggx-0.15 -o out --closure-fresnel f83");
   EXPECT_EQ(fresnel.status, 2);
   EXPECT_NE(fresnel.err.find("--closure-fresnel f83: must be f82 or schlick"), std::string::npos) << fresnel.err;

@@ -1374,7 +1374,7 @@ TEST(MemoryBudget, SizesParseAndRendersOverTheBudgetAreRefusedBeforeAllocating) 
   EXPECT_EQ(parse_byte_size("1.5GiB"), std::uint64_t(3) << 29);
   EXPECT_EQ(parse_byte_size("2KB"), 2048u);
   EXPECT_EQ(parse_byte_size("1000"), 1000u);
-  for (const char* bad : {"", "G", "-1G", "0", "1X", "nanG", "1e30T", "4 G"}) EXPECT_FALSE(parse_byte_size(bad)) << bad;
+  for (const char* bad : {"", "G", "-1G", "0", "1X", "nanG", "1e30T", "4 G", "0x10G", " 4G", "0x1p4M"}) EXPECT_FALSE(parse_byte_size(bad)) << bad;
   EXPECT_GT(default_memory_budget(), 0u);
 
   // An image over the budget: one line, before any buffer exists (16384^2 would take 15 GiB).

@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -21,6 +22,9 @@ std::optional<std::uint64_t> parse_byte_size(const std::string& text) {
   char* end = nullptr;
   const double value = std::strtod(text.c_str(), &end);
   if (end == text.c_str() || !std::isfinite(value) || value <= 0.0) return std::nullopt;
+  // A decimal number: strtod also reads hexadecimal ("0x10G" was 16 GiB) and skips leading spaces.
+  for (const char* c = text.c_str(); c != end; ++c)
+    if (!std::isdigit(static_cast<unsigned char>(*c)) && *c != '.' && *c != 'e' && *c != 'E' && *c != '+' && *c != '-') return std::nullopt;
   std::string unit(end);  // K, M, G or T, optionally followed by iB or B; or B; or nothing
   if (unit.size() >= 3 && unit.compare(unit.size() - 2, 2, "iB") == 0) unit.resize(unit.size() - 2);
   else if (unit.size() == 2 && unit.back() == 'B') unit.pop_back();

@@ -164,6 +164,7 @@ py::array_t<float> render_scene(const py::object& scene, int spp, std::uint64_t 
   } else {
     desc = parse_scene(py::str(py::module_::import("os").attr("fspath")(scene)).cast<std::string>());
   }
+  if (spp < 0 || spp > (1 << 20)) throw py::value_error("spp: must be in [1, 1048576], or 0 for the scene's");
   RenderSettings settings;
   settings.spp = spp;
   settings.seed = seed;
@@ -185,16 +186,23 @@ py::array_t<float> render_scene(const py::object& scene, int spp, std::uint64_t 
 py::tuple delta_e(const py::handle& a, const py::handle& b, const py::object& mask, bool a_display_referred, bool b_display_referred) {
   using FloatArray = py::array_t<float, py::array::c_style | py::array::forcecast>;
   const FloatArray fa = FloatArray::ensure(a), fb = FloatArray::ensure(b);
-  if (!fa || !fb || fa.ndim() != 3 || fb.ndim() != 3 || fa.shape(2) < 3 || fb.shape(2) < 3 || fa.shape(0) != fb.shape(0) ||
+  const auto rgb_or_rgba = [](const FloatArray& x) { return x.shape(2) == 3 || x.shape(2) == 4; };
+  if (!fa || !fb || fa.ndim() != 3 || fb.ndim() != 3 || !rgb_or_rgba(fa) || !rgb_or_rgba(fb) || fa.shape(0) != fb.shape(0) ||
       fa.shape(1) != fb.shape(1))
     throw py::value_error("delta_e: images must be (height, width, 3 or 4) arrays of the same size");
   const py::ssize_t h = fa.shape(0), w = fa.shape(1);
   const std::size_t pixels = std::size_t(h) * std::size_t(w);
-  const auto rgb = [pixels](const FloatArray& x) {
+  // A NaN or infinite pixel has no colour difference: refused, as `facetfit diff` refuses it.
+  const auto rgb = [pixels, w](const FloatArray& x, const char* name) {
     std::vector<float> v(pixels * 3);
     const py::ssize_t channels = x.shape(2);
     for (std::size_t p = 0; p < pixels; ++p)
-      for (int c = 0; c < 3; ++c) v[3 * p + c] = x.data()[p * std::size_t(channels) + c];
+      for (int c = 0; c < 3; ++c) {
+        v[3 * p + c] = x.data()[p * std::size_t(channels) + c];
+        if (!std::isfinite(v[3 * p + c]))
+          throw py::value_error(std::string("delta_e: ") + name + "[" + std::to_string(p / std::size_t(w)) + ", " +
+                                std::to_string(p % std::size_t(w)) + "] is NaN or infinite");
+      }
     return v;
   };
   std::vector<bool> keep(pixels, true);
@@ -204,7 +212,7 @@ py::tuple delta_e(const py::handle& a, const py::handle& b, const py::object& ma
     if (!m || m.ndim() != 2 || m.shape(0) != h || m.shape(1) != w) throw py::value_error("delta_e: mask must be a (height, width) array");
     for (std::size_t p = 0; p < pixels; ++p) keep[p] = m.data()[p];
   }
-  std::vector<float> va = rgb(fa), vb = rgb(fb);
+  std::vector<float> va = rgb(fa, "a"), vb = rgb(fb, "b");
   ImageDiff d;
   {
     py::gil_scoped_release release;

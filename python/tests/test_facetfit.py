@@ -238,6 +238,15 @@ def test_render_and_delta_e(gold_fit, tmp_path):
     assert dmap.shape == (48, 48) and mask.sum() > 500
     assert mean < 1.0 and worst >= mean
     assert facetfit.delta_e(truth, truth, mask)[1] == 0.0
+    # Issue 47: NaN pixels gave 71.4 and five channels were taken; -1 samples per pixel was accepted.
+    broken = truth.copy()
+    broken[3, 5, 1] = np.nan
+    with pytest.raises(ValueError, match=r"b\[3, 5\] is NaN or infinite"):
+        facetfit.delta_e(truth, broken, mask)
+    with pytest.raises(ValueError, match="3 or 4"):
+        facetfit.delta_e(np.zeros((48, 48, 5), np.float32), truth)
+    with pytest.raises(ValueError, match="spp"):
+        facetfit.render(scene, spp=-1)
     # The memory budget is checked before allocating: one line, nothing rendered.
     big = dict(scene, camera=dict(scene["camera"], width=16384, height=16384))
     with pytest.raises(facetfit.Error, match="over the memory budget of 1.0 GiB"):
