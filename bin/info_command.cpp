@@ -67,8 +67,9 @@ void print_closures(const Closures& c, double error, bool fitted) {
 
 void print_info(const Lut& lut) {
   const LutMetadata& m = lut.meta;
-  std::printf("source          %s\nsource_sha256   %s\nfacetfit        %s (LUT format %d)\n", m.source.c_str(),
-              m.source_sha256.c_str(), m.facetfit_version.c_str(), m.format_version);
+  // The file's strings as printable ASCII: a newline or a terminal escape in an edited LUT stays text.
+  std::printf("source          %s\nsource_sha256   %s\nfacetfit        %s (LUT format %d)\n", excerpt(m.source, 4096).c_str(),
+              excerpt(m.source_sha256, 64).c_str(), excerpt(m.facetfit_version, 64).c_str(), m.format_version);
   std::printf("fit             resolution %d, smith %s, %d iterations, residual %.2e\n", m.resolution, to_string(m.smith),
               m.iterations, m.residual);
   std::printf("alpha_ggx       %.5f   (NDF error %.4f)\nalpha_beckmann  %.5f   (NDF error %.4f)\n", m.alpha_ggx,

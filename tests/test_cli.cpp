@@ -10,7 +10,9 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "fit/fit.h"
 #include "io/merl.h"
+#include "lut/lut.h"
 #include "io/utia.h"
 #include "model/analytic.h"
 #include "support/tensor_file.h"
@@ -81,6 +83,19 @@ TEST(Cli, WithoutThePluginCoreCommandsRunAndOthersFailInOneLine) {
   EXPECT_EQ(bake.status, 1);
   EXPECT_EQ(lines(bake.err), 1) << bake.err;
   EXPECT_NE(bake.err.find("facetfit: error: cannot load the command plugin facetfit-commands.so"), std::string::npos) << bake.err;
+}
+
+// A LUT's source holding a newline and a terminal escape (an edited file): info prints them as text
+// (issue 47: they reached the terminal).
+TEST(Cli, InfoPrintsMetadataAsText) {
+  TempDir dir;
+  const Fitter fitter{FitOptions::paper()};
+  write_lut(dir.file("evil.exr"), make_lut(fitter.fit(MerlTable::tabulate(LambertBrdf(Rgb(0.5)))), fitter.quadrature(),
+                                           "evil\x1b[2J\nforged line", "x", 0.02, false));
+  const RunResult r = facetfit("info " + dir.file("evil.exr"));
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.out.find('\x1b'), std::string::npos);
+  EXPECT_NE(r.out.find("source          evil?[2J?forged line\n"), std::string::npos) << r.out;
 }
 
 TEST(Cli, InfoOnAMeasurementSaysWhatToRun) {

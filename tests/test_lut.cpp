@@ -437,6 +437,19 @@ TEST(Lut, BadFilesGetOneClearLine) {
     const std::string e = error_of([&] { read_lut(file); });
     EXPECT_NE(e.find(falls ? "row 8, column 11: the sampling CDF falls" : "row 8: the sampling CDF must run from 0 to 1"), std::string::npos) << e;
   }
+  // A negative Fresnel reflectance (issue 47: accepted, it rendered negative pixels).
+  {
+    auto in = OIIO::ImageInput::open(dir.file("good.exr"));
+    OIIO::ImageSpec spec = in->spec();
+    std::vector<float> px(std::size_t(spec.width) * std::size_t(spec.height) * std::size_t(spec.nchannels));
+    ASSERT_TRUE(in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, px.data()));
+    px[(std::size_t(LutLayout::kFresnelRow) * std::size_t(spec.width) + 7) * std::size_t(spec.nchannels) + 1] = -0.25f;
+    auto out = OIIO::ImageOutput::create(dir.file("negative-fresnel.exr"));
+    ASSERT_TRUE(out->open(dir.file("negative-fresnel.exr"), spec) && out->write_image(OIIO::TypeDesc::FLOAT, px.data()) && out->close());
+  }
+  const std::string fresnel = error_of([&] { read_lut(dir.file("negative-fresnel.exr")); });
+  EXPECT_NE(fresnel.find("row " + std::to_string(LutLayout::kFresnelRow) + ", column 7: the Fresnel reflectance must be >= 0"), std::string::npos)
+      << fresnel;
 }
 
 }  // namespace

@@ -345,7 +345,7 @@ void validate(const std::string& path, const LutMetadata& m) {
   for (const auto& [name, v] : {std::pair{"tolerance", m.tolerance}, {"residual", m.residual}, {"error", m.error},
                                 {"error_ggx", m.error_ggx}, {"error_beckmann", m.error_beckmann}, {"error_lsq", m.error_lsq},
                                 {"error_extraction", m.error_extraction}, {"ndf_error_ggx", m.ndf_error_ggx},
-                                {"ndf_error_beckmann", m.ndf_error_beckmann}})
+                                {"ndf_error_beckmann", m.ndf_error_beckmann}, {"anisotropic_ggx_error", m.anisotropic_ggx.error}})
     in_range(name, v, 0.0, 1e30);
 }
 
@@ -459,6 +459,14 @@ Lut read_lut(const std::string& path) {
     return double(v);
   };
 
+  // A Fresnel row's reflectance: a negative one (an edited file) would render negative pixels.
+  const auto reflectance = [&](int row, int x) {
+    const Rgb f(get(row, x, 0), get(row, x, 1), get(row, x, 2));
+    if (!(f.r >= 0.0 && f.g >= 0.0 && f.b >= 0.0))
+      fail(path, "row " + std::to_string(row) + ", column " + std::to_string(x) + ": the Fresnel reflectance must be >= 0");
+    return f;
+  };
+
   const int nodes = m.resolution + 1;
   TabulatedNdf& ndf = lut.tables.ndf;
   ndf.grid = ThetaGrid{m.resolution};
@@ -470,9 +478,7 @@ Lut read_lut(const std::string& path) {
       fail(path, "rows " + std::to_string(LutLayout::kNdfRow) + " and " + std::to_string(LutLayout::kSigmaRow) + ", column " +
                      std::to_string(x) + ": D must be >= 0 and sigma > 0");
   }
-  for (int x = 0; x < FresnelCurve::kSize; ++x)
-    lut.tables.fresnel.value[std::size_t(x)] = Rgb(get(LutLayout::kFresnelRow, x, 0), get(LutLayout::kFresnelRow, x, 1),
-                                                   get(LutLayout::kFresnelRow, x, 2));
+  for (int x = 0; x < FresnelCurve::kSize; ++x) lut.tables.fresnel.value[std::size_t(x)] = reflectance(LutLayout::kFresnelRow, x);
   lut.tables.smith = m.smith;
   lut.tables.body = m.body;
   lut.tables.body_exponent = m.body_exponent;
@@ -497,8 +503,7 @@ Lut read_lut(const std::string& path) {
     a.grid = ThetaGrid{m.anisotropic_resolution};
     a.phi_count = m.anisotropic_phi_count;
     a.smith = m.smith;
-    for (int x = 0; x < FresnelCurve::kSize; ++x)
-      a.fresnel.value[std::size_t(x)] = Rgb(get(layout.anisotropic_row, x, 0), get(layout.anisotropic_row, x, 1), get(layout.anisotropic_row, x, 2));
+    for (int x = 0; x < FresnelCurve::kSize; ++x) a.fresnel.value[std::size_t(x)] = reflectance(layout.anisotropic_row, x);
     for (int x = 0; x <= m.anisotropic_resolution; ++x)
       for (int p = 0; p < a.phi_count; ++p) {
         a.ndf.push_back(get(layout.anisotropic_row + 1 + p, x, 0));
