@@ -45,6 +45,12 @@ TEST_P(CliBadFile, OneClearLine) {
     std::memset(bytes.data() + 12 + 8 * 1000, 0xff, 8);  // all ones: a NaN
     test::write_bytes(path, bytes);
   }
+  if (name == "big.binary") {  // a single 1e308, finite as a double, not as the table's float (issue 47)
+    std::string bytes = test::merl_header(90, 90, 180) + std::string(3 * MerlTable::kBins * 8, '\0');
+    const double big = 1e308;
+    std::memcpy(bytes.data() + 12 + 8 * 1000, &big, 8);
+    test::write_bytes(path, bytes);
+  }
   if (name == "folder.binary") std::filesystem::create_directory(path);
   const RunResult r = facetfit("fit " + path);
   EXPECT_EQ(r.status, 1);
@@ -58,7 +64,8 @@ INSTANTIATE_TEST_SUITE_P(
     testing::Values(std::make_pair("missing.binary", "no such file"), std::make_pair("empty.binary", "file is empty"),
                     std::make_pair("truncated.binary", "truncated"), std::make_pair("dims.binary", "90 x 90 x 90"),
                     std::make_pair("huge.binary", "1000 x 1000 x 1000"),
-                    std::make_pair("nan.binary", "NaN at byte offset 8012"), std::make_pair("folder.binary", "is a folder")),
+                    std::make_pair("nan.binary", "NaN at byte offset 8012"),
+                    std::make_pair("big.binary", "1e+308 (out of float's range) at byte offset 8012"), std::make_pair("folder.binary", "is a folder")),
     [](const testing::TestParamInfo<std::pair<std::string, std::string>>& param) {
       return param.param.first.substr(0, param.param.first.find('.'));
     });

@@ -960,6 +960,20 @@ TEST(Render, LargeScenesParseWhole) {
   EXPECT_NE(test::error_of([&] { parse_scene_text(nested(32), "deep.json", "."); }).find("deep.json: not a JSON object"), std::string::npos);
 }
 
+// Radiance past a float (an environment of 1e30 scaled by 1e30): refused, naming the pixel, where it wrote
+// infinite pixels with success (issue 47); the same scene at scale 1 renders.
+TEST(Render, RadiancePastAFloatIsRefused) {
+  const auto scene = [](double scale) {
+    return parse_scene_text(R"({"camera": {"width": 8, "height": 8}, "render": {"spp": 1},
+        "environment": {"constant": [1e30, 1e30, 1e30], "scale": )" + std::to_string(scale) + R"(},
+        "materials": {"m": {"type": "lambert"}}, "objects": [{"type": "sphere", "material": "m"}]})",
+                            "bright.json", ".");
+  };
+  EXPECT_NE(test::error_of([&] { render(scene(1e30)); }).find("bright.json: pixel (0, 0) is brighter than an image holds"), std::string::npos);
+  const RenderedImage image = render(scene(1.0));
+  EXPECT_TRUE(std::all_of(image.rgba.begin(), image.rgba.end(), [](float v) { return std::isfinite(v); }));
+}
+
 TEST(Render, BadScenesGetOneClearLine) {
   test::TempDir dir;
   test::write_bytes(dir.file("a.json"), R"({"objects": [{"type": "sphere", "material": "nope"}]})");

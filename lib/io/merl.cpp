@@ -172,7 +172,7 @@ MerlTable MerlTable::read(const std::string& path, BinPoint at) {
 #pragma omp simd reduction(+ : nonfinite)
       for (std::size_t k = t; k < end; ++k) {
         const double x = buf[k];
-        nonfinite += (x - x == 0.0) ? 0 : 1;  // NaN and Inf give NaN
+        nonfinite += (x - x == 0.0 && x * scale <= kMaxValue) ? 0 : 1;  // NaN and Inf give NaN
         out[k] = x < 0.0 ? kMissing : float(x * scale);
       }
       t = end;
@@ -189,11 +189,13 @@ MerlTable MerlTable::read(const std::string& path, BinPoint at) {
     if (::pread(fd, buf.data(), n * sizeof(double), off_t(sizeof dims + first * sizeof(double))) != ssize_t(n * sizeof(double)))
       fail(path, "read error (file changed while reading?)");
     for (std::size_t t = 0; t < n; ++t) {
-      if (std::isfinite(buf[t])) continue;
       const std::size_t c = (first + t) / kBins, bin = (first + t) % kBins;
+      if (std::isfinite(buf[t]) && buf[t] * kScale[c] <= kMaxValue) continue;
       const std::size_t offset = sizeof dims + (first + t) * sizeof(double);
       const int k = int(bin % kPhiD), j = int(bin / kPhiD % kThetaD), i = int(bin / (kPhiD * kThetaD));
-      fail(path, std::string(std::isnan(buf[t]) ? "NaN" : "Inf") + " at byte offset " + std::to_string(offset) + " (" +
+      char value[32];
+      std::snprintf(value, sizeof value, "%g", buf[t]);
+      fail(path, std::string(std::isnan(buf[t]) ? "NaN" : std::isinf(buf[t]) ? "Inf" : std::string(value) + " (out of float's range)") + " at byte offset " + std::to_string(offset) + " (" +
                      channel_name(int(c)) + " channel, bin theta_h " + std::to_string(i) + ", theta_d " + std::to_string(j) +
                      ", phi_d " + std::to_string(k) + ")");
     }

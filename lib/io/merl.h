@@ -10,6 +10,7 @@
 
 #include <cmath>
 #include <cstddef>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -29,6 +30,8 @@ class MerlTable final : public Brdf {
   static constexpr std::size_t kFileBytes = 3 * sizeof(int) + 3 * kBins * sizeof(double);
   // MERL's reference reader multiplies the stored doubles by these.
   static constexpr double kScale[3] = {1.0 / 1500.0, 1.15 / 1500.0, 1.66 / 1500.0};
+  // The largest value, scaled, a table holds: its float (beyond it, a value read as infinite).
+  static constexpr double kMaxValue = double(std::numeric_limits<float>::max());
 
   // How eval() reads between bins. The fit never calls eval(): it reads the bins themselves.
   enum class Lookup {

@@ -5,6 +5,7 @@
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
@@ -523,6 +524,15 @@ RenderedImage render(const SceneDesc& desc, const RenderSettings& settings) {
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, accum.size(), 1 << 14), [&](const tbb::blocked_range<std::size_t>& part) {
     for (std::size_t k = part.begin(); k < part.end(); ++k) image.rgba[k] = float(accum[k] / done);
   });
+  // A radiance past float's range (lights or an environment scaled to 1e30 and more) is refused, never
+  // written as an infinite pixel.
+  const auto overflow = std::find_if(image.rgba.begin(), image.rgba.end(), [](float v) { return !std::isfinite(v); });
+  if (overflow != image.rgba.end()) {
+    const std::size_t p = std::size_t(overflow - image.rgba.begin()) / 4;
+    fail(desc.source.empty() ? "render" : desc.source,
+         "pixel (" + std::to_string(p % std::size_t(width)) + ", " + std::to_string(p / std::size_t(width)) +
+             ") is brighter than an image holds (a float): the lights or the environment are too bright");
+  }
   image.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return image;
 }
