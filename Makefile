@@ -12,20 +12,24 @@ FUZZ_SECONDS ?= 600
 JOBS       ?= $(shell nproc)
 CMAKE_GEN  := -G Ninja
 
-.PHONY: all deps build demo test asan fuzz-build fuzz osl-host mitsuba-host python osl-docs bench accuracy clean
+.PHONY: all deps configure build demo test asan fuzz-build fuzz osl-host mitsuba-host python osl-docs bench accuracy clean
 
 all: build
 
 deps:
 	@scripts/install-deps.sh
 
-build: deps
+configure: deps
 	@cmake -S . -B $(BUILD) $(CMAKE_GEN) -DCMAKE_BUILD_TYPE=Release -DFACETFIT_WERROR=ON \
 	  -DFACETFIT_BPY_PYTHON=$(CURDIR)/$(BPY_VENV)/bin/python -DFACETFIT_MITSUBA_PYTHON=$(CURDIR)/$(MITSUBA_VENV)/bin/python \
 	  -DFACETFIT_PY_PYTHON=$(CURDIR)/$(PY_VENV)/bin/python >/dev/null
+
+build: configure
 	@cmake --build $(BUILD) -j $(JOBS)
 
-demo: build
+# The demo builds the command alone (and its plugin), not the tests and benchmarks.
+demo: configure
+	@cmake --build $(BUILD) -j $(JOBS) --target facetfit_cli
 	$(BUILD)/bin/facetfit fit --builtin
 	$(BUILD)/bin/facetfit bake builtin: -o out/luts
 	@echo "LUTs: $(CURDIR)/out/luts (index: out/luts/index.json; inspect one with: $(BUILD)/bin/facetfit info out/luts/gold-ggx-0.15.exr)"
