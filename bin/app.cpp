@@ -1,12 +1,14 @@
 // The facetfit command line: the app every command registers on, and the settings they share.
 #include <tbb/global_control.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <iostream>
 #include <memory>
+#include <vector>
 
 #include "commands.h"
 #include "core/error.h"
@@ -124,6 +126,58 @@ std::optional<FitOptions> fit_options(const FitSettings& s, int& status) {
   return options;
 }
 
+namespace {
+
+// The edit distance of two short words (insertions, deletions, substitutions).
+std::size_t edit_distance(const std::string& a, const std::string& b) {
+  std::vector<std::size_t> row(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    std::size_t diagonal = row[0];
+    row[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const std::size_t above = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diagonal = above;
+    }
+  }
+  return row[b.size()];
+}
+
+const CLI::App* find_command(const CLI::App& app, const std::string& name) {
+  for (const CLI::App* sub : app.get_subcommands({}))
+    if (sub->check_name(name)) return sub;
+  return nullptr;
+}
+
+// Where a usage error points: the command's own help, or for a word that is no command, the nearest one.
+std::string usage_hint(const CLI::App& app, const std::string& word) {
+  if (word.empty() || word[0] == '-') return "see facetfit --help";
+  if (find_command(app, word) == nullptr) {
+    std::string nearest;
+    std::size_t best = 3;  // suggest within two edits
+    for (const CLI::App* sub : app.get_subcommands({}))
+      if (const std::size_t d = edit_distance(word, sub->get_name()); d < best) best = d, nearest = sub->get_name();
+    return nearest.empty() ? "see facetfit --help" : "did you mean 'facetfit " + nearest + "'?";
+  }
+  return "see facetfit " + word + " --help";
+}
+
+}  // namespace
+
+std::string command_word(int argc, char** argv) {
+  for (int k = 1; k < argc; ++k) {
+    const std::string arg = argv[k];
+    if (arg == "--threads") {
+      ++k;
+      continue;
+    }
+    if (arg.rfind("--threads=", 0) == 0 || arg == "-q" || arg == "--quiet" || arg == "-v" || arg == "--verbose") continue;
+    return arg;
+  }
+  return "";
+}
+
 int run_app(int argc, char** argv, void (*register_more)(CLI::App& app, Context& ctx)) {
   CLI::App app{"facetfit: measured BRDFs to microfacet components (Dupuy et al. 2015, power iterations)", "facetfit"};
   app.require_subcommand(1);
@@ -145,13 +199,21 @@ int run_app(int argc, char** argv, void (*register_more)(CLI::App& app, Context&
   add_convert_command(app, ctx);
   add_builtins_command(app, ctx);
   if (register_more) register_more(app, ctx);
+  // `facetfit help [COMMAND]` is --help.
+  if (argc >= 2 && std::string(argv[1]) == "help") {
+    const CLI::App* sub = argc >= 3 ? find_command(app, argv[2]) : nullptr;
+    std::cout << (sub ? sub->help() : app.help());
+    return 0;
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     // Help and --version exit 0; every usage error exits 2, as bin/commands.h promises, with one line in
     // the command's error style.
     if (e.get_exit_code() == static_cast<int>(CLI::ExitCodes::Success)) return app.exit(e);
-    report_error(std::string(e.what()) + " (see facetfit --help)");
+    const std::string word = command_word(argc, argv);
+    const bool unknown = !word.empty() && word[0] != '-' && find_command(app, word) == nullptr;
+    report_error((unknown ? "unknown command '" + word + "'" : std::string(e.what())) + " (" + usage_hint(app, word) + ")");
     return 2;
   } catch (const facetfit::Error& e) {
     report_error(e.what());

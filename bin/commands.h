@@ -71,5 +71,7 @@ void report_error(const std::string& message);
 int run_app(int argc, char** argv, void (*register_more)(CLI::App& app, Context& ctx));
 // Whether a subcommand is one of the core commands, which need no image I/O, colour or ray tracing.
 bool is_core_command(const std::string& name);
+// The command the command line names: its first argument past -q, -v and --threads N ("" for none).
+std::string command_word(int argc, char** argv);
 
 }  // namespace facetfit::cli

@@ -17,19 +17,6 @@
 namespace {
 
 // The subcommand named on the command line (after the global --threads N, -q and -v), or "".
-std::string subcommand(int argc, char** argv) {
-  for (int k = 1; k < argc; ++k) {
-    const std::string arg = argv[k];
-    if (arg == "--threads") {
-      ++k;
-      continue;
-    }
-    if (arg.rfind("--threads=", 0) == 0 || arg == "-q" || arg == "--quiet" || arg == "-v" || arg == "--verbose") continue;
-    return arg;
-  }
-  return "";
-}
-
 // The plugin beside the executable (the build tree) or in ../lib/facetfit (an installed tree).
 std::vector<std::filesystem::path> plugin_candidates() {
   std::error_code error;
@@ -43,7 +30,7 @@ std::vector<std::filesystem::path> plugin_candidates() {
 
 int main(int argc, char** argv) {
   using namespace facetfit::cli;
-  const std::string command = subcommand(argc, argv);
+  const std::string command = command_word(argc, argv);
   if (command == "--version" || is_core_command(command)) return run_app(argc, argv, nullptr);
   std::string errors;
   for (const std::filesystem::path& path : plugin_candidates()) {

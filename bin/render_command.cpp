@@ -164,7 +164,8 @@ void add_render_command(CLI::App& app, Context& ctx) {
   cmd->add_option("--width", args->width, "Image width (default: the scene's)")->check(CLI::Range(1, 16384));
   cmd->add_option("--height", args->height, "Image height (default: the scene's)")->check(CLI::Range(1, 16384));
   add_max_memory_option(cmd, args->max_memory);
-  cmd->add_option("--material", args->material, "Default scene only: the sphere's material file")->capture_default_str();
+  cmd->add_option("--material", args->material, "Default scene only: the sphere's material file (a LUT .exr renders as lut "
+                  "unless --material-type says otherwise)")->capture_default_str();
   cmd->add_option("--material-type", args->material_type, "Default scene only: measured, lut, ggx, beckmann, lsq or closures (a measurement is baked first for the last five), "
                   "analytic (a built-in's analytic model) or lambert (albedo 0.8)")
       ->check(CLI::IsMember({"measured", "lut", "ggx", "beckmann", "lsq", "closures", "analytic", "lambert"}))
@@ -176,6 +177,8 @@ void add_render_command(CLI::App& app, Context& ctx) {
       ctx.status = 2;
       return;
     }
+    // A baked LUT named without a type renders as the tabulated model (a measurement's is "measured").
+    if (cmd->count("--material-type") == 0 && std::filesystem::path(args->material).extension() == ".exr") args->material_type = "lut";
     run_render(*args, ctx);
   });
 }

@@ -299,6 +299,15 @@ TEST(RenderCli, DefaultMaterialAsEveryRepresentation) {
     EXPECT_EQ(r.status, 0) << type << ": " << r.err;
     EXPECT_TRUE(std::filesystem::exists(dir.file(std::string(type) + ".exr"))) << type;
   }
+  // A LUT named without a type is rendered as one (issue 48: "unsupported format '.exr'"), the same image
+  // as --material-type lut.
+  ASSERT_EQ(facetfit("bake builtin:gold-ggx-0.15 -o " + dir.file("luts")).status, 0);
+  const std::string lut = " --material " + dir.file("luts/gold-ggx-0.15.exr") + " --width 16 --height 16 --spp 2 -o ";
+  const RunResult inferred = facetfit("render" + lut + dir.file("inferred.exr"));
+  ASSERT_EQ(inferred.status, 0) << inferred.err;
+  ASSERT_EQ(facetfit("render --material-type lut" + lut + dir.file("typed.exr")).status, 0);
+  const RunResult same = facetfit("diff " + dir.file("inferred.exr") + " " + dir.file("typed.exr"));
+  EXPECT_NE(same.out.find("mean 0.000000"), std::string::npos) << same.out;
 }
 
 }  // namespace

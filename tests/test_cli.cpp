@@ -261,6 +261,16 @@ TEST(Cli, UsageErrors) {
     EXPECT_EQ(r.status, 2) << args << ": " << r.err;
     EXPECT_EQ(lines(r.err), 1) << args << ": " << r.err;
   }
+  // Usage errors point to the command's help, and a mistyped command to the nearest one (issue 48).
+  const RunResult typo = facetfit("rendr -o x.exr");
+  EXPECT_EQ(typo.status, 2);
+  EXPECT_NE(typo.err.find("unknown command 'rendr' (did you mean 'facetfit render'?)"), std::string::npos) << typo.err;
+  const RunResult jobs = facetfit("bake --jobs 0 builtin:gold-ggx-0.15 -o out");
+  EXPECT_EQ(jobs.status, 2);
+  EXPECT_NE(jobs.err.find("(see facetfit bake --help)"), std::string::npos) << jobs.err;
+  const RunResult help = facetfit("help render");
+  EXPECT_EQ(help.status, 0);
+  EXPECT_NE(help.out.find("--material-type"), std::string::npos) << help.out;
   const RunResult fresnel = facetfit("bake builtin:gold-ggx-0.15 -o out --closure-fresnel f83");
   EXPECT_EQ(fresnel.status, 2);
   EXPECT_NE(fresnel.err.find("--closure-fresnel f83: must be f82 or schlick"), std::string::npos) << fresnel.err;
