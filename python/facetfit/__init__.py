@@ -6,7 +6,7 @@ directions have shape (..., 3); one of the two may be a single vector. Errors in
 :class:`facetfit.Error` with one line naming the input. See docs/python.md.
 """
 from ._facetfit import (Error, Fit, Lut, Measurement, Model, __version__, bake, builtins, delta_e, fit, load,
-                        material, read_lut, render)
+                        material, read_lut, render, write_image)
 
 __all__ = ["Error", "Fit", "Lut", "Measurement", "Model", "__version__", "bake", "builtins", "delta_e", "fit", "load",
-           "material", "read_lut", "render"]
+           "material", "read_lut", "render", "write_image"]

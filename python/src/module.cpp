@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <functional>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -223,6 +224,29 @@ py::tuple delta_e(const py::handle& a, const py::handle& b, const py::object& ma
   return py::make_tuple(map, d.mean, d.max);
 }
 
+// A render's image, (height, width, 3 or 4) scene-linear float, as a linear EXR (alpha 1 where it has none)
+// or a display-referred sRGB PNG, as `facetfit render -o` and `--png` write them.
+void write_image(const std::string& path, const py::handle& image) {
+  using FloatArray = py::array_t<float, py::array::c_style | py::array::forcecast>;
+  const FloatArray a = FloatArray::ensure(image);
+  if (!a || a.ndim() != 3 || (a.shape(2) != 3 && a.shape(2) != 4) || a.shape(0) < 1 || a.shape(1) < 1)
+    throw py::value_error("write_image: image must be a (height, width, 3 or 4) array");
+  const int height = int(a.shape(0)), width = int(a.shape(1)), channels = int(a.shape(2));
+  const float* px = a.data();
+  if (!std::all_of(px, px + a.size(), [](float v) { return std::isfinite(v); }))
+    throw py::value_error("write_image: the image holds NaN or infinite values");
+  const std::string ext = std::filesystem::path(path).extension().string();
+  py::gil_scoped_release release;
+  if (ext == ".png") return write_display_png(path, px, width, height, channels, DisplayTransform());
+  if (ext != ".exr") throw py::value_error("write_image: " + path + ": must end in .exr or .png");
+  RenderedImage out;
+  out.width = width, out.height = height;
+  out.rgba.resize(std::size_t(width) * std::size_t(height) * 4, 1.0f);
+  for (std::size_t p = 0; p < std::size_t(width) * std::size_t(height); ++p)
+    for (int c = 0; c < channels; ++c) out.rgba[4 * p + std::size_t(c)] = px[std::size_t(channels) * p + std::size_t(c)];
+  write_exr(path, out, {});
+}
+
 py::array_t<double> fresnel_array(const FresnelCurve& f) {
   py::array_t<double> a({py::ssize_t(FresnelCurve::kSize), py::ssize_t(3)});
   for (int j = 0; j < FresnelCurve::kSize; ++j)
@@ -406,26 +430,47 @@ PYBIND11_MODULE(_facetfit, m) {
         o.force = force;
         o.tolerance = tolerance;
         o.with_sampling = sampling;
-        if (name.empty()) name = source_name(source);
-        BakeOutcome r;
-        {
-          py::gil_scoped_release release;
-          r = bake_material(source, name, out_dir, o, Fitter(o.fit));
-        }
-        if (r.status == BakeOutcome::Status::failed) throw Error(r.error);
-        py::dict d = to_python(r.record);
-        d["status"] = r.status == BakeOutcome::Status::baked ? "baked" : "cached";
-        return d;
+        std::error_code ec;
+        std::filesystem::create_directories(out_dir, ec);  // as the command does
+        if (!std::filesystem::is_directory(out_dir)) throw Error(out_dir + ": cannot create output folder" + (ec ? ": " + ec.message() : ""));
+        const std::vector<std::string> sources = expand_inputs({source});
+        const bool batch = sources.size() != 1 || sources.front() != source;  // a folder, a glob or builtin:
+        if (batch && !name.empty()) throw py::value_error("name: for one source, not a folder or glob of them");
+        const Fitter fitter(o.fit);
+        const auto bake_one = [&](const std::string& s, const std::string& n) {
+          BakeOutcome r;
+          {
+            py::gil_scoped_release release;
+            r = bake_material(s, n, out_dir, o, fitter);
+          }
+          if (r.status == BakeOutcome::Status::failed) {
+            if (!batch) throw Error(r.error);
+            return py::dict(py::arg("source") = s, py::arg("status") = "failed", py::arg("error") = r.error);
+          }
+          py::dict d = to_python(r.record);
+          d["status"] = r.status == BakeOutcome::Status::baked ? "baked" : "cached";
+          return d;
+        };
+        if (!batch) return py::object(bake_one(source, name.empty() ? source_name(source) : name));
+        // A batch goes on past a bad file, as the command does: its entry says "failed" and why.
+        py::list out;
+        for (const std::string& s : sources) out.append(bake_one(s, source_name(s)));
+        return py::object(out);
       },
       py::arg("source"), py::arg("out_dir"), py::arg("name") = "", py::arg("force") = false, py::arg("tolerance") = 0.02,
       py::arg("sampling") = true, py::arg("refine") = "full", py::arg("resolution") = 90, py::arg("smith") = "correlated",
       py::arg("merl_bins") = "start", py::arg("closure_fresnel") = "f82",
-      "Bakes OUT_DIR/NAME.exr and its JSON sidecar as `facetfit bake` does (cached by content); returns the sidecar.");
+      "Bakes OUT_DIR/NAME.exr and its JSON sidecar as `facetfit bake` does (cached by content, OUT_DIR created); "
+      "returns the sidecar, or for a folder, glob or 'builtin:' a list of them (a failed one as {source, status: "
+      "'failed', error}).");
 
   m.def("render", &render_scene, py::arg("scene"), py::arg("spp") = 0, py::arg("seed") = 0, py::arg("max_memory") = "",
         "Renders a scene (a path, or a dict as in docs/scene-format.md; relative files against the current folder): "
         "(height, width, 4) float32, linear Rec.709 RGB and coverage. max_memory ('4G', '512M'; default half of the "
         "machine's) bounds the image and environment map, checked before allocating.");
+  m.def("write_image", &write_image, py::arg("path"), py::arg("image"),
+        "Writes a (height, width, 3 or 4) scene-linear image: .exr as it is (linear Rec.709, float), .png through the "
+        "display transform (8-bit sRGB), each through a temporary file.");
   m.def("delta_e", &delta_e, py::arg("a"), py::arg("b"), py::arg("mask") = py::none(), py::arg("a_display_referred") = false,
         py::arg("b_display_referred") = false,
         "CIE Delta E 2000 per pixel through the display chain (docs/colour.md): (map, mean, max) over the mask.");

@@ -201,6 +201,37 @@ def test_bake_caches(tmp_path):
     assert os.path.exists(tmp_path / "gold-ggx-0.15.exr")
 
 
+def test_bake_takes_what_the_command_takes(tmp_path):
+    """Issue 48: a folder (the command bakes it; Python said it held no supported file) and a missing output
+    folder (created, not 'cannot lock'); a batch goes on past a bad file."""
+    src = tmp_path / "src"
+    src.mkdir()
+    (src / "bad.binary").write_bytes(b"\x01")
+    rgl = os.path.join(RGL_DIR, "paper_white_rgb.bsdf")
+    if os.path.exists(rgl):
+        os.symlink(rgl, src / "paper.bsdf")
+    records = facetfit.bake(str(src), str(tmp_path / "new" / "luts"), refine="none")
+    assert records[0]["status"] == "failed" and "bad.binary" in records[0]["error"]
+    if os.path.exists(rgl):
+        assert records[1]["status"] == "baked" and (tmp_path / "new" / "luts" / "paper.exr").exists()
+    with pytest.raises(ValueError, match="name"):
+        facetfit.bake(str(src), str(tmp_path / "x"), name="one")
+    records = facetfit.bake("builtin:", str(tmp_path / "all"), refine="none", sampling=False)
+    assert len(records) == len(facetfit.builtins()) and all(r["status"] == "baked" for r in records)
+
+
+def test_write_image(tmp_path):
+    image = facetfit.render({"camera": {"width": 16, "height": 12}, "materials": {"m": {"type": "lambert"}},
+                             "objects": [{"type": "sphere", "material": "m"}]}, spp=2)
+    facetfit.write_image(str(tmp_path / "a.exr"), image)
+    facetfit.write_image(str(tmp_path / "a.png"), image[..., :3])
+    assert (tmp_path / "a.exr").stat().st_size > 0 and (tmp_path / "a.png").stat().st_size > 0
+    with pytest.raises(ValueError, match=".exr or .png"):
+        facetfit.write_image(str(tmp_path / "a.tif"), image)
+    with pytest.raises(ValueError, match="NaN"):
+        facetfit.write_image(str(tmp_path / "b.exr"), np.full((2, 2, 3), np.nan, np.float32))
+
+
 def test_bad_inputs_raise_one_line(tmp_path):
     bad = tmp_path / "bad.binary"
     bad.write_bytes(b"\x01\x02")
