@@ -58,6 +58,26 @@ TEST(Report, TwoInputsOfOneNameAreNotTwoRows) {
             std::string::npos);
 }
 
+// Folders of a report that are symbolic links are not followed (issue 47: its writes and clean-up went
+// outside the report): a material's image folder fails that material, the luts folder the report.
+TEST(Report, SymlinkedFoldersAreNotFollowed) {
+  TempDir dir;
+  std::filesystem::create_directories(dir.path() / "outside");
+  std::filesystem::create_directories(dir.path() / "out" / "images");
+  std::filesystem::create_directory_symlink(dir.path() / "outside", dir.path() / "out" / "images" / "gold-ggx-0.15");
+  ReportOptions o = small(dir.file("out"));
+  o.inputs = {"builtin:gold-ggx-0.15"};
+  const json r = run_report(o);
+  ASSERT_EQ(r["failures"].size(), 1u);
+  EXPECT_NE(r["failures"][0]["error"].get<std::string>().find("gold-ggx-0.15: is a symbolic link"), std::string::npos) << r["failures"];
+  EXPECT_TRUE(std::filesystem::is_empty(dir.path() / "outside"));
+  std::filesystem::create_directory_symlink(dir.path() / "outside", dir.path() / "out2-luts");
+  std::filesystem::create_directories(dir.path() / "out2");
+  std::filesystem::rename(dir.path() / "out2-luts", dir.path() / "out2" / "luts");
+  EXPECT_NE(test::error_of([&] { run_report(small(dir.file("out2"))); }).find("luts: is a symbolic link"), std::string::npos);
+  EXPECT_TRUE(std::filesystem::is_empty(dir.path() / "outside"));
+}
+
 json read_json(const std::string& path) {
   std::ifstream in(path);
   return json::parse(in);
@@ -178,6 +198,16 @@ TEST(Report, ShardsMergeIntoTheWholeReport) {
             std::string::npos);
   EXPECT_FALSE(std::filesystem::exists(out));
   EXPECT_FALSE(std::filesystem::exists(refused.path() / "p1"));
+  // A merged report's image folder that is a symbolic link is not copied through.
+  TempDir linked;
+  std::filesystem::create_directories(linked.path() / "outside");
+  std::filesystem::create_directories(linked.path() / "m" / "images");
+  std::filesystem::create_directory_symlink(linked.path() / "outside",
+                                            linked.path() / "m" / "images" / ra["materials"][0]["name"].get<std::string>());
+  EXPECT_NE(test::error_of([&] { merge_reports({part1.path().string(), part2.path().string()}, (linked.path() / "m").string()); })
+                .find("is a symbolic link"),
+            std::string::npos);
+  EXPECT_TRUE(std::filesystem::is_empty(linked.path() / "outside"));
 }
 
 }  // namespace

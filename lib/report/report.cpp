@@ -253,9 +253,22 @@ json find_regressions(const json& previous, const json& current) {
   return out;
 }
 
+namespace {
+
+// A report writes only inside its folder: a folder of it that is a symbolic link (planted, or made by
+// another tool) would take its writes, and its clean-up of stale temporaries, elsewhere.
+void refuse_link(const fs::path& p) {
+  std::error_code ec;
+  if (fs::is_symlink(p, ec)) fail(p.string(), "is a symbolic link; a report writes only into folders of its own");
+}
+
+}  // namespace
+
 json run_report(const ReportOptions& o) {
   std::error_code ec;
   const fs::path luts = o.luts_dir.empty() ? fs::path(o.out_dir) / "luts" : fs::path(o.luts_dir);
+  refuse_link(fs::path(o.out_dir) / "images");
+  if (o.luts_dir.empty()) refuse_link(luts);  // a --luts folder is the user's to place
   fs::create_directories(fs::path(o.out_dir), ec);
   fs::create_directories(luts, ec);
   if (!fs::is_directory(o.out_dir) || !fs::is_directory(luts))
@@ -263,7 +276,7 @@ json run_report(const ReportOptions& o) {
   remove_stale_temporaries(o.out_dir);
   remove_stale_temporaries(luts.string());
   for (const auto& entry : fs::directory_iterator(fs::path(o.out_dir) / "images", ec))
-    if (entry.is_directory(ec)) remove_stale_temporaries(entry.path().string());
+    if (!entry.is_symlink(ec) && entry.is_directory(ec)) remove_stale_temporaries(entry.path().string());
   const json previous = read_json_file((fs::path(o.out_dir) / "report.json").string());
   std::map<std::string, json> reusable;
   if (previous.is_object() && previous.contains("materials"))
@@ -305,6 +318,7 @@ json run_report(const ReportOptions& o) {
       if (!o.force && old != reusable.end() && old->second.value("key", "") == key && images_complete(images, key)) {
         report["materials"].push_back(old->second);
       } else {
+        refuse_link(images);
         fs::create_directories(images, ec);
         fs::remove(images / kCompleteStamp, ec);
         const std::string lut = (luts / (name + ".exr")).string();
@@ -393,6 +407,9 @@ json merge_reports(const std::vector<std::string>& parts, const std::string& out
         fail(parts.front(), "shard " + std::to_string(k) + "/" + std::to_string(n) + " of its split is not among the parts");
   }
 
+  refuse_link(fs::path(out_dir) / "images");
+  for (const json& r : reports)
+    for (const json& m : r["materials"]) refuse_link(fs::path(out_dir) / "images" / m["name"].get<std::string>());
   std::error_code ec;
   fs::create_directories(fs::path(out_dir) / "images", ec);
   const json previous = read_json_file((fs::path(out_dir) / "report.json").string());
