@@ -29,6 +29,7 @@ NOTES = {
     "BM_VisibleSlopes": "the renderer's visible-slope tables of one material (once per render)",
     "BM_WriteLut": "write one LUT EXR (float32, zip)",
     "BM_BakeBatch": "8 materials baked at once, as `bake --jobs` (the paper's method: the pipeline's overhead)",
+    "BM_ClosureFit": "the closure representation's fit alone (fit/closure_fit.h) on the same RGL materials (felt, metallic), one core and both",
     "BM_ParseScene": "parse and check a 3.9 MB scene of 100k Lambert materials (issue 47's bar: 2 MB under 1 s)",
 }
 
@@ -76,7 +77,8 @@ def main(src, dst, startup_md=None):
         "both cores (`BM_BakeBatch`, materials_per_second). The default fit on the whole measurement (issue 10)",
         "adds the solves of `BM_FitRgl` (felt and metallic against the paper's fit of the same table; `BM_Bake`",
         "bakes with it; the issue's budget: 300 ms per material on one core; where the time goes:",
-        "docs/extraction.md, \"Refinement\").",
+        "docs/extraction.md, \"Refinement\"), and the closure representation's fit (issue 45, `BM_ClosureFit`: about",
+        "0.19 s of one core on each; its budget is the bake's wall time, at most +50%: +14-41% measured).",
         "",
         "Anisotropic extraction (issue 12): <= 100 ms and <= 50 MB at 90 x 128 (`BM_Extraction2D`); the reference",
         "implementation's dense (J M)^2 matrix took 6.58 s of CPU and 994 MiB there (1.78 s and 128 MiB at 64 x 64).",
