@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <iostream>
 #include <memory>
 #include <vector>
@@ -181,7 +182,7 @@ std::string command_word(int argc, char** argv) {
 int run_app(int argc, char** argv, void (*register_more)(CLI::App& app, Context& ctx)) {
   CLI::App app{"facetfit: measured BRDFs to microfacet components (Dupuy et al. 2015, power iterations)", "facetfit"};
   app.require_subcommand(1);
-  app.set_version_flag("--version", FACETFIT_VERSION);
+  app.set_version_flag("--version", std::string("facetfit ") + FACETFIT_VERSION + " (" + FACETFIT_BUILD_INFO + ")");
   // --threads N caps every parallel part of every command (TBB's global limit), set as soon as parsed.
   std::unique_ptr<tbb::global_control> threads;
   app.add_option_function<int>(
@@ -217,6 +218,10 @@ int run_app(int argc, char** argv, void (*register_more)(CLI::App& app, Context&
     return 2;
   } catch (const facetfit::Error& e) {
     report_error(e.what());
+    return 1;
+  } catch (const std::filesystem::filesystem_error& e) {
+    // A path the system refuses (too long, a loop of links): the path and the system's reason, one line.
+    report_error(excerpt(e.path1().string(), 200) + ": " + e.code().message());
     return 1;
   } catch (const std::exception& e) {
     report_error(std::string("internal: ") + e.what());

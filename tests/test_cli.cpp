@@ -271,6 +271,11 @@ TEST(Cli, UsageErrors) {
   const RunResult help = facetfit("help render");
   EXPECT_EQ(help.status, 0);
   EXPECT_NE(help.out.find("--material-type"), std::string::npos) << help.out;
+  // A path the system refuses is one line naming it, not "internal: filesystem error" (issue 47).
+  const RunResult long_path = facetfit("bake builtin:gold-ggx-0.15 -o /tmp/" + std::string(300, 'b'));
+  EXPECT_EQ(long_path.status, 1);
+  EXPECT_EQ(lines(long_path.err), 1) << long_path.err;
+  EXPECT_NE(long_path.err.find("bbb...: File name too long"), std::string::npos) << long_path.err;
   const RunResult fresnel = facetfit("bake builtin:gold-ggx-0.15 -o out --closure-fresnel f83");
   EXPECT_EQ(fresnel.status, 2);
   EXPECT_NE(fresnel.err.find("--closure-fresnel f83: must be f82 or schlick"), std::string::npos) << fresnel.err;
@@ -284,6 +289,7 @@ TEST(Cli, UsageErrors) {
   const RunResult version = facetfit("--version");
   EXPECT_EQ(version.status, 0);
   EXPECT_NE(version.out.find(FACETFIT_VERSION), std::string::npos) << version.out;
+  EXPECT_NE(version.out.find("Embree 3."), std::string::npos) << version.out;  // the build's details (issue 48)
   // --threads caps the work, it does not change it.
   const RunResult one = facetfit("--threads 1 fit builtin:gold-ggx-0.15 --refine none --json");
   ASSERT_EQ(one.status, 0) << one.err;
