@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <fstream>
 #include <map>
+#include <regex>
 
 #include "io/atomic_file.h"
 #include "io/merl.h"
@@ -110,12 +111,21 @@ TEST(Report, WritesEveryOutputAndTheRightOrder) {
   EXPECT_LT(entry("copper-beckmann-0.30")["delta_e"]["beckmann"].get<double>(), 0.5);
   EXPECT_GT(entry("gold-ggx-0.15")["delta_e"]["beckmann"].get<double>(), 3.0);
   EXPECT_EQ(r["worst"][0]["name"], "gold-ggx-0.15");
+  EXPECT_EQ(r["worst"][0]["representation"], "beckmann");
   // What production shades with, beside the tabulated model, and what each costs to render.
   EXPECT_LT(entry("gold-ggx-0.15")["delta_e"]["closures"].get<double>(), 0.5);
   for (const char* column : {"tabulated", "ggx", "closures"}) EXPECT_GT(r["database_mean_render_seconds"][column].get<double>(), 0.0) << column;
   EXPECT_EQ(read_json(dir.file("report.json")), r);
   const std::string html = test::read_bytes(dir.file("index.html"));
   EXPECT_NE(html.find("<svg"), std::string::npos);          // run time against error
+  // A page a person reads (issue 48): two decimals, the worst entry's representation, the recommended
+  // representation of each material, the heatmaps' scale.
+  EXPECT_FALSE(std::regex_search(html, std::regex(R"(<td>-?[0-9]+\.[0-9]{3,}</td>)"))) << "a table figure with more than two decimals";
+  EXPECT_NE(html.find(" (beckmann)</li>"), std::string::npos);
+  EXPECT_NE(html.find("<th>recommended</th>"), std::string::npos);
+  EXPECT_NE(html.find("<td>" + entry("gold-ggx-0.15")["representation"].get<std::string>() + "</td>"), std::string::npos);
+  EXPECT_NE(html.find("class='heatmap-scale'"), std::string::npos);
+  EXPECT_TRUE(std::regex_search(html, std::regex("<text x='50' y='275'>[0-9.e+-]{1,7}</text>"))) << "the time axis' bound";
   EXPECT_NE(html.find("images/red-plastic/ggx_delta_e.png"), std::string::npos);
 }
 

@@ -89,14 +89,19 @@ ImageDiff image_delta_e(std::vector<float> a, bool a_display_referred, std::vect
   return d;
 }
 
+std::array<std::uint8_t, 3> heatmap_colour(double delta_e) {
+  const double t = std::clamp(delta_e / kHeatmapMax, 0.0, 1.0);
+  const auto& c = kViridis[int(std::lround(t * 255))];
+  return {c[0], c[1], c[2]};
+}
+
 void write_heatmap_png(const std::string& path, int width, int height, const std::vector<float>& delta_e,
                        const std::vector<bool>& mask) {
   std::vector<std::uint8_t> pixels(3 * delta_e.size(), 0);  // outside the mask: black, not on the map
   for (std::size_t p = 0; p < delta_e.size(); ++p) {
     if (!mask[p]) continue;
-    const double t = std::clamp(double(delta_e[p]) / kHeatmapMax, 0.0, 1.0);
-    const auto& c = kViridis[int(std::lround(t * 255))];
-    std::copy(c, c + 3, pixels.begin() + std::ptrdiff_t(3 * p));
+    const auto c = heatmap_colour(double(delta_e[p]));
+    std::copy(c.begin(), c.end(), pixels.begin() + std::ptrdiff_t(3 * p));
   }
   write_png8(path, width, height, pixels);
 }

@@ -2,6 +2,9 @@
 // each pixel through the display chain (docs/colour.md), a false-colour heatmap, display-referred PNGs.
 #pragma once
 
+#include <array>
+#include <cstdint>
+
 #include <cstddef>
 #include <string>
 #include <vector>
@@ -24,6 +27,9 @@ struct ImageDiff {
 // is applied) or display code values already. Only pixels with mask[p] count.
 ImageDiff image_delta_e(std::vector<float> a, bool a_display_referred, std::vector<float> b, bool b_display_referred,
                         const std::vector<bool>& mask, const DisplayTransform& display);
+
+// The heatmap's colour of a Delta E: viridis from 0 to kHeatmapMax, 8-bit RGB.
+std::array<std::uint8_t, 3> heatmap_colour(double delta_e);
 
 // Viridis from 0 to kHeatmapMax, black outside the mask; an 8-bit PNG through a temporary file.
 void write_heatmap_png(const std::string& path, int width, int height, const std::vector<float>& delta_e,

@@ -7,6 +7,7 @@
 #include <fstream>
 #include <map>
 #include <sstream>
+#include <tuple>
 
 #include "color/image_diff.h"
 #include "core/error.h"
@@ -80,16 +81,19 @@ void summarize(json& report) {
     seconds[r] = n > 0 ? json(sum / n) : json(nullptr);
   }
   report["database_mean_render_seconds"] = seconds;
-  std::vector<std::pair<double, std::string>> worst;
+  // Each material's worst representation, the worst five materials first.
+  std::vector<std::tuple<double, std::string, std::string>> worst;
   for (const json& m : report["materials"]) {
     double w = 0.0;
-    for (const auto& [r, v] : m["delta_e"].items()) w = std::max(w, v.get<double>());
-    worst.emplace_back(w, m["name"].get<std::string>());
+    std::string of;
+    for (const auto& [r, v] : m["delta_e"].items())
+      if (v.get<double>() >= w) w = v.get<double>(), of = r;
+    worst.emplace_back(w, m["name"].get<std::string>(), of);
   }
   std::sort(worst.rbegin(), worst.rend());
   report["worst"] = json::array();
   for (std::size_t k = 0; k < std::min<std::size_t>(5, worst.size()); ++k)
-    report["worst"].push_back({{"name", worst[k].second}, {"max_delta_e", worst[k].first}});
+    report["worst"].push_back({{"name", std::get<1>(worst[k])}, {"max_delta_e", std::get<0>(worst[k])}, {"representation", std::get<2>(worst[k])}});
 }
 
 std::string html_escape(const std::string& s) {
@@ -104,6 +108,17 @@ std::string html_escape(const std::string& s) {
   }
   return out;
 }
+
+namespace {
+
+// An axis bound: three significant digits.
+std::string axis_number(double v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.3g", v);
+  return text;
+}
+
+}  // namespace
 
 // Run time against error: one point per material and representation, log-scaled time.
 std::string time_error_plot(const json& report) {
@@ -121,8 +136,8 @@ std::string time_error_plot(const json& report) {
   svg << "<svg width='560' height='300' xmlns='http://www.w3.org/2000/svg' font-size='11'>"
       << "<line x1='50' y1='260' x2='540' y2='260' stroke='black'/><line x1='50' y1='20' x2='50' y2='260' stroke='black'/>"
       << "<text x='240' y='292'>render time (s, log scale)</text><text x='4' y='14'>mean Delta E 2000</text>"
-      << "<text x='50' y='275'>" << min_t << "</text><text x='500' y='275'>" << max_t << "</text>"
-      << "<text x='8' y='30'>" << max_de << "</text>";
+      << "<text x='50' y='275'>" << axis_number(min_t) << "</text><text x='500' y='275'>" << axis_number(max_t) << "</text>"
+      << "<text x='8' y='30'>" << axis_number(max_de) << "</text>";
   for (std::size_t k = 0; k < report_representations().size(); ++k) {
     const std::string& r = report_representations()[k];
     svg << "<text x='" << 420 << "' y='" << 30 + 14 * k << "' fill='" << kColumns[k].colour << "'>&#9679; " << r << "</text>";
@@ -137,6 +152,33 @@ std::string time_error_plot(const json& report) {
   svg << "</svg>";
   return svg.str();
 }
+
+namespace {
+
+// A figure of the page: two decimals (Delta E differences below 0.01 are noise at any spp).
+std::string two_decimals(double v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.2f", v);
+  return text;
+}
+
+// The heatmaps' scale: viridis from 0 to kHeatmapMax, saturating beyond, as an inline SVG bar.
+std::string heatmap_scale() {
+  std::ostringstream s;
+  s << "<svg class='heatmap-scale' width='300' height='34'><defs><linearGradient id='hm'>";
+  for (int k = 0; k <= 10; ++k) {
+    const auto c = heatmap_colour(kHeatmapMax * k / 10.0);
+    s << "<stop offset='" << k * 10 << "%' stop-color='rgb(" << int(c[0]) << "," << int(c[1]) << "," << int(c[2]) << ")'/>";
+  }
+  s << "</linearGradient></defs><rect x='10' y='2' width='280' height='14' fill='url(#hm)'/>";
+  for (int k = 0; k <= 2; ++k)
+    s << "<text x='" << 10 + 140 * k << "' y='30' font-size='11' text-anchor='middle'>" << kHeatmapMax * k / 2 << (k == 2 ? "+" : "")
+      << "</text>";
+  s << "</svg>";
+  return s.str();
+}
+
+}  // namespace
 
 std::string report_html(const json& report) {
   std::ostringstream h;
@@ -154,7 +196,7 @@ std::string report_html(const json& report) {
     h << "<tr>";
     for (const std::string& r : report_representations()) {
       const json& v = report.value(key, json::object()).value(r, json(nullptr));
-      h << "<td>" << (v.is_null() ? std::string("-") : std::to_string(v.get<double>())) << "</td>";
+      h << "<td>" << (v.is_null() ? std::string("-") : two_decimals(v.get<double>())) << "</td>";
     }
     h << "<td>" << label << "</td></tr>";
   }
@@ -163,23 +205,26 @@ std::string report_html(const json& report) {
     h << "<h2 class='bad'>Regressions against the previous report</h2><ul>";
     for (const json& g : report["regressions"])
       h << "<li class='bad'>" << html_escape(g["name"].get<std::string>()) << " " << g["representation"].get<std::string>() << ": "
-        << g["before"].get<double>() << " &rarr; " << g["after"].get<double>() << "</li>";
+        << two_decimals(g["before"].get<double>()) << " &rarr; " << two_decimals(g["after"].get<double>()) << "</li>";
     h << "</ul>";
   }
   h << "<h2>Worst materials</h2><ol>";
-  for (const json& w : report["worst"]) h << "<li>" << html_escape(w["name"].get<std::string>()) << ": " << w["max_delta_e"].get<double>() << "</li>";
+  for (const json& w : report["worst"])
+    h << "<li>" << html_escape(w["name"].get<std::string>()) << ": " << two_decimals(w["max_delta_e"].get<double>()) << " ("
+      << html_escape(w.value("representation", std::string())) << ")</li>";
   h << "</ol><h2>Run time against error</h2>" << time_error_plot(report);
-  h << "<h2>Materials</h2><p>Click a column header to sort.</p><table id='t'><tr><th>material</th>";
+  h << "<h2>Materials</h2><p>Click a column header to sort. &Delta;E maps: " << heatmap_scale()
+    << "</p><table id='t'><tr><th>material</th><th>recommended</th>";
   for (const std::string& r : report_representations()) h << "<th>&Delta;E " << r << "</th>";
   h << "<th>bake s</th><th>measured</th>";
   for (const std::string& r : report_representations()) h << "<th>" << r << "</th><th>&Delta;E map</th>";
   h << "</tr>";
   for (const json& m : report["materials"]) {
     const std::string name = m["name"].get<std::string>();
-    h << "<tr><td>" << html_escape(name) << "</td>";
+    h << "<tr><td>" << html_escape(name) << "</td><td>" << html_escape(m.value("representation", std::string("-"))) << "</td>";
     for (const std::string& r : report_representations())
-      h << "<td>" << (m["delta_e"].contains(r) ? std::to_string(m["delta_e"][r].get<double>()) : std::string("-")) << "</td>";
-    h << "<td>" << m["seconds"]["bake"].get<double>() << "</td><td><img src='images/" << html_escape(name) << "/measured.png'></td>";
+      h << "<td>" << (m["delta_e"].contains(r) ? two_decimals(m["delta_e"][r].get<double>()) : std::string("-")) << "</td>";
+    h << "<td>" << two_decimals(m["seconds"]["bake"].get<double>()) << "</td><td><img src='images/" << html_escape(name) << "/measured.png'></td>";
     for (const std::string& r : report_representations())
       h << "<td><img src='images/" << html_escape(name) << "/" << r << ".png'></td><td><img src='images/" << html_escape(name) << "/"
         << r << "_delta_e.png'></td>";
