@@ -41,10 +41,11 @@ void report_outcome(Progress& progress, const BakeOutcome& o) {
   char line[512];
   std::snprintf(line, sizeof line, "%s %s (%.0f ms)", o.status == BakeOutcome::Status::cached ? "cached" : "baked ", o.name.c_str(),
                 o.seconds * 1e3);
-  progress.step(o.name, line, o.status == BakeOutcome::Status::failed ? o.error : "");
   // Implausible values are baked as measured, never silently: one warning line each.
+  std::vector<std::string> warnings;
   if (o.status != BakeOutcome::Status::failed && o.record.contains("warnings"))
-    for (const auto& w : o.record["warnings"]) std::fprintf(stderr, "facetfit: warning: %s: %s\n", o.source.c_str(), w.get<std::string>().c_str());
+    for (const auto& w : o.record["warnings"]) warnings.push_back(o.source + ": " + w.get<std::string>());
+  progress.step(o.name, line, o.status == BakeOutcome::Status::failed ? o.error : "", warnings);
 }
 
 std::string canonical(const std::string& source) {

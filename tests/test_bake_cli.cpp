@@ -13,7 +13,9 @@
 #include <set>
 #include <thread>
 
+#include "io/merl.h"
 #include "lut/lut.h"
+#include "model/analytic.h"
 #include "test_util.h"
 
 namespace facetfit {
@@ -26,6 +28,24 @@ using test::TempDir;
 nlohmann::json read_json(const std::string& path) {
   std::ifstream in(path);
   return nlohmann::json::parse(in);
+}
+
+// On a terminal, a warning takes the progress bar's line, cleared first, and the bar is drawn again after
+// it (issue 48: warnings were printed over the bar). A terminal from script(1), where it is installed.
+TEST(Bake, WarningsDoNotOverwriteTheProgressBar) {
+  if (test::run_command("command -v script >/dev/null").status != 0) GTEST_SKIP() << "no script(1) to give the command a terminal";
+  TempDir dir;
+  MerlTable::tabulate(LambertBrdf(Rgb(1.3, 0.3, 0.1))).write(dir.file("bright.binary"));  // albedo above 1: warnings
+  MerlTable::tabulate(LambertBrdf(Rgb(0.5))).write(dir.file("plain.binary"));
+  const RunResult r = test::run_command("script -qec \"" + std::string(FACETFIT_CLI) + " bake " + dir.file("bright.binary") + " " +
+                                        dir.file("plain.binary") + " --refine none -o " + dir.file("out") + "\" /dev/null");
+  ASSERT_EQ(r.status, 0) << r.out << r.err;
+  std::size_t warnings = 0;
+  for (std::size_t at = r.out.find("facetfit: warning:"); at != std::string::npos; at = r.out.find("facetfit: warning:", at + 1), ++warnings)
+    EXPECT_EQ(r.out.substr(at - 4, 4), "\r\033[K") << r.out;
+  EXPECT_GT(warnings, 0u) << r.out;
+  EXPECT_NE(r.out.rfind("] 2/2 "), std::string::npos) << r.out;  // the bar, drawn last
+  EXPECT_GT(r.out.rfind("] 2/2 "), r.out.rfind("facetfit: warning:"));
 }
 
 TEST(Bake, BatchGoesOnPastACorruptedFile) {
