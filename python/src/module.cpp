@@ -88,6 +88,10 @@ FitOptions fit_options(const std::string& refine, int resolution, const std::str
   return o;
 }
 
+// A path argument (str, bytes or os.PathLike) as the file system's bytes: a name that is not UTF-8 (a
+// str of os.fsdecode's surrogates) is taken as it is, where pybind11's str conversion refused it.
+std::string fs_path(const py::handle& path) { return py::module_::import("os").attr("fsencode")(path).cast<std::string>(); }
+
 Measurement load(const std::string& source, const std::string& merl_bins) {
   const auto b = parse_bin_point(merl_bins);
   if (!b) throw py::value_error("merl_bins: must be start or center, not '" + merl_bins + "'");
@@ -163,7 +167,7 @@ py::array_t<float> render_scene(const py::object& scene, int spp, std::uint64_t 
     const std::string text = to_json_text(scene);
     desc = parse_scene_text(text, "scene", py::module_::import("os").attr("getcwd")().cast<std::string>());
   } else {
-    desc = parse_scene(py::str(py::module_::import("os").attr("fspath")(scene)).cast<std::string>());
+    desc = parse_scene(fs_path(scene));
   }
   if (spp < 0 || spp > (1 << 20)) throw py::value_error("spp: must be in [1, 1048576], or 0 for the scene's");
   RenderSettings settings;
@@ -226,7 +230,8 @@ py::tuple delta_e(const py::handle& a, const py::handle& b, const py::object& ma
 
 // A render's image, (height, width, 3 or 4) scene-linear float, as a linear EXR (alpha 1 where it has none)
 // or a display-referred sRGB PNG, as `facetfit render -o` and `--png` write them.
-void write_image(const std::string& path, const py::handle& image) {
+void write_image(const py::handle& path_arg, const py::handle& image) {
+  const std::string path = fs_path(path_arg);
   using FloatArray = py::array_t<float, py::array::c_style | py::array::forcecast>;
   const FloatArray a = FloatArray::ensure(image);
   if (!a || a.ndim() != 3 || (a.shape(2) != 3 && a.shape(2) != 4) || a.shape(0) < 1 || a.shape(1) < 1)
@@ -284,7 +289,18 @@ using namespace facetfit::python;
 PYBIND11_MODULE(_facetfit, m) {
   m.doc() = "facetfit: microfacet fits of measured BRDFs (Dupuy et al. 2015), LUTs, rendering, Delta E 2000";
   m.attr("__version__") = FACETFIT_VERSION;
-  py::register_exception<Error>(m, "Error", PyExc_RuntimeError);
+  // facetfit.Error, its message decoded as os.fsdecode does: a path in it that is not UTF-8 stays readable.
+  static py::exception<Error> error_type(m, "Error", PyExc_RuntimeError);
+  py::register_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const Error& e) {
+      const std::string what = e.what();
+      PyObject* message = PyUnicode_DecodeUTF8(what.data(), Py_ssize_t(what.size()), "surrogateescape");
+      PyErr_SetObject(error_type.ptr(), message);
+      Py_XDECREF(message);
+    }
+  });
 
   py::class_<Measurement>(m, "Measurement", "A measured material in MERL layout (MERL, RGL or builtin: source).")
       .def_readonly("source", &Measurement::source)
@@ -300,7 +316,9 @@ PYBIND11_MODULE(_facetfit, m) {
           py::arg("o"), py::arg("i"), "f(o, i) in 1/sr, shape (..., 3); NaN where the measurement has no value.")
       .def("__repr__", [](const Measurement& x) { return "<facetfit.Measurement " + x.source + ">"; });
 
-  m.def("load", &load, py::arg("source"), py::arg("merl_bins") = "start",
+  m.def(
+      "load", [](const py::object& source, const std::string& merl_bins) { return load(fs_path(source), merl_bins); }, py::arg("source"),
+      py::arg("merl_bins") = "start",
         "Loads a measurement: a MERL .binary, an RGL .bsdf, a UTIA .bin or builtin:NAME. Raises facetfit.Error naming the file.");
   m.def("builtins", [] {
     std::vector<std::string> names;
@@ -361,8 +379,9 @@ PYBIND11_MODULE(_facetfit, m) {
       }, "The closure representation as a model.")
       .def(
           "write_lut",
-          [](const Fit& f, const std::string& path, double tolerance, bool sampling) {
+          [](const Fit& f, const py::object& path_arg, double tolerance, bool sampling) {
             if (!f.result.ok()) throw Error(f.source + ": " + f.result.problem);
+            const std::string path = fs_path(path_arg);
             py::gil_scoped_release release;
             write_lut(path, make_lut(f.result, f.fitter->quadrature(), f.source, source_sha256(f.source), tolerance, sampling));
           },
@@ -377,7 +396,7 @@ PYBIND11_MODULE(_facetfit, m) {
          const std::string& closure_fresnel) {
         const FitOptions o = fit_options(refine, resolution, smith, merl_bins, closure_fresnel);
         if (py::isinstance<Measurement>(what)) return fit(what.cast<const Measurement&>(), o);
-        return fit(load(py::str(py::module_::import("os").attr("fspath")(what)).cast<std::string>(), merl_bins), o);
+        return fit(load(fs_path(what), merl_bins), o);
       },
       py::arg("measurement"), py::arg("refine") = "full", py::arg("resolution") = 90, py::arg("smith") = "correlated",
       py::arg("merl_bins") = "start", py::arg("closure_fresnel") = "f82",
@@ -414,7 +433,8 @@ PYBIND11_MODULE(_facetfit, m) {
           },
           py::arg("family"), "One of the parametric fits the LUT carries: 'ggx', 'beckmann' or 'lsq'.");
   m.def(
-      "read_lut", [](const std::string& path) {
+      "read_lut", [](const py::object& path_arg) {
+        const std::string path = fs_path(path_arg);
         py::gil_scoped_release release;
         return read_lut(path);
       },
@@ -422,9 +442,10 @@ PYBIND11_MODULE(_facetfit, m) {
 
   m.def(
       "bake",
-      [](const std::string& source, const std::string& out_dir, std::string name, bool force, double tolerance, bool sampling,
+      [](const py::object& source_arg, const py::object& out_dir_arg, std::string name, bool force, double tolerance, bool sampling,
          const std::string& refine, int resolution, const std::string& smith, const std::string& merl_bins,
          const std::string& closure_fresnel) {
+        const std::string source = fs_path(source_arg), out_dir = fs_path(out_dir_arg);
         BakeOptions o;
         o.fit = fit_options(refine, resolution, smith, merl_bins, closure_fresnel);
         o.force = force;

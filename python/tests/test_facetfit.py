@@ -242,6 +242,15 @@ def test_bad_inputs_raise_one_line(tmp_path):
         facetfit.fit(GOLD, refine="some")
     with pytest.raises(facetfit.Error, match="type must be"):
         facetfit.material({"type": "phong"})
+    # A path whose name is not UTF-8 (issue 47: "Unable to cast") is read as the bytes it is, and named in the error.
+    odd = os.path.join(os.fsencode(str(tmp_path)), b"\xffodd.binary")
+    with open(odd, "wb") as f:
+        f.write(b"\x01\x02")
+    for path in (odd, os.fsdecode(odd)):
+        with pytest.raises(facetfit.Error) as e:
+            facetfit.load(path)
+        assert "odd.binary" in str(e.value) and "\udcff" in str(e.value)
+    os.remove(odd)
     # Output names are file names (issue 47: "../x" and absolute names wrote outside out_dir, NUL lost the LUT).
     (tmp_path / "out").mkdir()
     for name, problem in [("../x", "holds a '/'"), (str(tmp_path / "abs"), "holds a '/'"), ("x\x00y", "control character")]:
