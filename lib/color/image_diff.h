@@ -3,9 +3,8 @@
 #pragma once
 
 #include <array>
-#include <cstdint>
-
 #include <cstddef>
+#include <cstdint>
 #include <string>
 #include <vector>
 

@@ -31,12 +31,10 @@ inline double luminance(const Rgb& c) { return 0.2126 * c.r + 0.7152 * c.g + 0.0
 // Whether a microfacet lobe's f(o, i) can be formed: both directions above the horizon and, for its
 // denominator 4 cos(theta_o) cos(theta_i), a product of the cosines that does not underflow to zero (both
 // within ~1e-162 of the horizon, or one a denormal). Such a pair counts as on the horizon: f is 0 there,
-// not 0 / 0. A pair with a NaN or infinite coordinate, or one whose squared length overflows, is not
-// (the tables a model indexes by angle would be indexed by NaN).
-inline bool finite_direction(const Vec3& v) { return std::isfinite(glm::dot(v, v)); }
-inline bool above_horizon(const Vec3& o, const Vec3& i) {
-  return o.z > 0.0 && i.z > 0.0 && o.z * i.z > 0.0 && finite_direction(o) && finite_direction(i);
-}
+// not 0 / 0. A direction with a NaN or infinite coordinate, or whose squared length overflows, is not
+// above it (the tables a model indexes by angle would be indexed by NaN).
+inline bool above_horizon(const Vec3& v) { return v.z > 0.0 && std::isfinite(glm::dot(v, v)); }
+inline bool above_horizon(const Vec3& o, const Vec3& i) { return above_horizon(o) && above_horizon(i) && o.z * i.z > 0.0; }
 
 inline double clamp(double x, double lo, double hi) { return x < lo ? lo : (x > hi ? hi : x); }
 

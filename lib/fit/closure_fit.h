@@ -48,7 +48,6 @@ struct ClosureFitOptions {
   ClosureLobe::Fresnel fresnel = ClosureLobe::Fresnel::f82_tint;
 };
 
-
 struct ClosureFit {
   Closures closures;
   double error = 0.0;  // measurement_error of the closures on the error bins

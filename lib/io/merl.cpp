@@ -43,6 +43,10 @@ struct BinCoords {
   double h, d, p;
 };
 
+// Whether a stored double, scaled, is a value the table's float holds: not NaN or infinite (x - x is NaN for
+// both), not past a float's range. Branch-free, for the reader's vectorized loop.
+bool representable(double x, double scale) { return x - x == 0.0 && x * scale <= MerlTable::kMaxValue; }
+
 BinCoords bin_coords(const Vec3& o, const Vec3& i) {
   const HalfDiff hd = to_half_diff(o, i);
   double phi_d = hd.phi_d;
@@ -172,7 +176,7 @@ MerlTable MerlTable::read(const std::string& path, BinPoint at) {
 #pragma omp simd reduction(+ : nonfinite)
       for (std::size_t k = t; k < end; ++k) {
         const double x = buf[k];
-        nonfinite += (x - x == 0.0 && x * scale <= kMaxValue) ? 0 : 1;  // NaN and Inf give NaN
+        nonfinite += representable(x, scale) ? 0 : 1;
         out[k] = x < 0.0 ? kMissing : float(x * scale);
       }
       t = end;
@@ -190,12 +194,13 @@ MerlTable MerlTable::read(const std::string& path, BinPoint at) {
       fail(path, "read error (file changed while reading?)");
     for (std::size_t t = 0; t < n; ++t) {
       const std::size_t c = (first + t) / kBins, bin = (first + t) % kBins;
-      if (std::isfinite(buf[t]) && buf[t] * kScale[c] <= kMaxValue) continue;
+      if (representable(buf[t], kScale[c])) continue;
       const std::size_t offset = sizeof dims + (first + t) * sizeof(double);
       const int k = int(bin % kPhiD), j = int(bin / kPhiD % kThetaD), i = int(bin / (kPhiD * kThetaD));
-      char value[32];
-      std::snprintf(value, sizeof value, "%g", buf[t]);
-      fail(path, std::string(std::isnan(buf[t]) ? "NaN" : std::isinf(buf[t]) ? "Inf" : std::string(value) + " (out of float's range)") + " at byte offset " + std::to_string(offset) + " (" +
+      char value[48];
+      std::snprintf(value, sizeof value, "%g (out of float's range)", buf[t]);
+      const std::string what = std::isnan(buf[t]) ? "NaN" : std::isinf(buf[t]) ? "Inf" : value;
+      fail(path, what + " at byte offset " + std::to_string(offset) + " (" +
                      channel_name(int(c)) + " channel, bin theta_h " + std::to_string(i) + ", theta_d " + std::to_string(j) +
                      ", phi_d " + std::to_string(k) + ")");
     }
@@ -243,9 +248,9 @@ void MerlTable::write(const std::string& path) const {
 
 std::optional<Rgb> MerlTable::eval(const Vec3& o, const Vec3& i) const {
   // No cosine divides here: a pair whose product of cosines underflows is still looked up (as the lanes do).
-  if (!(i.z > 0.0 && o.z > 0.0) || !finite_direction(o) || !finite_direction(i)) return Rgb(0.0);
+  if (!above_horizon(o) || !above_horizon(i)) return Rgb(0.0);
   const BinCoords x = bin_coords(o, i);
-  if (!(std::isfinite(x.h) && std::isfinite(x.d) && std::isfinite(x.p))) return Rgb(0.0);  // a zero vector
+  if (!(std::isfinite(x.h) && std::isfinite(x.d) && std::isfinite(x.p))) return Rgb(0.0);  // far from unit length: no angle
   return lookup_ == Lookup::nearest ? eval_nearest(x.h, x.d, x.p) : eval_linear(x.h, x.d, x.p);
 }
 

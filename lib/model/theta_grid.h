@@ -52,10 +52,9 @@ struct ThetaGrid {
     return s;
   }
 
-  // Interval and fraction of theta (clamped to [0, pi/2]; NaN reads as 0, never as an index).
+  // Interval and fraction of theta (clamped to [0, pi/2]; NaN reads as 0: u_of_theta's max takes 0 over it).
   void locate(double theta, int* j, double* t) const {
-    const double u = u_of_theta(theta);
-    const double x = (u > 0.0 ? std::min(u, 1.0) : 0.0) * resolution;
+    const double x = std::min(u_of_theta(theta), 1.0) * resolution;
     *j = std::min(int(x), resolution - 1);
     *t = x - *j;
   }

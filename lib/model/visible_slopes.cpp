@@ -93,7 +93,7 @@ VisibleSlopes::VisibleSlopes(const TabulatedNdf& ndf) {
 }
 
 Vec3 VisibleSlopes::sample(const Vec3& o, double u1, double u2) const {
-  if (!(o.z > 0.0) || !finite_direction(o)) return {0.0, 0.0, 1.0};  // no view slice (callers draw for o above the horizon)
+  if (!above_horizon(o)) return {0.0, 0.0, 1.0};  // no view slice (callers draw for o above the horizon)
   // One of the two view slices around o with the weights of the mixture, reusing u1.
   const ViewSlice view = view_slice(o, scale_);
   const int s = view.s + pick_of_two(view.t, &u1);
@@ -130,7 +130,7 @@ double VisibleSlopes::pdf(const Vec3& o, const Vec3& h) const {
 }
 
 std::optional<Vec3> VisibleSlopeProposal::sample_direction(const Vec3& o, double u1, double u2) const {
-  if (!(o.z > 0.0) || !finite_direction(o)) return std::nullopt;
+  if (!above_horizon(o)) return std::nullopt;
   return parts_.sample(o, u1, u2, [&](double a, double b) -> std::optional<Vec3> {
     const Vec3 h = slopes_.sample(o, a, b);
     const Vec3 i = reflect_about(o, h);

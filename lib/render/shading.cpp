@@ -106,7 +106,7 @@ std::optional<ShadingModel::Sample> ShadingModel::sample(const Vec3& o, double u
 }
 
 std::optional<Vec3> ShadingModel::sample_direction(const Vec3& o, double u1, double u2, double u3) const {
-  if (!(o.z > 0.0) || !finite_direction(o)) return std::nullopt;
+  if (!above_horizon(o)) return std::nullopt;
   if (u3 < lobe_weight_) return proposal_->sample_direction(o, u1, u2);
   // cosine-weighted hemisphere (concentric disc)
   const double a = 2.0 * u1 - 1.0, b = 2.0 * u2 - 1.0;

@@ -118,6 +118,29 @@ std::string axis_number(double v) {
   return text;
 }
 
+// A figure of the page: two decimals (Delta E differences below 0.01 are noise at any spp).
+std::string two_decimals(double v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.2f", v);
+  return text;
+}
+
+// The heatmaps' scale: viridis from 0 to kHeatmapMax, saturating beyond, as an inline SVG bar.
+std::string heatmap_scale() {
+  std::ostringstream s;
+  s << "<svg class='heatmap-scale' width='300' height='34'><defs><linearGradient id='hm'>";
+  for (int k = 0; k <= 10; ++k) {
+    const auto c = heatmap_colour(kHeatmapMax * k / 10.0);
+    s << "<stop offset='" << k * 10 << "%' stop-color='rgb(" << int(c[0]) << "," << int(c[1]) << "," << int(c[2]) << ")'/>";
+  }
+  s << "</linearGradient></defs><rect x='10' y='2' width='280' height='14' fill='url(#hm)'/>";
+  for (int k = 0; k <= 2; ++k)
+    s << "<text x='" << 10 + 140 * k << "' y='30' font-size='11' text-anchor='middle'>" << kHeatmapMax * k / 2 << (k == 2 ? "+" : "")
+      << "</text>";
+  s << "</svg>";
+  return s.str();
+}
+
 }  // namespace
 
 // Run time against error: one point per material and representation, log-scaled time.
@@ -152,33 +175,6 @@ std::string time_error_plot(const json& report) {
   svg << "</svg>";
   return svg.str();
 }
-
-namespace {
-
-// A figure of the page: two decimals (Delta E differences below 0.01 are noise at any spp).
-std::string two_decimals(double v) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.2f", v);
-  return text;
-}
-
-// The heatmaps' scale: viridis from 0 to kHeatmapMax, saturating beyond, as an inline SVG bar.
-std::string heatmap_scale() {
-  std::ostringstream s;
-  s << "<svg class='heatmap-scale' width='300' height='34'><defs><linearGradient id='hm'>";
-  for (int k = 0; k <= 10; ++k) {
-    const auto c = heatmap_colour(kHeatmapMax * k / 10.0);
-    s << "<stop offset='" << k * 10 << "%' stop-color='rgb(" << int(c[0]) << "," << int(c[1]) << "," << int(c[2]) << ")'/>";
-  }
-  s << "</linearGradient></defs><rect x='10' y='2' width='280' height='14' fill='url(#hm)'/>";
-  for (int k = 0; k <= 2; ++k)
-    s << "<text x='" << 10 + 140 * k << "' y='30' font-size='11' text-anchor='middle'>" << kHeatmapMax * k / 2 << (k == 2 ? "+" : "")
-      << "</text>";
-  s << "</svg>";
-  return s.str();
-}
-
-}  // namespace
 
 std::string report_html(const json& report) {
   std::ostringstream h;
