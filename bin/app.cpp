@@ -151,17 +151,16 @@ const CLI::App* find_command(const CLI::App& app, const std::string& name) {
   return nullptr;
 }
 
-// Where a usage error points: the command's own help, or for a word that is no command, the nearest one.
-std::string usage_hint(const CLI::App& app, const std::string& word) {
-  if (word.empty() || word[0] == '-') return "see facetfit --help";
-  if (find_command(app, word) == nullptr) {
-    std::string nearest;
-    std::size_t best = 3;  // suggest within two edits
-    for (const CLI::App* sub : app.get_subcommands({}))
-      if (const std::size_t d = edit_distance(word, sub->get_name()); d < best) best = d, nearest = sub->get_name();
-    return nearest.empty() ? "see facetfit --help" : "did you mean 'facetfit " + nearest + "'?";
-  }
-  return "see facetfit " + word + " --help";
+// A usage error's line: the parser's complaint pointing to the command's own help, or for a command word
+// that is no command, that, with the nearest command (within two edits).
+std::string usage_error(const CLI::App& app, const std::string& word, const std::string& complaint) {
+  if (word.empty() || word[0] == '-') return complaint + " (see facetfit --help)";
+  if (find_command(app, word)) return complaint + " (see facetfit " + word + " --help)";
+  std::string nearest;
+  std::size_t best = 3;
+  for (const CLI::App* sub : app.get_subcommands({}))
+    if (const std::size_t d = edit_distance(word, sub->get_name()); d < best) best = d, nearest = sub->get_name();
+  return "unknown command '" + word + "' (" + (nearest.empty() ? "see facetfit --help" : "did you mean 'facetfit " + nearest + "'?") + ")";
 }
 
 }  // namespace
@@ -212,9 +211,7 @@ int run_app(int argc, char** argv, void (*register_more)(CLI::App& app, Context&
     // Help and --version exit 0; every usage error exits 2, as bin/commands.h promises, with one line in
     // the command's error style.
     if (e.get_exit_code() == static_cast<int>(CLI::ExitCodes::Success)) return app.exit(e);
-    const std::string word = command_word(argc, argv);
-    const bool unknown = !word.empty() && word[0] != '-' && find_command(app, word) == nullptr;
-    report_error((unknown ? "unknown command '" + word + "'" : std::string(e.what())) + " (" + usage_hint(app, word) + ")");
+    report_error(usage_error(app, command_word(argc, argv), e.what()));
     return 2;
   } catch (const facetfit::Error& e) {
     report_error(e.what());

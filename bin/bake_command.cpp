@@ -79,14 +79,13 @@ void run_bake(const BakeArgs& args, Context& ctx) {
     status = 2;
     return;
   }
-  std::error_code ec;
-  fs::create_directories(args.out_dir, ec);
-  if (!fs::is_directory(args.out_dir)) {
-    report_error(args.out_dir + ": cannot create output folder" + (ec ? ": " + ec.message() : ""));
+  try {
+    prepare_output_folder(args.out_dir);
+  } catch (const Error& e) {
+    report_error(e.what());
     status = 1;
     return;
   }
-  remove_stale_temporaries(args.out_dir);
 
   BakeOptions options;
   options.fit = *fit;

@@ -94,6 +94,13 @@ bool is_running(long pid) {
 
 }  // namespace
 
+void prepare_output_folder(const std::string& dir) {
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (!fs::is_directory(dir)) fail(dir, "cannot create output folder" + (ec ? ": " + ec.message() : std::string()));
+  remove_stale_temporaries(dir);
+}
+
 std::string output_name_problem(const std::string& name) {
   if (name.empty() || name == "." || name == "..") return "is not a file name";
   if (name.size() > kMaxOutputName) return "is " + std::to_string(name.size()) + " bytes long; the limit is " + std::to_string(kMaxOutputName);

@@ -32,6 +32,10 @@ class AtomicFile {
 // how many.
 int remove_stale_temporaries(const std::string& dir);
 
+// Makes the output folder `dir` (and its parents) where missing and removes the temporaries killed runs
+// left in it. Throws Error("<dir>: cannot create output folder[: reason]").
+void prepare_output_folder(const std::string& dir);
+
 // Writes `content` to `path` through an AtomicFile.
 void write_file_atomic(const std::string& path, const std::string& content);
 

@@ -24,6 +24,7 @@
 #include "core/error.h"
 #include "core/memory_budget.h"
 #include "fit/fit.h"
+#include "io/atomic_file.h"
 #include "io/input.h"
 #include "lut/bake.h"
 #include "lut/lut.h"
@@ -241,9 +242,9 @@ void write_image(const py::handle& path_arg, const py::handle& image) {
   if (!std::all_of(px, px + a.size(), [](float v) { return std::isfinite(v); }))
     throw py::value_error("write_image: the image holds NaN or infinite values");
   const std::string ext = std::filesystem::path(path).extension().string();
+  if (ext != ".exr" && ext != ".png") throw py::value_error("write_image: " + path + ": must end in .exr or .png");
   py::gil_scoped_release release;
   if (ext == ".png") return write_display_png(path, px, width, height, channels, DisplayTransform());
-  if (ext != ".exr") throw py::value_error("write_image: " + path + ": must end in .exr or .png");
   RenderedImage out;
   out.width = width, out.height = height;
   out.rgba.resize(std::size_t(width) * std::size_t(height) * 4, 1.0f);
@@ -451,9 +452,7 @@ PYBIND11_MODULE(_facetfit, m) {
         o.force = force;
         o.tolerance = tolerance;
         o.with_sampling = sampling;
-        std::error_code ec;
-        std::filesystem::create_directories(out_dir, ec);  // as the command does
-        if (!std::filesystem::is_directory(out_dir)) throw Error(out_dir + ": cannot create output folder" + (ec ? ": " + ec.message() : ""));
+        prepare_output_folder(out_dir);  // as the command does
         const std::vector<std::string> sources = expand_inputs({source});
         const bool batch = sources.size() != 1 || sources.front() != source;  // a folder, a glob or builtin:
         if (batch && !name.empty()) throw py::value_error("name: for one source, not a folder or glob of them");
