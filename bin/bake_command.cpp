@@ -55,48 +55,37 @@ std::string canonical(const std::string& source) {
   return ec ? source : p.string();
 }
 
-void run_bake(const BakeArgs& args, Context& ctx) {
-  int& status = ctx.status;
-  const auto fit = fit_options(args.settings, status);
-  if (!fit) return;
+// The inputs to bake: the expanded INPUTs, or with --scene only what the scene references: its list, or
+// the inputs that are in it.
+std::vector<std::string> select_inputs(const BakeArgs& args, const Context& ctx) {
   std::vector<std::string> inputs = expand_inputs(args.inputs);
-  if (!args.scene.empty()) {
-    // Only what the scene references: its list, or the inputs that are in it.
-    const std::vector<std::string> wanted = scene_materials(args.scene);
-    if (inputs.empty()) {
-      inputs = wanted;
-    } else {
-      std::vector<std::string> kept;
-      for (const auto& in : inputs)
-        for (const auto& w : wanted)
-          if (canonical(in) == canonical(w)) kept.push_back(in);
-      if (!ctx.quiet()) std::fprintf(stderr, "facetfit: the scene references %zu of %zu inputs\n", kept.size(), inputs.size());
-      inputs = kept;
-    }
-  }
-  if (inputs.empty()) {
-    report_error("no input (give files, folders, globs, builtin:NAME or builtin:, or --scene)");
-    status = 2;
-    return;
-  }
+  if (args.scene.empty()) return inputs;
+  const std::vector<std::string> wanted = scene_materials(args.scene);
+  if (inputs.empty()) return wanted;
+  std::vector<std::string> kept;
+  for (const auto& in : inputs)
+    for (const auto& w : wanted)
+      if (canonical(in) == canonical(w)) kept.push_back(in);
+  if (!ctx.quiet()) std::fprintf(stderr, "facetfit: the scene references %zu of %zu inputs\n", kept.size(), inputs.size());
+  return kept;
+}
+
+// Runs `step`; an Error it throws is reported, with status 1. Returns whether it succeeded.
+template <class Step>
+bool run_step(int& status, Step&& step) {
   try {
-    prepare_output_folder(args.out_dir);
+    step();
+    return true;
   } catch (const Error& e) {
     report_error(e.what());
     status = 1;
-    return;
+    return false;
   }
+}
 
-  BakeOptions options;
-  options.fit = *fit;
-  options.tolerance = args.tolerance;
-  options.with_sampling = !args.eval_only;
-  options.force = args.force;
-  const Fitter fitter(options.fit);
-  report_settings(ctx, "bake", options.fit);
-
-  // Output names must be unique: a second input with the same stem is an error, not an overwrite.
-  std::vector<BakeOutcome> outcomes(inputs.size());
+// Output names must be unique: a second input with the same stem is an error, not an overwrite. Returns
+// the indices of the inputs to bake; the others' outcomes hold the error.
+std::vector<std::size_t> claim_output_names(const std::vector<std::string>& inputs, std::vector<BakeOutcome>& outcomes) {
   std::map<std::string, std::string> owner;
   std::vector<std::size_t> todo;
   for (std::size_t k = 0; k < inputs.size(); ++k) {
@@ -110,9 +99,12 @@ void run_bake(const BakeArgs& args, Context& ctx) {
       outcomes[k].error = inputs[k] + ": output name " + name + " is already taken by " + it->second;
     }
   }
-  Progress progress(inputs.size(), ctx.verbosity);
-  for (const auto& o : outcomes)
-    if (!o.error.empty()) report_outcome(progress, o);
+  return todo;
+}
+
+// The inputs at `todo`, baked `jobs` at a time (all cores for 0), each reported as it ends.
+void bake_inputs(const std::vector<std::string>& inputs, const std::vector<std::size_t>& todo, const BakeArgs& args,
+                 const BakeOptions& options, const Fitter& fitter, Progress& progress, std::vector<BakeOutcome>& outcomes) {
   const int jobs = args.jobs > 0 ? args.jobs : int(std::thread::hardware_concurrency());
   tbb::task_arena arena(std::max(1, jobs));
   arena.execute([&] {
@@ -122,62 +114,104 @@ void run_bake(const BakeArgs& args, Context& ctx) {
       report_outcome(progress, outcomes[k]);
     }, tbb::simple_partitioner());
   });
+}
 
-  // index.json is read, merged and written under the folder's lock, from the sidecars as they are on disk:
-  // a concurrent bake of the same names may have replaced them since, and the index must agree with them.
-  std::optional<FolderLock> lock;
-  try {
-    lock.emplace(args.out_dir);
-  } catch (const Error& e) {
-    report_error(e.what());
-    status = 1;
-    return;
-  }
+// Each baked or cached outcome's record as its sidecar is on disk now.
+void reread_sidecars(const std::string& out_dir, std::vector<BakeOutcome>& outcomes) {
   for (auto& o : outcomes) {
     if (o.status == BakeOutcome::Status::failed) continue;
-    nlohmann::json on_disk = read_json_file((fs::path(args.out_dir) / (o.name + ".json")).string());
+    nlohmann::json on_disk = read_json_file((fs::path(out_dir) / (o.name + ".json")).string());
     if (on_disk.is_object() && on_disk.contains("cache_key")) o.record = std::move(on_disk);
   }
-  nlohmann::json index;
-  index["facetfit_version"] = FACETFIT_VERSION;
-  index["materials"] = nlohmann::json::array();
-  index["failures"] = nlohmann::json::array();
-  // The index accumulates across batches: earlier entries stay while their LUT exists and this batch did
-  // not bake it again; the failures are this batch's.
+}
+
+// The index accumulates across batches: earlier entries stay while their LUT exists and this batch did
+// not bake it again.
+void keep_earlier_entries(const std::string& out_dir, const std::vector<BakeOutcome>& outcomes, nlohmann::json& materials) {
   std::set<std::string> luts_now;
   for (const auto& o : outcomes)
     if (o.status != BakeOutcome::Status::failed) luts_now.insert(o.record.value("lut", ""));
-  const nlohmann::json previous = read_json_file((fs::path(args.out_dir) / "index.json").string());
+  const nlohmann::json previous = read_json_file((fs::path(out_dir) / "index.json").string());
   if (previous.is_object() && previous.contains("materials") && previous["materials"].is_array())
     for (const auto& m : previous["materials"]) {
       const std::string lut = m.is_object() ? m.value("lut", "") : "";
       std::error_code exists_error;
-      if (!lut.empty() && !luts_now.count(lut) && fs::exists(fs::path(args.out_dir) / lut, exists_error)) index["materials"].push_back(m);
+      if (!lut.empty() && !luts_now.count(lut) && fs::exists(fs::path(out_dir) / lut, exists_error)) materials.push_back(m);
     }
+}
+
+struct BakeCounts {
   int baked = 0, cached = 0, failed = 0;
+};
+
+// index.json's content: the earlier entries that stay, this batch's records, and this batch's failures.
+BakeCounts make_index(const std::string& out_dir, const std::vector<BakeOutcome>& outcomes, nlohmann::json& index) {
+  index["facetfit_version"] = FACETFIT_VERSION;
+  index["materials"] = nlohmann::json::array();
+  index["failures"] = nlohmann::json::array();
+  keep_earlier_entries(out_dir, outcomes, index["materials"]);
+  BakeCounts counts;
   for (const auto& o : outcomes) {
     if (o.status == BakeOutcome::Status::failed) {
       index["failures"].push_back({{"source", o.source}, {"error", o.error}});
-      ++failed;
+      ++counts.failed;
     } else {
       index["materials"].push_back(o.record);
-      (o.status == BakeOutcome::Status::cached ? cached : baked)++;
+      (o.status == BakeOutcome::Status::cached ? counts.cached : counts.baked)++;
     }
   }
-  try {
-    write_file_atomic((fs::path(args.out_dir) / "index.json").string(), json_text(index, 2) + "\n");
-  } catch (const Error& e) {
-    report_error(e.what());
-    status = 1;
-    return;
-  }
-  if (!ctx.quiet()) std::printf("baked %d, cached %d, failed %d: %s\n", baked, cached, failed, (fs::path(args.out_dir) / "index.json").c_str());
-  if (failed > 0) {
-    std::fprintf(stderr, "facetfit: %d of %zu inputs failed:\n", failed, inputs.size());
+  return counts;
+}
+
+// The batch's counts, and each failure's error again at the end (status 1 when there is one).
+void report_summary(const BakeCounts& counts, const std::vector<BakeOutcome>& outcomes, const std::string& out_dir, Context& ctx) {
+  if (!ctx.quiet())
+    std::printf("baked %d, cached %d, failed %d: %s\n", counts.baked, counts.cached, counts.failed, (fs::path(out_dir) / "index.json").c_str());
+  if (counts.failed > 0) {
+    std::fprintf(stderr, "facetfit: %d of %zu inputs failed:\n", counts.failed, outcomes.size());
     for (const auto& o : outcomes)
       if (o.status == BakeOutcome::Status::failed) std::fprintf(stderr, "  %s\n", o.error.c_str());
-    status = 1;
+    ctx.status = 1;
   }
+}
+
+void run_bake(const BakeArgs& args, Context& ctx) {
+  int& status = ctx.status;
+  const auto fit = fit_options(args.settings, status);
+  if (!fit) return;
+  const std::vector<std::string> inputs = select_inputs(args, ctx);
+  if (inputs.empty()) {
+    report_error("no input (give files, folders, globs, builtin:NAME or builtin:, or --scene)");
+    status = 2;
+    return;
+  }
+  if (!run_step(status, [&] { prepare_output_folder(args.out_dir); })) return;
+
+  BakeOptions options;
+  options.fit = *fit;
+  options.tolerance = args.tolerance;
+  options.with_sampling = !args.eval_only;
+  options.force = args.force;
+  const Fitter fitter(options.fit);
+  report_settings(ctx, "bake", options.fit);
+
+  std::vector<BakeOutcome> outcomes(inputs.size());
+  const std::vector<std::size_t> todo = claim_output_names(inputs, outcomes);
+  Progress progress(inputs.size(), ctx.verbosity);
+  for (const auto& o : outcomes)
+    if (!o.error.empty()) report_outcome(progress, o);
+  bake_inputs(inputs, todo, args, options, fitter, progress, outcomes);
+
+  // index.json is read, merged and written under the folder's lock, from the sidecars as they are on disk:
+  // a concurrent bake of the same names may have replaced them since, and the index must agree with them.
+  std::optional<FolderLock> lock;
+  if (!run_step(status, [&] { lock.emplace(args.out_dir); })) return;
+  reread_sidecars(args.out_dir, outcomes);
+  nlohmann::json index;
+  const BakeCounts counts = make_index(args.out_dir, outcomes, index);
+  if (!run_step(status, [&] { write_file_atomic((fs::path(args.out_dir) / "index.json").string(), json_text(index, 2) + "\n"); }))
+    return;
+  report_summary(counts, outcomes, args.out_dir, ctx);
 }
 
 }  // namespace

@@ -58,6 +58,154 @@ bool string_vector_fits(const std::vector<char>& v) {
   return true;
 }
 
+// What the first part's header says of the chunks: its data window, tile size and compression.
+struct ExrLayout {
+  std::int32_t window[4] = {0, 0, -1, -1};
+  std::uint32_t tile[2] = {1, 1};
+  int compression = 0;
+  bool has_window = false;
+};
+
+// An attribute of a type whose value OpenEXR reads by its own size must state that size.
+void check_fixed_size(const std::string& path, const std::string& name, const std::string& type, std::int32_t size) {
+  static const std::pair<const char*, int> kFixedSizes[] = {
+      {"box2i", 16}, {"box2f", 16}, {"compression", 1}, {"lineOrder", 1}, {"envmap", 1}, {"deepImageState", 1},
+      {"float", 4},  {"int", 4},    {"double", 8},      {"rational", 8},  {"timecode", 8}, {"keycode", 28},
+      {"v2i", 8},    {"v2f", 8},    {"v2d", 16},        {"v3i", 12},      {"v3f", 12},     {"v3d", 24},
+      {"m33f", 36},  {"m33d", 72},  {"m44f", 64},       {"m44d", 128},    {"tiledesc", 9}, {"chromaticities", 32}};
+  for (const auto& [known, bytes] : kFixedSizes)
+    if (type == known && size != bytes)
+      fail(path, "OpenEXR header: attribute '" + name + "' of type " + type + " has " + std::to_string(size) + " bytes, not " +
+                     std::to_string(bytes));
+}
+
+// A preview's value: OpenEXR allocates width x height x 4 bytes from its first 8.
+void check_preview(const std::string& path, const std::string& name, std::int32_t size, const std::vector<char>& value) {
+  std::uint32_t wh[2] = {0, 0};
+  if (size >= 8) std::memcpy(wh, value.data(), 8);
+  if (size < 8 || std::uint64_t(wh[0]) * wh[1] * 4u + 8u != std::uint64_t(size))
+    fail(path, "OpenEXR header: preview '" + name + "' does not match its size");
+}
+
+// The data window, compression and tiles of the first part, from an attribute's first (up to 16) bytes.
+void record_layout(const std::string& name, std::int32_t size, const std::vector<char>& value, ExrLayout& layout) {
+  if (name == "dataWindow" && size == 16) {
+    std::memcpy(layout.window, value.data(), 16);
+    layout.has_window = true;
+  }
+  if (name == "compression" && size == 1) layout.compression = static_cast<unsigned char>(value[0]);
+  if (name == "tiles" && size >= 8) std::memcpy(layout.tile, value.data(), 8);
+}
+
+// An OpenEXR file's headers, walked attribute by attribute: every attribute must fit in the file (of
+// `file_size` bytes), a name in `max_name` characters.
+struct ExrHeaderWalk {
+  std::istream& in;
+  const std::string& path;
+  std::uint64_t file_size;
+  std::size_t max_name;
+
+  void read_name(std::string& out) {
+    out.clear();
+    for (char c; in.get(c);) {
+      if (c == '\0') return;
+      if (out.size() == max_name) fail(path, "OpenEXR header: a name longer than " + std::to_string(max_name) + " characters");
+      out += c;
+    }
+    fail(path, "OpenEXR header: truncated");
+  }
+
+  // A value that OpenEXR reads entry by entry (a channel list, a string vector), of `size` bytes from
+  // `at`: each entry must fit.
+  void check_entries(const std::string& name, const std::string& type, std::int32_t size, std::uint64_t at) {
+    std::vector<char> all(static_cast<std::size_t>(size));
+    in.seekg(std::streamoff(at));
+    in.read(all.data(), size);
+    if (!in) fail(path, "OpenEXR header: truncated");
+    if (!(type == "chlist" ? channel_list_fits(all, max_name) : string_vector_fits(all)))
+      fail(path, "OpenEXR header: attribute '" + name + "' of type " + type + " does not match its size");
+  }
+
+  // The attribute `name` of header `part`, after its name: its type, size and value, left behind.
+  void read_attribute(const std::string& name, int part, ExrLayout& layout) {
+    std::string type;
+    read_name(type);
+    std::int32_t size = 0;
+    if (!in.read(reinterpret_cast<char*>(&size), 4)) fail(path, "OpenEXR header: truncated");
+    const std::uint64_t at = std::uint64_t(in.tellg());
+    if (size < 0 || std::uint64_t(size) > file_size - at)
+      fail(path, "OpenEXR header: attribute '" + name + "' claims " + std::to_string(size) + " bytes, the file has " +
+                     std::to_string(file_size - at) + " left");
+    check_fixed_size(path, name, type, size);
+    std::vector<char> value(std::size_t(std::min<std::int32_t>(size, 16)));
+    in.read(value.data(), std::streamsize(value.size()));
+    if (type == "chlist" || type == "stringvector") check_entries(name, type, size, at);
+    if (type == "preview") check_preview(path, name, size, value);
+    if (part == 0) record_layout(name, size, value, layout);
+    in.seekg(std::streamoff(at + std::uint64_t(size)));
+  }
+
+  // Every header (one, or each part's of a multi-part file), to the end of the last.
+  ExrLayout read_headers(bool multipart) {
+    ExrLayout layout;
+    for (int part = 0;; ++part) {
+      std::string name;
+      read_name(name);
+      if (name.empty()) break;  // end of this header (or, in a multi-part file, of all headers)
+      for (; !name.empty(); read_name(name)) read_attribute(name, part, layout);
+      if (!multipart) break;
+    }
+    return layout;
+  }
+};
+
+// The data window's width and height, which OpenEXR sizes its line buffers by.
+std::pair<std::int64_t, std::int64_t> data_window_size(const std::string& path, const ExrLayout& layout) {
+  const std::int32_t* window = layout.window;
+  const std::int64_t width = std::int64_t(window[2]) - window[0] + 1, height = std::int64_t(window[3]) - window[1] + 1;
+  if (width < 1 || height < 1) fail(path, "OpenEXR header: empty data window");
+  // OpenEXR sizes its line buffers by the width as it opens the file: nothing facetfit reads is wider or
+  // taller than 65536 (an 8-million-pixel-wide 416-byte file took seconds to open and close).
+  if (width > 65536 || height > 65536)
+    fail(path, "OpenEXR header: a " + std::to_string(width) + " x " + std::to_string(height) + " image; at most 65536 x 65536");
+  return {width, height};
+}
+
+// The chunks of a width x height image: its scanline blocks, or the tiles of the first level.
+std::uint64_t chunk_count(const std::string& path, const ExrLayout& layout, bool tiled, std::int64_t width, std::int64_t height) {
+  // Scanlines per chunk of each compression (OpenEXR's table).
+  static constexpr int kLines[] = {1, 1, 1, 16, 32, 16, 32, 32, 32, 256};
+  if (tiled) {
+    const std::uint32_t* tile = layout.tile;
+    if (tile[0] == 0 || tile[1] == 0) fail(path, "OpenEXR header: zero tile size");
+    return std::uint64_t((width + tile[0] - 1) / tile[0]) * std::uint64_t((height + tile[1] - 1) / tile[1]);
+  }
+  const int compression = layout.compression;
+  const int lines = compression >= 0 && compression < 10 ? kLines[compression] : 1;
+  return std::uint64_t((height + lines - 1) / lines);
+}
+
+// A scanline file's chunks follow its offset table, every offset inside the file. A data window changed
+// after writing implies a table of another length, and OpenEXR then decodes chunks of other sizes
+// without an error: a 512 x 256 map whose window said 65536 x 1 read as one line of garbage.
+void check_chunk_offsets(std::istream& in, const std::string& path, std::uint64_t file_size, std::uint64_t header_end,
+                         std::uint64_t chunks) {
+  const std::uint64_t table_end = header_end + 8 * chunks;
+  std::uint64_t first = file_size;
+  for (std::uint64_t c = 0; c < chunks; ++c) {
+    std::uint64_t offset = 0;
+    if (!in.read(reinterpret_cast<char*>(&offset), 8)) fail(path, "OpenEXR: truncated chunk offset table");
+    if (offset < table_end || offset >= file_size)
+      fail(path, "OpenEXR: chunk " + std::to_string(c) + "'s offset " + std::to_string(offset) +
+                     " is outside the file's chunks (an incomplete file, or a data window that does not match its data)");
+    first = std::min(first, offset);
+  }
+  if (first != table_end)
+    fail(path, "OpenEXR: the chunks start at byte " + std::to_string(first) + ", not right after the " + std::to_string(chunks) +
+                   "-entry offset table the data window implies (byte " + std::to_string(table_end) +
+                   "): the data window does not match the data");
+}
+
 // OpenEXR 3.1 allocates what a header claims before reading it: a 6 KB file whose string attribute
 // claims 1.6 GB took 1.7 GB (found by fuzz_lut). The headers are walked here first, and every attribute
 // must fit in the file, as must the chunk offset table the data window implies (8 bytes per chunk).
@@ -74,106 +222,16 @@ bool check_exr_header(const std::string& path) {
   // types it knows by their own size, whatever size the header states: a header that disagrees is parsed
   // differently by OpenEXR than here, so it is refused.
   const std::size_t max_name = (magic[5] & 0x04) != 0 ? 255 : 31;
-  const auto read_name = [&](std::string& out) {
-    out.clear();
-    for (char c; in.get(c);) {
-      if (c == '\0') return true;
-      if (out.size() == max_name) fail(path, "OpenEXR header: a name longer than " + std::to_string(max_name) + " characters");
-      out += c;
-    }
-    fail(path, "OpenEXR header: truncated");
-  };
-  static const std::pair<const char*, int> kFixedSizes[] = {
-      {"box2i", 16}, {"box2f", 16}, {"compression", 1}, {"lineOrder", 1}, {"envmap", 1}, {"deepImageState", 1},
-      {"float", 4},  {"int", 4},    {"double", 8},      {"rational", 8},  {"timecode", 8}, {"keycode", 28},
-      {"v2i", 8},    {"v2f", 8},    {"v2d", 16},        {"v3i", 12},      {"v3f", 12},     {"v3d", 24},
-      {"m33f", 36},  {"m33d", 72},  {"m44f", 64},       {"m44d", 128},    {"tiledesc", 9}, {"chromaticities", 32}};
-  std::int32_t window[4] = {0, 0, -1, -1};
-  std::uint32_t tile[2] = {1, 1};
-  int compression = 0;
-  bool has_window = false;
-  for (int part = 0;; ++part) {
-    std::string name, type;
-    read_name(name);
-    if (name.empty()) break;  // end of this header (or, in a multi-part file, of all headers)
-    for (; !name.empty(); read_name(name)) {
-      read_name(type);
-      std::int32_t size = 0;
-      if (!in.read(reinterpret_cast<char*>(&size), 4)) fail(path, "OpenEXR header: truncated");
-      const std::uint64_t at = std::uint64_t(in.tellg());
-      if (size < 0 || std::uint64_t(size) > file_size - at)
-        fail(path, "OpenEXR header: attribute '" + name + "' claims " + std::to_string(size) + " bytes, the file has " +
-                       std::to_string(file_size - at) + " left");
-      for (const auto& [known, bytes] : kFixedSizes)
-        if (type == known && size != bytes)
-          fail(path, "OpenEXR header: attribute '" + name + "' of type " + type + " has " + std::to_string(size) + " bytes, not " +
-                         std::to_string(bytes));
-      std::vector<char> value(std::size_t(std::min<std::int32_t>(size, 16)));
-      in.read(value.data(), std::streamsize(value.size()));
-      if (type == "chlist" || type == "stringvector") {  // read by OpenEXR entry by entry: each must fit
-        std::vector<char> all(static_cast<std::size_t>(size));
-        in.seekg(std::streamoff(at));
-        in.read(all.data(), size);
-        if (!in) fail(path, "OpenEXR header: truncated");
-        if (!(type == "chlist" ? channel_list_fits(all, max_name) : string_vector_fits(all)))
-          fail(path, "OpenEXR header: attribute '" + name + "' of type " + type + " does not match its size");
-      }
-      if (type == "preview") {  // OpenEXR allocates width x height x 4 bytes from the first 8
-        std::uint32_t wh[2] = {0, 0};
-        if (size >= 8) std::memcpy(wh, value.data(), 8);
-        if (size < 8 || std::uint64_t(wh[0]) * wh[1] * 4u + 8u != std::uint64_t(size))
-          fail(path, "OpenEXR header: preview '" + name + "' does not match its size");
-      }
-      if (part == 0 && name == "dataWindow" && size == 16) {
-        std::memcpy(window, value.data(), 16);
-        has_window = true;
-      }
-      if (part == 0 && name == "compression" && size == 1) compression = static_cast<unsigned char>(value[0]);
-      if (part == 0 && name == "tiles" && size >= 8) std::memcpy(tile, value.data(), 8);
-      in.seekg(std::streamoff(at + std::uint64_t(size)));
-    }
-    if (!multipart) break;
-  }
-  if (multipart || !has_window) return true;  // OpenEXR refuses a header without a data window
-  const std::int64_t width = std::int64_t(window[2]) - window[0] + 1, height = std::int64_t(window[3]) - window[1] + 1;
-  if (width < 1 || height < 1) fail(path, "OpenEXR header: empty data window");
-  // OpenEXR sizes its line buffers by the width as it opens the file: nothing facetfit reads is wider or
-  // taller than 65536 (an 8-million-pixel-wide 416-byte file took seconds to open and close).
-  if (width > 65536 || height > 65536)
-    fail(path, "OpenEXR header: a " + std::to_string(width) + " x " + std::to_string(height) + " image; at most 65536 x 65536");
-  // Scanlines per chunk of each compression (OpenEXR's table), or tiles of the first level.
-  static constexpr int kLines[] = {1, 1, 1, 16, 32, 16, 32, 32, 32, 256};
-  std::uint64_t chunks;
-  if (tiled) {
-    if (tile[0] == 0 || tile[1] == 0) fail(path, "OpenEXR header: zero tile size");
-    chunks = std::uint64_t((width + tile[0] - 1) / tile[0]) * std::uint64_t((height + tile[1] - 1) / tile[1]);
-  } else {
-    const int lines = compression >= 0 && compression < 10 ? kLines[compression] : 1;
-    chunks = std::uint64_t((height + lines - 1) / lines);
-  }
+  ExrHeaderWalk walk{in, path, file_size, max_name};
+  const ExrLayout layout = walk.read_headers(multipart);
+  if (multipart || !layout.has_window) return true;  // OpenEXR refuses a header without a data window
+  const auto [width, height] = data_window_size(path, layout);
+  const std::uint64_t chunks = chunk_count(path, layout, tiled, width, height);
   const std::uint64_t header_end = std::uint64_t(in.tellg());
   if (chunks > (file_size - header_end) / 8)
     fail(path, "OpenEXR header: a " + std::to_string(width) + " x " + std::to_string(height) + " image needs " +
                    std::to_string(chunks) + " chunks, more than the file's " + std::to_string(file_size) + " bytes can hold");
-  // A scanline file's chunks follow its offset table, every offset inside the file. A data window changed
-  // after writing implies a table of another length, and OpenEXR then decodes chunks of other sizes
-  // without an error: a 512 x 256 map whose window said 65536 x 1 read as one line of garbage.
-  if (!tiled && (magic[5] & 0x08) == 0) {
-    const std::uint64_t table_end = header_end + 8 * chunks;
-    std::uint64_t first = file_size;
-    for (std::uint64_t c = 0; c < chunks; ++c) {
-      std::uint64_t offset = 0;
-      if (!in.read(reinterpret_cast<char*>(&offset), 8)) fail(path, "OpenEXR: truncated chunk offset table");
-      if (offset < table_end || offset >= file_size)
-        fail(path, "OpenEXR: chunk " + std::to_string(c) + "'s offset " + std::to_string(offset) +
-                       " is outside the file's chunks (an incomplete file, or a data window that does not match its data)");
-      first = std::min(first, offset);
-    }
-    if (first != table_end)
-      fail(path, "OpenEXR: the chunks start at byte " + std::to_string(first) + ", not right after the " + std::to_string(chunks) +
-                     "-entry offset table the data window implies (byte " + std::to_string(table_end) +
-                     "): the data window does not match the data");
-  }
+  if (!tiled && (magic[5] & 0x08) == 0) check_chunk_offsets(in, path, file_size, header_end, chunks);
   return true;
 }
 

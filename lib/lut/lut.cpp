@@ -349,20 +349,19 @@ void validate(const std::string& path, const LutMetadata& m) {
     in_range(name, v, 0.0, 1e30);
 }
 
-}  // namespace
-
-Lut read_lut(const std::string& path) {
-  ImageReader image = ImageReader::open(path);
-  const ImageSpec& spec = image.spec();
+// The format version, one this facetfit reads.
+int read_format_version(const std::string& path, const ImageSpec& spec) {
   const int version = spec.get_int(key("format_version"), -1);
   if (version < 0) fail(path, "not a facetfit LUT (no facetfit:format_version attribute)");
   if (version < 1 || version > kLutClosuresVersion)
     fail(path, "LUT format version " + std::to_string(version) + "; this facetfit reads versions 1 to " +
                    std::to_string(kLutClosuresVersion));
+  return version;
+}
 
-  Lut lut;
-  LutMetadata& m = lut.meta;
-  m.format_version = version;
+// The attributes of every version that say what the tables are: provenance, resolution, the Smith model,
+// the recommended representation and the Fresnel curve's f0 and f82.
+void read_lut_header(const std::string& path, const ImageSpec& spec, LutMetadata& m) {
   m.facetfit_version = spec.get_string(key("facetfit_version"));
   m.source = spec.get_string(key("source"));
   m.source_sha256 = spec.get_string(key("source_sha256"));
@@ -383,6 +382,11 @@ Lut read_lut(const std::string& path) {
     fail(path, "facetfit LUT whose smith_code or representation_code contradicts its smith or representation");
   m.f0 = *f0;
   m.f82 = *f82;
+}
+
+// The paper's fit (iterations, residual, moment alphas and NDF distances), the settings and the warnings,
+// one a line.
+void read_extraction_attributes(const ImageSpec& spec, LutMetadata& m) {
   m.iterations = spec.get_int(key("iterations"));
   m.residual = spec.get_float(key("residual"));
   m.alpha_ggx = spec.get_float(key("alpha_ggx"));
@@ -396,125 +400,188 @@ Lut read_lut(const std::string& path) {
     m.warnings.push_back(text.substr(0, end));
     text = end == std::string::npos ? "" : text.substr(end + 1);
   }
+}
+
+// Version 2 on: the body, its exponent (version 4 on), the coat, the three parametric fits and the errors.
+void read_parametric_attributes(const std::string& path, const ImageSpec& spec, int version, LutMetadata& m) {
+  const auto body = get_color(spec, "body");
+  if (!body) fail(path, "facetfit LUT version 2 without facetfit:body");
+  m.body = *body;
+  if (version >= kLutBodyExponentVersion) {
+    m.body_exponent = spec.get_float(key("body_exponent"), -1.0f);
+    if (!(m.body_exponent >= 1.0 && m.body_exponent <= kMaxBodyExponent))
+      fail(path, "facetfit:body_exponent is missing or outside [1, " + std::to_string(int(kMaxBodyExponent)) + "]");
+  }
+  m.coat = {spec.get_float(key("coat_alpha")), spec.get_float(key("coat_f0"))};
+  for (const auto& [name, p] : {std::pair{"ggx", &m.ggx}, {"beckmann", &m.beckmann}, {"lsq", &m.lsq}}) {
+    const std::string n = name;
+    const auto pb = get_color(spec, (n + "_body").c_str()), pf0 = get_color(spec, (n + "_f0").c_str()),
+               pf82 = get_color(spec, (n + "_f82").c_str());
+    p->alpha = spec.get_float(key((n + "_alpha").c_str()), -1.0f);
+    if (!pb || !pf0 || !pf82 || !(p->alpha > 0.0)) fail(path, "facetfit LUT without a valid facetfit:" + n + "_* fit");
+    *p = {p->alpha, *pb, *pf0, *pf82,
+          {spec.get_float(key((n + "_coat_alpha").c_str())), spec.get_float(key((n + "_coat_f0").c_str()))}};
+  }
+  m.error = spec.get_float(key("error"));
+  m.error_ggx = spec.get_float(key("error_ggx"));
+  m.error_beckmann = spec.get_float(key("error_beckmann"));
+  m.error_lsq = spec.get_float(key("error_lsq"));
+  m.error_extraction = spec.get_float(key("error_extraction"));
+}
+
+// Whether the LUT has the anisotropic rows: version 3 always; versions 4 and 5 where they say so.
+bool has_anisotropic_rows(const ImageSpec& spec, int version) {
+  return version == kLutAnisotropicVersion ||
+         (version >= kLutBodyExponentVersion && spec.get_int(key("anisotropic_phi_count"), 0) > 0);
+}
+
+// The anisotropic rows' size and the anisotropic GGX fit.
+void read_anisotropic_attributes(const std::string& path, const ImageSpec& spec, LutMetadata& m) {
+  m.anisotropic_resolution = spec.get_int(key("anisotropic_resolution"), -1);
+  m.anisotropic_phi_count = spec.get_int(key("anisotropic_phi_count"), -1);
+  // Bounded before anything is sized from them; the quadrature's own limits.
+  if (m.anisotropic_resolution < 4 || m.anisotropic_resolution > 4096 || m.anisotropic_phi_count < 4 ||
+      m.anisotropic_phi_count > 4096 || m.anisotropic_phi_count % 2 != 0)
+    fail(path, "facetfit:anisotropic_resolution or facetfit:anisotropic_phi_count is missing or out of range (" +
+                   std::to_string(m.anisotropic_resolution) + ", " + std::to_string(m.anisotropic_phi_count) + ")");
+  AnisotropicParametricFit& g = m.anisotropic_ggx;
+  g.alpha = {spec.get_float(key("anisotropic_ggx_alpha_x")), spec.get_float(key("anisotropic_ggx_alpha_y")),
+             spec.get_float(key("anisotropic_ggx_angle"))};
+  const auto g_body = get_color(spec, "anisotropic_ggx_body"), g_f0 = get_color(spec, "anisotropic_ggx_f0"),
+             g_f82 = get_color(spec, "anisotropic_ggx_f82");
+  if (!g_body || !g_f0 || !g_f82) fail(path, "facetfit LUT with an anisotropic lobe without facetfit:anisotropic_ggx_body, _f0 or _f82");
+  g.body = *g_body, g.f0 = *g_f0, g.f82 = *g_f82;
+  g.error = spec.get_float(key("anisotropic_ggx_error"));
+}
+
+// Every attribute of a LUT of `version`, checked as it is read.
+LutMetadata read_lut_attributes(const std::string& path, const ImageSpec& spec, int version) {
+  LutMetadata m;
+  m.format_version = version;
+  read_lut_header(path, spec, m);
+  read_extraction_attributes(spec, m);
   if (version == 1) {  // no body; the parametric fits are the moment alphas with the curve's f0 and f82
     m.ggx = {m.alpha_ggx, Rgb(0.0), m.f0, m.f82, {}};
     m.beckmann = {m.alpha_beckmann, Rgb(0.0), m.f0, m.f82, {}};
     m.lsq = m.ggx;
   } else {
-    const auto body = get_color(spec, "body");
-    if (!body) fail(path, "facetfit LUT version 2 without facetfit:body");
-    m.body = *body;
-    if (version >= kLutBodyExponentVersion) {
-      m.body_exponent = spec.get_float(key("body_exponent"), -1.0f);
-      if (!(m.body_exponent >= 1.0 && m.body_exponent <= kMaxBodyExponent))
-        fail(path, "facetfit:body_exponent is missing or outside [1, " + std::to_string(int(kMaxBodyExponent)) + "]");
-    }
-    m.coat = {spec.get_float(key("coat_alpha")), spec.get_float(key("coat_f0"))};
-    for (const auto& [name, p] : {std::pair{"ggx", &m.ggx}, {"beckmann", &m.beckmann}, {"lsq", &m.lsq}}) {
-      const std::string n = name;
-      const auto pb = get_color(spec, (n + "_body").c_str()), pf0 = get_color(spec, (n + "_f0").c_str()),
-                 pf82 = get_color(spec, (n + "_f82").c_str());
-      p->alpha = spec.get_float(key((n + "_alpha").c_str()), -1.0f);
-      if (!pb || !pf0 || !pf82 || !(p->alpha > 0.0)) fail(path, "facetfit LUT without a valid facetfit:" + n + "_* fit");
-      *p = {p->alpha, *pb, *pf0, *pf82,
-            {spec.get_float(key((n + "_coat_alpha").c_str())), spec.get_float(key((n + "_coat_f0").c_str()))}};
-    }
-    m.error = spec.get_float(key("error"));
-    m.error_ggx = spec.get_float(key("error_ggx"));
-    m.error_beckmann = spec.get_float(key("error_beckmann"));
-    m.error_lsq = spec.get_float(key("error_lsq"));
-    m.error_extraction = spec.get_float(key("error_extraction"));
+    read_parametric_attributes(path, spec, version, m);
   }
-
   if (version >= kLutClosuresVersion) read_closures(path, spec, m);
-  // Version 3 always has the anisotropic rows; versions 4 and 5 where they say so.
-  if (version == kLutAnisotropicVersion || (version >= kLutBodyExponentVersion && spec.get_int(key("anisotropic_phi_count"), 0) > 0)) {
-    m.anisotropic_resolution = spec.get_int(key("anisotropic_resolution"), -1);
-    m.anisotropic_phi_count = spec.get_int(key("anisotropic_phi_count"), -1);
-    // Bounded before anything is sized from them; the quadrature's own limits.
-    if (m.anisotropic_resolution < 4 || m.anisotropic_resolution > 4096 || m.anisotropic_phi_count < 4 ||
-        m.anisotropic_phi_count > 4096 || m.anisotropic_phi_count % 2 != 0)
-      fail(path, "facetfit:anisotropic_resolution or facetfit:anisotropic_phi_count is missing or out of range (" +
-                     std::to_string(m.anisotropic_resolution) + ", " + std::to_string(m.anisotropic_phi_count) + ")");
-    AnisotropicParametricFit& g = m.anisotropic_ggx;
-    g.alpha = {spec.get_float(key("anisotropic_ggx_alpha_x")), spec.get_float(key("anisotropic_ggx_alpha_y")),
-               spec.get_float(key("anisotropic_ggx_angle"))};
-    const auto g_body = get_color(spec, "anisotropic_ggx_body"), g_f0 = get_color(spec, "anisotropic_ggx_f0"),
-               g_f82 = get_color(spec, "anisotropic_ggx_f82");
-    if (!g_body || !g_f0 || !g_f82) fail(path, "facetfit LUT with an anisotropic lobe without facetfit:anisotropic_ggx_body, _f0 or _f82");
-    g.body = *g_body, g.f0 = *g_f0, g.f82 = *g_f82;
-    g.error = spec.get_float(key("anisotropic_ggx_error"));
-  }
-  validate(path, m);
-  const LutLayout layout = LutLayout::of(m.resolution, m.sampling, m.anisotropic_resolution, m.anisotropic_phi_count);
+  if (has_anisotropic_rows(spec, version)) read_anisotropic_attributes(path, spec, m);
+  return m;
+}
+
+// The image is the size the metadata implies.
+void check_image_size(const std::string& path, const ImageSpec& spec, const LutLayout& layout, int resolution) {
   if (spec.width != layout.width || spec.height != layout.height)
     fail(path, "image is " + std::to_string(spec.width) + " x " + std::to_string(spec.height) + ", expected " +
                    std::to_string(layout.width) + " x " + std::to_string(layout.height) + " for resolution " +
-                   std::to_string(m.resolution));
-  const std::array<int, 3> channel = rgb_channels(spec, path, OneChannel::refused);
-  const std::vector<float> pixels = image.read_pixels();
-  const auto get = [&](int row, int x, int c) {
-    const float v = pixels[(std::size_t(row) * spec.width + x) * spec.channels.size() + channel[std::size_t(c)]];
+                   std::to_string(resolution));
+}
+
+// The LUT image's pixels, read by row, column and channel (R, G, B), each refused unless finite.
+struct LutPixels {
+  const std::string& path;
+  const ImageSpec& spec;
+  std::array<int, 3> channel;
+  std::vector<float> values;
+
+  double get(int row, int x, int c) const {
+    const float v = values[(std::size_t(row) * spec.width + x) * spec.channels.size() + channel[std::size_t(c)]];
     if (!std::isfinite(v)) fail(path, "non-finite value in row " + std::to_string(row) + ", column " + std::to_string(x));
     return double(v);
-  };
+  }
 
   // A Fresnel row's reflectance: a negative one (an edited file) would render negative pixels.
-  const auto reflectance = [&](int row, int x) {
+  Rgb reflectance(int row, int x) const {
     const Rgb f(get(row, x, 0), get(row, x, 1), get(row, x, 2));
     if (!(f.r >= 0.0 && f.g >= 0.0 && f.b >= 0.0))
       fail(path, "row " + std::to_string(row) + ", column " + std::to_string(x) + ": the Fresnel reflectance must be >= 0");
     return f;
-  };
-
-  const int nodes = m.resolution + 1;
-  TabulatedNdf& ndf = lut.tables.ndf;
-  ndf.grid = ThetaGrid{m.resolution};
-  for (int x = 0; x < nodes; ++x) {
-    ndf.ndf.push_back(get(LutLayout::kNdfRow, x, 0));
-    ndf.sigma.push_back(get(LutLayout::kSigmaRow, x, 0));
-    // A negative density or projected area is no lobe (an edited file): refused, as for the anisotropic rows.
-    if (!(ndf.ndf.back() >= 0.0 && ndf.sigma.back() > 0.0))
-      fail(path, "rows " + std::to_string(LutLayout::kNdfRow) + " and " + std::to_string(LutLayout::kSigmaRow) + ", column " +
-                     std::to_string(x) + ": D must be >= 0 and sigma > 0");
   }
-  for (int x = 0; x < FresnelCurve::kSize; ++x) lut.tables.fresnel.value[std::size_t(x)] = reflectance(LutLayout::kFresnelRow, x);
+};
+
+// A negative density or projected area is no lobe (an edited file): refused, in the isotropic and the
+// anisotropic rows alike.
+bool is_lobe_node(double d, double sigma) { return d >= 0.0 && sigma > 0.0; }
+
+// The isotropic NDF and sigma rows.
+void read_ndf_rows(const LutPixels& pixels, int resolution, TabulatedNdf& ndf) {
+  ndf.grid = ThetaGrid{resolution};
+  for (int x = 0; x <= resolution; ++x) {
+    ndf.ndf.push_back(pixels.get(LutLayout::kNdfRow, x, 0));
+    ndf.sigma.push_back(pixels.get(LutLayout::kSigmaRow, x, 0));
+    if (!is_lobe_node(ndf.ndf.back(), ndf.sigma.back()))
+      fail(pixels.path, "rows " + std::to_string(LutLayout::kNdfRow) + " and " + std::to_string(LutLayout::kSigmaRow) + ", column " +
+                            std::to_string(x) + ": D must be >= 0 and sigma > 0");
+  }
+}
+
+// A Fresnel curve's row.
+void read_fresnel_row(const LutPixels& pixels, int row, FresnelCurve& fresnel) {
+  for (int x = 0; x < FresnelCurve::kSize; ++x) fresnel.value[std::size_t(x)] = pixels.reflectance(row, x);
+}
+
+// The visible-normal sampling rows, one CDF per row.
+void read_sampling_rows(const LutPixels& pixels, int resolution, VisibleNormalTables& sampling) {
+  const int nodes = resolution + 1;
+  sampling.resolution = resolution;
+  sampling.cdf.resize(std::size_t(nodes) * nodes);
+  for (int s = 0; s < nodes; ++s) {
+    double* row = sampling.cdf.data() + std::size_t(s) * nodes;
+    for (int x = 0; x < nodes; ++x) row[x] = pixels.get(LutLayout::kSamplingRow + s, x, 0);
+    // The samplers search each row as running sums (sample_cdf, the lanes' guide): 0 to 1, never falling.
+    for (int x = 1; x < nodes; ++x)
+      if (!(row[x] >= row[x - 1]))
+        fail(pixels.path, "row " + std::to_string(LutLayout::kSamplingRow + s) + ", column " + std::to_string(x) +
+                              ": the sampling CDF falls (or is not a number)");
+    if (row[0] != 0.0 || row[nodes - 1] != 1.0)
+      fail(pixels.path, "row " + std::to_string(LutLayout::kSamplingRow + s) + ": the sampling CDF must run from 0 to 1");
+  }
+}
+
+// The anisotropic rows from `first_row`: the Fresnel curve, then one row of D and sigma per azimuth.
+AnisotropicTables read_anisotropic_rows(const LutPixels& pixels, const LutMetadata& m, int first_row) {
+  AnisotropicTables a;
+  a.grid = ThetaGrid{m.anisotropic_resolution};
+  a.phi_count = m.anisotropic_phi_count;
+  a.smith = m.smith;
+  read_fresnel_row(pixels, first_row, a.fresnel);
+  for (int x = 0; x <= m.anisotropic_resolution; ++x)
+    for (int p = 0; p < a.phi_count; ++p) {
+      a.ndf.push_back(pixels.get(first_row + 1 + p, x, 0));
+      a.sigma.push_back(pixels.get(first_row + 1 + p, x, 1));
+      if (!is_lobe_node(a.ndf.back(), a.sigma.back()))
+        fail(pixels.path, "anisotropic row " + std::to_string(first_row + 1 + p) + ", column " + std::to_string(x) +
+                              ": D must be >= 0 and sigma > 0");
+    }
+  a.axis = m.anisotropic_ggx.alpha.angle;
+  return a;
+}
+
+}  // namespace
+
+Lut read_lut(const std::string& path) {
+  ImageReader image = ImageReader::open(path);
+  const ImageSpec& spec = image.spec();
+  Lut lut;
+  lut.meta = read_lut_attributes(path, spec, read_format_version(path, spec));
+  const LutMetadata& m = lut.meta;
+  validate(path, m);
+  const LutLayout layout = LutLayout::of(m.resolution, m.sampling, m.anisotropic_resolution, m.anisotropic_phi_count);
+  check_image_size(path, spec, layout, m.resolution);
+  const std::array<int, 3> channel = rgb_channels(spec, path, OneChannel::refused);
+  const LutPixels pixels{path, spec, channel, image.read_pixels()};
+
+  read_ndf_rows(pixels, m.resolution, lut.tables.ndf);
+  read_fresnel_row(pixels, LutLayout::kFresnelRow, lut.tables.fresnel);
   lut.tables.smith = m.smith;
   lut.tables.body = m.body;
   lut.tables.body_exponent = m.body_exponent;
   lut.tables.coat = m.coat;
-  if (m.sampling) {
-    lut.sampling.resolution = m.resolution;
-    lut.sampling.cdf.resize(std::size_t(nodes) * nodes);
-    for (int s = 0; s < nodes; ++s) {
-      double* row = lut.sampling.cdf.data() + std::size_t(s) * nodes;
-      for (int x = 0; x < nodes; ++x) row[x] = get(LutLayout::kSamplingRow + s, x, 0);
-      // The samplers search each row as running sums (sample_cdf, the lanes' guide): 0 to 1, never falling.
-      for (int x = 1; x < nodes; ++x)
-        if (!(row[x] >= row[x - 1]))
-          fail(path, "row " + std::to_string(LutLayout::kSamplingRow + s) + ", column " + std::to_string(x) +
-                         ": the sampling CDF falls (or is not a number)");
-      if (row[0] != 0.0 || row[nodes - 1] != 1.0)
-        fail(path, "row " + std::to_string(LutLayout::kSamplingRow + s) + ": the sampling CDF must run from 0 to 1");
-    }
-  }
-  if (m.anisotropic_phi_count > 0) {
-    AnisotropicTables a;
-    a.grid = ThetaGrid{m.anisotropic_resolution};
-    a.phi_count = m.anisotropic_phi_count;
-    a.smith = m.smith;
-    for (int x = 0; x < FresnelCurve::kSize; ++x) a.fresnel.value[std::size_t(x)] = reflectance(layout.anisotropic_row, x);
-    for (int x = 0; x <= m.anisotropic_resolution; ++x)
-      for (int p = 0; p < a.phi_count; ++p) {
-        a.ndf.push_back(get(layout.anisotropic_row + 1 + p, x, 0));
-        a.sigma.push_back(get(layout.anisotropic_row + 1 + p, x, 1));
-        if (!(a.ndf.back() >= 0.0 && a.sigma.back() > 0.0))
-          fail(path, "anisotropic row " + std::to_string(layout.anisotropic_row + 1 + p) + ", column " + std::to_string(x) +
-                         ": D must be >= 0 and sigma > 0");
-      }
-    a.axis = m.anisotropic_ggx.alpha.angle;
-    lut.anisotropic = std::move(a);
-  }
+  if (m.sampling) read_sampling_rows(pixels, m.resolution, lut.sampling);
+  if (m.anisotropic_phi_count > 0) lut.anisotropic = read_anisotropic_rows(pixels, m, layout.anisotropic_row);
   return lut;
 }
 
