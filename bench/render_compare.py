@@ -375,7 +375,7 @@ def main(facetfit, mitsuba_python, dst, rgl=None):
                   "falls as 1 / spp, so *time to equal noise* = (facetfit's render time x its variance) / (Mitsuba's x\n"
                   "its): the ratio of the times the two need for the same noise. Per sample facetfit lights a hit by every\n"
                   "light (the directional light's shadow ray each sample) and by one BRDF sample for the environment (a\n"
-                  "map also gets a light sample, the two weighted by multiple importance sampling: render/renderer.cpp;\n"
+                  "map also gets a light sample, the two weighted by multiple importance sampling: render/integrator.cpp;\n"
                   "a constant environment's uniform light sample, so weighted, added noise: at 64 spp the variance of the\n"
                   "GGX sphere fell from 0.00023 to 0.000132 and of the LUT sphere from 0.000149 to 0.0000838 without it,\n"
                   "one-off measurement of 2026-12-05). Mitsuba's `direct` integrator draws one emitter sample, from one of\n"
@@ -397,7 +397,7 @@ def main(facetfit, mitsuba_python, dst, rgl=None):
                   "is its render time plus this.\n" % (RUNS, startup[0], startup[1], startup[2]))
         out.write("\n## Where the time goes\n\n`perf record` of one facetfit render (64 spp, whole process), self time by\n"
                   "library and symbol (the sphere is intersected in closed form, render/tracer.h; Embree traces triangles only).\n"
-                  "A tile's samples are shaded in steps (render/renderer.cpp), each in SIMD lanes over the tile (`N_AVX3::` on\n"
+                  "A tile's samples are shaded in steps (render/integrator_streams.cpp), each in SIMD lanes over the tile (`N_AVX3::` on\n"
                   "an AVX-512 host, `N_AVX2::` with AVX2): their numbers and camera rays (`DrawCameraSamples`,\n"
                   "render/camera_batch.h), the spheres' hits (`NearestSpheresFromPoint` for camera rays, render/sphere_batch.h),\n"
                   "the tile's hit columns (`TakeHits`, render/wavefront.h), the hits placed per\n"

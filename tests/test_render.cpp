@@ -493,7 +493,7 @@ TEST(Wavefront, HitsAndSlotsEqualTheOneHitPath) {
           ++e;
         }
         EXPECT_EQ(e, slots.size()) << where;
-        // The values (the one-hit path's, render/renderer.cpp): an environment light sample f L cos w / p_light,
+        // The values (the one-hit path's, render/integrator.cpp): an environment light sample f L cos w / p_light,
         // a light's f E cos, a BRDF sample f cos / p L w, w by the power heuristic, 1 against a density of 0
         // (a constant environment's, or a map's where it is black); none cast for a BRDF sample of density 0.
         // Densities so small that their squares underflow (1e-170) too, against 0 and against another.
@@ -1154,7 +1154,7 @@ TEST(Render, StretchedLutMaterials) {
 }
 
 // A constant environment is lit by the BRDF sample alone, a map by a light sample and a BRDF sample
-// weighted by multiple importance sampling (render/renderer.cpp): two estimators of the same integral.
+// weighted by multiple importance sampling (render/integrator.cpp): two estimators of the same integral.
 // A map whose every pixel is the constant must then give the same sphere, to the noise, for every kind of
 // model: closed-form GGX, tabulated Beckmann, Lambert, a measured table under its fitted proposal, a LUT,
 // and a stretched LUT (shaded one pair at a time).

@@ -12,7 +12,7 @@
 
 namespace facetfit {
 
-// The numbers a sample draws: two for the pixel's jitter, five for its shading (render/renderer.cpp).
+// The numbers a sample draws: two for the pixel's jitter, five for its shading (render/integrator.h).
 constexpr int kSampleNumbers = 7;
 
 // SplitMix64, a counter-based generator: the sequence of sample s of pixel (x, y) starts at a state that

@@ -4,7 +4,7 @@
 // shadow rays' values took half of a GGX sphere's render (docs/render-speed.md).
 //
 // Per hit the slots are, in this order: the environment's light sample (a map's; a constant environment
-// has none, render/renderer.cpp), the BRDF sample (with an environment), then each light. A slot that
+// has none, render/integrator.cpp), the BRDF sample (with an environment), then each light. A slot that
 // lights nothing (below the horizon, no direction found) casts no ray. The renderer adds a hit's unblocked rays in slot order, as its one-ray-at-a-time path does.
 #pragma once
 
