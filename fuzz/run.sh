@@ -6,7 +6,7 @@
 set -euo pipefail
 build=$1; seconds=$2; shift 2
 here="$(cd "$(dirname "$0")" && pwd)"
-targets=("${@:-merl rgl scene obj lut env deltae}")
+targets=("${@:-merl rgl utia scene obj lut env deltae}")
 targets=(${targets[@]})
 mkdir -p "$build/findings"
 python3 "$here/make_seeds.py" "$build/seeds"
@@ -21,6 +21,7 @@ for t in "${targets[@]}"; do
   log="$build/fuzz_$t.log"
   max_len=65536; [[ $t == rgl ]] && max_len=1048576  # a real RGL material is 0.66 MB
   [[ $t == lut ]] && max_len=262144                   # a LUT with sampling tables is ~100 KB
+  [[ $t == utia ]] && max_len=1990656                 # a UTIA file is 3 x 6 x 48 x 6 x 48 doubles
   run_target() {
     "$build/fuzz/fuzz_$t" "$corpus" "${seeds[@]}" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 \
       -max_len="$max_len" -artifact_prefix="$build/findings/$t-" -print_final_stats=1 >"$log" 2>&1

@@ -1,5 +1,6 @@
-// write_seeds OUT: the seeds of fuzz_lut and fuzz_env that only the library can write: LUTs of a
-// built-in material (with and without sampling tables), and small environment maps (EXR, HDR).
+// write_seeds OUT: the seeds that only the library can write: LUTs of a built-in material (with and
+// without sampling tables, fuzz_lut), small environment maps (EXR, HDR; fuzz_env), and a UTIA file of an
+// analytic model (fuzz_utia).
 #include <cstdio>
 #include <filesystem>
 #include <string>
@@ -7,6 +8,7 @@
 #include "fit/fit.h"
 #include "io/image_file.h"
 #include "io/input.h"
+#include "io/utia.h"
 #include "lut/lut.h"
 #include "render/environment.h"
 
@@ -20,6 +22,7 @@ int main(int argc, char** argv) {
   const fs::path out = argv[1];
   fs::create_directories(out / "lut");
   fs::create_directories(out / "env");
+  fs::create_directories(out / "utia");
   const Fitter fitter(FitOptions::paper());
   const FitResult fit = fitter.fit(load_table("builtin:gold-ggx-0.15"));
   for (const bool sampling : {false, true})
@@ -28,5 +31,6 @@ int main(int argc, char** argv) {
   const Environment sky = Environment::sky(16);
   const ImageSpec spec(sky.width(), sky.height(), {"R", "G", "B"});
   for (const char* name : {"sky.exr", "sky.hdr"}) write_image_atomic((out / "env" / name).string(), spec, sky.pixels().data());
+  UtiaBrdf::tabulate(*load_brdf("builtin:gold-ggx-0.15")).write((out / "utia" / "gold.bin").string());
   return 0;
 }

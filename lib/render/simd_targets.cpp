@@ -8,7 +8,11 @@
 #include <cpuid.h>
 #endif
 
+#ifdef FACETFIT_SIMD_BASELINE_ONLY
+static_assert(HWY_DISABLED_TARGETS == (HWY_AVX3_DL | HWY_AVX3 | HWY_AVX2 | HWY_SSE4 | HWY_SSSE3), "Highway's target bits moved");
+#else
 static_assert(HWY_DISABLED_TARGETS == (HWY_AVX3_DL | HWY_SSE4 | HWY_SSSE3), "Highway's target bits moved");
+#endif
 
 namespace facetfit {
 

@@ -1,15 +1,17 @@
 // The SIMD targets every Highway kernel of the renderer is compiled for, and the choice between them at
 // run time. Included first by each kernel file, before any of Highway's headers.
 //
-// Three targets: AVX3 (AVX-512, eight doubles a vector), AVX2 (four) and the baseline; AVX3_DL, SSE4 and SSSE3
-// are off (their bits in hwy/detect_targets.h, checked against Highway's names in simd_targets.cpp). AVX3 was
-// off while a render ran one hit at a time between its kernels (it made the GGX sphere of
-// docs/render-speed.md slower, 0.22 -> 0.24 s); with a tile's shading in lanes (render/wavefront.h) it
-// renders the GGX sphere at 64 spp in 0.345 s of one CPU against AVX2's 0.362, the LUT sphere in 0.29 s
-// against 0.42 on two, the MERL sphere in 0.45 against 0.65 (one-off probes, medians of alternating runs).
+// Three targets: AVX3 (AVX-512, eight doubles a vector), AVX2 (four) and the baseline; AVX3_DL, SSE4 and
+// SSSE3 are off (their bits in hwy/detect_targets.h, checked against Highway's names in simd_targets.cpp).
+// A build with FACETFIT_SIMD_BASELINE_ONLY (the fuzz build, which never times a kernel) compiles the
+// baseline alone: each kernel file then compiles once instead of three times.
 #pragma once
 
+#ifdef FACETFIT_SIMD_BASELINE_ONLY
+#define HWY_DISABLED_TARGETS ((1LL << 7) | (1LL << 8) | (1LL << 9) | (1LL << 11) | (1LL << 12))
+#else
 #define HWY_DISABLED_TARGETS ((1LL << 7) | (1LL << 11) | (1LL << 12))
+#endif
 
 namespace facetfit {
 
