@@ -6,7 +6,10 @@
 //
 // With FACETFIT_OSL_PICTURES=FOLDER set, the sphere tests also write the pictures and figures of
 // docs/osl.md there (make osl-docs).
+#include <fcntl.h>
 #include <gtest/gtest.h>
+#include <sys/file.h>
+#include <unistd.h>
 
 #include <OpenImageIO/imageio.h>
 
@@ -92,12 +95,57 @@ RunResult osl_compile(const std::string& folder, const std::string& out) {
 // Compiles the shaders of osl/ and tests/osl/ into `dir`. The renders load these .oso files: a script
 // node given a .osl compiles it into a temporary file of Blender's own, which concurrent test processes
 // would share.
-void compile_shaders(const TempDir& dir) {
+void compile_shaders(const std::filesystem::path& dir) {
   for (const std::string folder : {"/osl", "/tests/osl"}) {
-    const RunResult r = osl_compile(kSource + folder, dir.path().string());
+    const RunResult r = osl_compile(kSource + folder, dir.string());
     ASSERT_EQ(r.status, 0) << r.out << r.err;
   }
 }
+
+// A folder of the build that the test processes share (`make test` runs each test in a process of its own):
+// made by `make` once, under a lock that the other processes wait on, and made again when it is older
+// than what it was made from (the command and its plugin, this test binary, the shaders' sources).
+class SharedFolder {
+ public:
+  template <class Make>
+  SharedFolder(const std::filesystem::path& path, const Make& make) : path_(path) {
+    namespace fs = std::filesystem;
+    fs::create_directories(path.parent_path());
+    const std::string lock_path = path.string() + ".lock";
+    const int fd = ::open(lock_path.c_str(), O_CREAT | O_RDWR | O_CLOEXEC, 0644);
+    if (fd < 0 || ::flock(fd, LOCK_EX) != 0) throw std::runtime_error("cannot lock " + lock_path);
+    if (!fresh()) {
+      const fs::path staging = path.string() + ".making";
+      fs::remove_all(staging), fs::create_directories(staging);
+      make(staging);
+      if (::testing::Test::HasFailure()) throw std::runtime_error("could not make " + path.string());
+      std::ofstream(staging / "made").put('\n');
+      fs::remove_all(path), fs::rename(staging, path);
+    }
+    ::close(fd);  // releases the lock
+  }
+  std::string file(const std::string& name) const { return (path_ / name).string(); }
+  const std::filesystem::path& path() const { return path_; }
+
+ private:
+  // Whether the folder was made after every input last changed.
+  bool fresh() const {
+    namespace fs = std::filesystem;
+    std::error_code ec;
+    const auto made = fs::last_write_time(path_ / "made", ec);
+    if (ec) return false;
+    std::vector<fs::path> inputs = {FACETFIT_CLI, fs::path(FACETFIT_CLI).parent_path() / "facetfit-commands.so", "/proc/self/exe"};
+    for (const std::string folder : {"/osl", "/tests/osl"})
+      for (const auto& e : fs::directory_iterator(kSource + folder)) inputs.push_back(e.path());
+    for (fs::path input : inputs) {
+      if (input == "/proc/self/exe") input = fs::read_symlink(input);
+      const auto changed = fs::last_write_time(input, ec);
+      if (ec || changed > made) return false;
+    }
+    return true;
+  }
+  std::filesystem::path path_;
+};
 
 // ---- compilation ------------------------------------------------------------------------------------
 
@@ -137,7 +185,7 @@ TEST(OslCompile, BrokenShaderFailsWithTheCompilersMessage) {
 // shader says why, naming the file.
 TEST(OslMaterial, MissingLutRendersTheErrorColourAndWarns) {
   TempDir dir;
-  compile_shaders(dir);
+  compile_shaders(dir.path());
   const RunResult r = cycles("probe " + dir.file("facetfit_material.oso") + " " + dir.file("out.exr") + " 6 lut=" + dir.file("no-such-lut.exr"));
   const Image img = read_image(dir.file("out.exr"));
   const float* px = img.at(3, 3);
@@ -231,31 +279,37 @@ Cases sample_inputs(std::uint32_t seed) {
 
 class OslModel : public ::testing::TestWithParam<std::string> {
  protected:
-  static void SetUpTestSuite() {
-    luts_ = new TempDir;
+  static void SetUpTestSuite() { luts_ = new SharedFolder(FACETFIT_OSL_FIXTURE, make_luts); }
+  static void TearDownTestSuite() {
+    delete luts_;
+    luts_ = nullptr;
+  }
+
+ public:
+  // The LUTs the probe reads, and the compiled shaders, into `dir`.
+  static void make_luts(const std::filesystem::path& dir) {
+    const auto file = [&](const std::string& name) { return (dir / name).string(); };
     const RunResult r = facetfit("bake builtin:gold-ggx-0.15 builtin:silver-ggx-0.60 builtin:copper-beckmann-0.30 "
-                                 "builtin:blue-clearcoat-paint -o " + luts_->path().string());
+                                 "builtin:blue-clearcoat-paint -o " + dir.string());
     ASSERT_EQ(r.status, 0) << r.err;
     // One LUT fitted with the masking form, so that a Smith model other than the default is read.
-    const RunResult masking = facetfit("bake builtin:silver-ggx-0.60 --smith masking -o " + luts_->file("masking"));
+    const RunResult masking = facetfit("bake builtin:silver-ggx-0.60 --smith masking -o " + file("masking"));
     ASSERT_EQ(masking.status, 0) << masking.err;
     // A body darker toward grazing angles (Minnaert's exponent 1.4, model/body.h): format 4's attribute, in a
     // format 5 LUT.
     MerlTable::tabulate(SumBrdf({std::make_shared<LambertBrdf>(Rgb(0.5, 0.3, 0.1), 1.4),
                                  std::make_shared<MicrofacetBrdf>(Ndf::isotropic(NdfType::ggx, 0.2), Smith::correlated,
                                                                   Fresnel::schlick(Rgb(0.04)))}))
-        .write(luts_->file("minnaert-ggx-0.20.binary"));
-    const RunResult minnaert = facetfit("bake " + luts_->file("minnaert-ggx-0.20.binary") + " -o " + luts_->path().string());
+        .write(file("minnaert-ggx-0.20.binary"));
+    const RunResult minnaert = facetfit("bake " + file("minnaert-ggx-0.20.binary") + " -o " + dir.string());
     ASSERT_EQ(minnaert.status, 0) << minnaert.err;
-    const Lut minnaert_lut = read_lut(luts_->file("minnaert-ggx-0.20.exr"));
+    const Lut minnaert_lut = read_lut(file("minnaert-ggx-0.20.exr"));
     ASSERT_EQ(minnaert_lut.meta.format_version, kLutClosuresVersion);
     ASSERT_GT(minnaert_lut.tables.body_exponent, 1.0);
-    compile_shaders(*luts_);
+    compile_shaders(dir);
   }
-  static void TearDownTestSuite() {
-    delete luts_;
-    luts_ = nullptr;
-  }
+
+ protected:
   // A parameter ending in "+stretch" is that LUT with the artist's stretch (model/stretch.h), which the
   // probe hands to facetfit_stretch.
   bool stretched() const { return GetParam().size() > 8 && GetParam().substr(GetParam().size() - 8) == "+stretch"; }
@@ -312,9 +366,9 @@ class OslModel : public ::testing::TestWithParam<std::string> {
     return img;
   }
 
-  static TempDir* luts_;
+  static SharedFolder* luts_;
 };
-TempDir* OslModel::luts_ = nullptr;
+SharedFolder* OslModel::luts_ = nullptr;
 
 TEST_P(OslModel, MetadataEqualsLibrary) {
   const Lut table = read_lut(lut());
@@ -487,12 +541,14 @@ class OslSphere : public ::testing::Test {
  public:  // the comparison helper below the class uses the renders
   static void SetUpTestSuite() {
     work_ = new TempDir;
-    compile_shaders(*work_);
+    shaders_ = new SharedFolder(FACETFIT_OSL_FIXTURE, OslModel::make_luts);
     write_test_environment(work_->file("sky.exr"));
   }
   static void TearDownTestSuite() {
     delete work_;
     work_ = nullptr;
+    delete shaders_;
+    shaders_ = nullptr;
   }
 
   static std::string bake(const std::string& material) {
@@ -538,7 +594,7 @@ class OslSphere : public ::testing::Test {
   static std::string cycles_sphere(const std::string& name, const std::string& shader, int spp, const std::string& params,
                                    double* seconds) {
     const auto start = std::chrono::steady_clock::now();
-    cycles("sphere " + work_->file(shader + ".oso") + " " + work_->file(name + ".exr") + " " + std::to_string(sphere_size()) + " " +
+    cycles("sphere " + shaders_->file(shader + ".oso") + " " + work_->file(name + ".exr") + " " + std::to_string(sphere_size()) + " " +
            std::to_string(spp) + " " + work_->file("sky.exr") + " " + params);
     *seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return work_->file(name + ".exr");
@@ -577,8 +633,10 @@ class OslSphere : public ::testing::Test {
   }
 
   static TempDir* work_;
+  static SharedFolder* shaders_;  // the compiled shaders (and OslModel's LUTs)
 };
 TempDir* OslSphere::work_ = nullptr;
+SharedFolder* OslSphere::shaders_ = nullptr;
 
 // One comparison: `material` rendered by the reference renderer (`reference_material`, a scene-format
 // material, at `reference_spp`) and by Cycles through `shader` (`cycles_spp` samples per pixel, shader
@@ -748,7 +806,7 @@ TEST_F(OslSphere, MaterialShaderEmitsTheClosures) {
     nlohmann::json params = {{"lut", c.lut}};
     std::istringstream extra(c.params);
     for (std::string item; extra >> item;) params[item.substr(0, item.find('='))] = item.substr(item.find('=') + 1);
-    jobs.push_back({{"command", "sun"}, {"shader", work_->file("facetfit_material.oso")}, {"out", work_->file("cycles-closures-" + c.name + ".exr")},
+    jobs.push_back({{"command", "sun"}, {"shader", shaders_->file("facetfit_material.oso")}, {"out", work_->file("cycles-closures-" + c.name + ".exr")},
                     {"size", sphere_size()}, {"spp", kCyclesSpp}, {"params", params}});
   }
   std::ofstream(work_->file("closure-jobs.json")) << jobs.dump(1);
