@@ -70,6 +70,14 @@ void add_max_memory_option(CLI::App* cmd, std::uint64_t& bytes, const std::strin
              format_bytes(default_memory_budget()) + ")");
 }
 
+void add_tolerance_option(CLI::App* cmd, double& tolerance) {
+  cmd->add_option("--tolerance", tolerance,
+                  "The GGX or Beckmann fit is the recommended representation when its distance from the measurement is "
+                  "at most (1 + T) times the tabulated one's (or 0.005 more)")
+      ->check(finite_in(0.0, 1e30))  // what a LUT reader accepts (lut/lut.cpp)
+      ->capture_default_str();
+}
+
 void add_fit_settings(CLI::App* cmd, FitSettings& s) {
   cmd->add_option("--smith", s.smith,
                   "Masking-shadowing model the fit is consistent with: masking (the paper), correlated "

@@ -32,7 +32,7 @@ struct BakeArgs {
   int jobs = 0;
   bool force = false;
   std::string scene;
-  double tolerance = 0.02;
+  double tolerance = kDefaultTolerance;
   bool eval_only = false;
   FitSettings settings;
 };
@@ -224,10 +224,7 @@ void add_bake_command(CLI::App& app, Context& ctx) {
   cmd->add_option("-j,--jobs", args->jobs, "Materials baked at once (default: all cores)")->check(CLI::Range(1, 1024));
   cmd->add_flag("--force", args->force, "Bake even where the cache says the outputs are current");
   cmd->add_option("--scene", args->scene, "Bake only the materials this scene references");
-  cmd->add_option("--tolerance", args->tolerance,
-                  "NDF error (relative L1) within which the parametric fit is the recommended representation")
-      ->check(finite_in(0.0, 1e30))  // what a LUT reader accepts (lut/lut.cpp)
-      ->capture_default_str();
+  add_tolerance_option(cmd, args->tolerance);
   cmd->add_flag("--eval-only", args->eval_only, "Leave out the sampling tables");
   add_fit_settings(cmd, args->settings);
   cmd->callback([args, &ctx] { run_bake(*args, ctx); });

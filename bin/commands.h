@@ -35,6 +35,9 @@ struct FitSettings {
   std::string closure_fresnel = "f82";
 };
 void add_fit_settings(CLI::App* cmd, FitSettings& settings);
+// --tolerance, the one definition of fit/recommend.h: how much farther from the measurement a GGX or
+// Beckmann fit may be than the tabulated representation and still be the recommended one.
+void add_tolerance_option(CLI::App* cmd, double& tolerance);
 // The FitOptions they name, or nullopt after reporting a usage error (status 2).
 std::optional<FitOptions> fit_options(const FitSettings& settings, int& status);
 

@@ -1,4 +1,5 @@
-// facetfit fit INPUT... : NDF, Fresnel and roughness of each material, as a table or JSON lines.
+// facetfit fit INPUT... : each material's recommended representation and its own parameters (fit/recommend.h),
+// with the paper's moment alphas beside them, as a table or JSON lines (the whole record).
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -8,6 +9,7 @@
 #include "core/error.h"
 #include "fit/fit.h"
 #include "io/input.h"
+#include "fit/recommend.h"
 #include "lut/record.h"
 
 namespace facetfit::cli {
@@ -18,17 +20,30 @@ struct FitArgs {
   std::vector<std::string> inputs;
   bool builtin = false;
   FitSettings settings;
+  double tolerance = kDefaultTolerance;
   bool json = false;
 };
 
-void print_row(const std::string& source, const FitResult& r, double seconds) {
+void print_header() {
+  std::printf("%-28s  %-11s  %7s  %-17s  %-17s  %-17s  %8s  %15s  %7s\n", "material", "recommended", "alpha", "f0 (r g b)",
+              "f82 (r g b)", "body (r g b)", "distance", "moment alpha", "ms");
+  std::printf("%-28s  %-11s  %7s  %-17s  %-17s  %-17s  %8s  %7s %7s  %7s\n", "", "", "", "", "", "", "", "ggx", "bkm", "");
+}
+
+// The recommended representation's own parameters; the moment alphas are the paper's estimates of the
+// tabulated NDF, not a representation (the ggx fit's alpha differs).
+void print_row(const std::string& source, const FitResult& r, double tolerance, double seconds) {
   if (!r.ok()) {
     std::printf("%-28s  %-s\n", source.c_str(), ("no fit: " + r.problem).c_str());
     return;
   }
-  std::printf("%-28s  %9.4f  %9.4f  %5.3f %5.3f %5.3f  %5.3f %5.3f %5.3f  %5d  %8.1e  %7.1f\n", source.c_str(), r.alpha_ggx,
-              r.alpha_beckmann, r.f0.r, r.f0.g, r.f0.b, r.f82.r, r.f82.g, r.f82.b, r.extraction.iterations,
-              r.extraction.residual, seconds * 1e3);
+  const RepresentationParameters p = parameters_of(r, recommend(r, tolerance));
+  char alpha[16] = "table";  // the tabulated NDF has no alpha
+  if (p.alpha) std::snprintf(alpha, sizeof alpha, "%.4f", *p.alpha);
+  std::printf("%-28s  %-11s  %7s  %5.3f %5.3f %5.3f  %5.3f %5.3f %5.3f  %5.3f %5.3f %5.3f  %8.4f  %7.4f %7.4f  %7.1f\n",
+              source.c_str(), to_string(p.representation), alpha, p.f0.r, p.f0.g, p.f0.b, p.f82.r, p.f82.g, p.f82.b,
+              p.body.r, p.body.g, p.body.b, p.error, r.alpha_ggx, r.alpha_beckmann, seconds * 1e3);
+  if (p.coat.present()) std::printf("%-28s  coat: GGX alpha %.4f, f0 %.4f\n", "", p.coat.alpha, p.coat.f0);
   if (const auto& a = r.anisotropic)
     std::printf("%-28s  anisotropic: ggx %.4f x %.4f, beckmann %.4f x %.4f, x axis at %.1f degrees (the row above: the azimuthal mean)\n", "",
                 a->ggx.alpha.alpha_x, a->ggx.alpha.alpha_y, a->beckmann.alpha.alpha_x, a->beckmann.alpha.alpha_y,
@@ -50,10 +65,8 @@ void run_fit(const FitArgs& args, Context& ctx) {
   const Fitter fitter(*options);
   report_settings(ctx, "fit", *options);
 
-  if (!args.json)
-    std::printf("%-28s  %9s  %9s  %-17s  %-17s  %5s  %8s  %7s\n", "material", "alpha_ggx", "alpha_bkm", "f0 (r g b)",
-                "f82 (r g b)", "iters", "residual", "ms");
   int failures = 0;
+  bool header = false;  // printed before the first fit, so that a run whose inputs all fail prints none
   for (const std::string& source : inputs) {
     try {
       const auto start = std::chrono::steady_clock::now();
@@ -64,10 +77,12 @@ void run_fit(const FitArgs& args, Context& ctx) {
         ++failures;
       }
       for (const std::string& w : result.warnings) std::fprintf(stderr, "facetfit: warning: %s: %s\n", source.c_str(), w.c_str());
-      if (args.json)
-        std::printf("%s\n", json_text(fit_record(source, result, seconds)).c_str());
-      else
-        print_row(source_name(source), result, seconds);
+      if (args.json) {
+        std::printf("%s\n", json_text(fit_record(source, result, seconds, args.tolerance)).c_str());
+      } else {
+        if (!header) print_header(), header = true;
+        print_row(source_name(source), result, args.tolerance, seconds);
+      }
       std::fflush(stdout);
     } catch (const Error& e) {
       report_error(e.what());
@@ -88,6 +103,7 @@ void add_fit_command(CLI::App& app, Context& ctx) {
   cmd->add_option("inputs", args->inputs, "MERL .binary, RGL .bsdf or UTIA .bin files, folders of them, or builtin:NAME (builtin: for all)");
   cmd->add_flag("--builtin", args->builtin, "Fit every built-in synthetic material");
   add_fit_settings(cmd, args->settings);
+  add_tolerance_option(cmd, args->tolerance);
   cmd->add_flag("--json", args->json, "One JSON object per material on stdout");
   cmd->callback([args, &ctx] { run_fit(*args, ctx); });
 }

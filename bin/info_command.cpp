@@ -23,7 +23,8 @@ nlohmann::json info_json(const Lut& lut) {
                    {"ndf_error_ggx", m.ndf_error_ggx}, {"ndf_error_beckmann", m.ndf_error_beckmann},
                    {"representation", to_string(m.representation)}, {"tolerance", m.tolerance}, {"sampling", m.sampling},
                    {"body", rgb(m.body)}, {"body_exponent", m.body_exponent}, {"coat", coat_json(m.coat)}, {"error", m.error},
-                   {"error_extraction", m.error_extraction}, {"warnings", m.warnings}};
+                   {"error_extraction", m.error_extraction}, {"warnings", m.warnings},
+                   {"recommended", recommended_json(recommended_parameters(m), m.tolerance)}};
   const auto parametric = [](const LutMetadata::Parametric& p, double error) {
     return parametric_json(p.alpha, p.body, p.f0, p.f82, p.coat, error);
   };
@@ -65,6 +66,19 @@ void print_closures(const Closures& c, double error, bool fitted) {
   }
 }
 
+// The recommended representation and its own parameters (fit/recommend.h).
+void print_recommended(const RepresentationParameters& p, double tolerance) {
+  std::printf("recommended     %s (tolerance %.4f): ", to_string(p.representation), tolerance);
+  if (p.alpha)
+    std::printf("alpha %.5f, ", *p.alpha);
+  else
+    std::printf("tabulated NDF, ");
+  std::printf("f0 %.4f %.4f %.4f, f82 %.4f %.4f %.4f, body %.4f %.4f %.4f", p.f0.r, p.f0.g, p.f0.b, p.f82.r, p.f82.g, p.f82.b,
+              p.body.r, p.body.g, p.body.b);
+  if (p.coat.present()) std::printf(", coat alpha %.5f f0 %.4f", p.coat.alpha, p.coat.f0);
+  std::printf(", distance %.4f\n", p.error);
+}
+
 void print_info(const Lut& lut) {
   const LutMetadata& m = lut.meta;
   // The file's strings as printable ASCII: a newline or a terminal escape in an edited LUT stays text.
@@ -72,13 +86,14 @@ void print_info(const Lut& lut) {
               excerpt(m.source_sha256, 64).c_str(), excerpt(m.facetfit_version, 64).c_str(), m.format_version);
   std::printf("fit             resolution %d, smith %s, %d iterations, residual %.2e\n", m.resolution, to_string(m.smith),
               m.iterations, m.residual);
-  std::printf("alpha_ggx       %.5f   (NDF error %.4f)\nalpha_beckmann  %.5f   (NDF error %.4f)\n", m.alpha_ggx,
-              m.ndf_error_ggx, m.alpha_beckmann, m.ndf_error_beckmann);
-  std::printf("f0              %.4f %.4f %.4f\nf82             %.4f %.4f %.4f\n", m.f0.r, m.f0.g, m.f0.b, m.f82.r, m.f82.g,
-              m.f82.b);
-  std::printf("body            %.4f %.4f %.4f, Minnaert exponent %.3f\n", m.body.r, m.body.g, m.body.b, m.body_exponent);
-  if (m.coat.present()) std::printf("coat            GGX alpha %.5f, f0 %.4f\n", m.coat.alpha, m.coat.f0);
-  // Distances from the measurement (0: the paper's method alone, which measures none).
+  print_recommended(recommended_parameters(m), m.tolerance);
+  std::printf("moment alphas   ggx %.5f, beckmann %.5f (the paper's estimates from the tabulated NDF)\n", m.alpha_ggx, m.alpha_beckmann);
+  std::printf("NDF distance    ggx %.4f, beckmann %.4f (of each fit's NDF from the tabulated one)\n", m.ndf_error_ggx, m.ndf_error_beckmann);
+  std::printf("tabulated       body %.4f %.4f %.4f (Minnaert exponent %.3f), f0 %.4f %.4f %.4f, f82 %.4f %.4f %.4f", m.body.r,
+              m.body.g, m.body.b, m.body_exponent, m.f0.r, m.f0.g, m.f0.b, m.f82.r, m.f82.g, m.f82.b);
+  if (m.coat.present()) std::printf(", coat alpha %.5f f0 %.4f", m.coat.alpha, m.coat.f0);
+  std::printf("\n");
+  // Distances from the measurement (fit/measurement.h); a LUT baked before fit revision 9 with --refine none has 0.
   std::printf("distance        tabulated %.4f (paper's fit %.4f), ggx %.4f, beckmann %.4f, lsq %.4f\n", m.error,
               m.error_extraction, m.error_ggx, m.error_beckmann, m.error_lsq);
   const auto parametric = [](const char* name, const LutMetadata::Parametric& p) {
@@ -91,8 +106,7 @@ void print_info(const Lut& lut) {
   parametric("beckmann", m.beckmann);
   parametric("lsq", m.lsq);
   print_closures(lut.closures(), m.error_closures, m.format_version >= kLutClosuresVersion);
-  std::printf("representation  %s (tolerance %.4f)\nsampling tables %s\n", to_string(m.representation), m.tolerance,
-              m.sampling ? "yes" : "no (--eval-only)");
+  std::printf("sampling tables %s\n", m.sampling ? "yes" : "no (--eval-only)");
   for (const std::string& w : m.warnings) std::printf("warning         %s\n", w.c_str());
   std::printf("\n");
   std::printf("%4s %8s %10s %14s %14s %10s\n", "node", "u", "theta_deg", "ndf", "slope_pdf", "sigma");

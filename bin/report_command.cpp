@@ -26,7 +26,7 @@ struct ReportArgs {
   std::string shard = "1/1";
   bool fail_on_regression = false;
   bool force = false;
-  double tolerance = 0.02;
+  double tolerance = kDefaultTolerance;
   std::uint64_t max_memory = 0;
   FitSettings settings;
   // --farm local|slurm: the report as a plan of shards (report/farm.h) run by an adapter (bin/farm.h).
@@ -170,9 +170,7 @@ void add_report_command(CLI::App& app, Context& ctx) {
       ->capture_default_str();
   cmd->add_flag("--fail-on-regression", args->fail_on_regression, "Exit 3 when a material got worse than in the previous report");
   cmd->add_flag("--force", args->force, "Render even the materials whose previous entry is current");
-  cmd->add_option("--tolerance", args->tolerance, "Representation tolerance of the bake")
-      ->check(finite_in(0.0, 1e30))
-      ->capture_default_str();
+  add_tolerance_option(cmd, args->tolerance);
   add_fit_settings(cmd, args->settings);
   cmd->add_option("--farm", args->farm, "Split the report into shards run by: local (processes on this machine) or slurm (a job array and a merge job)")
       ->check(CLI::IsMember({"local", "slurm"}));

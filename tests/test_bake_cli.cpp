@@ -171,7 +171,52 @@ TEST(Bake, MetadataRoundTripThroughInfo) {
   EXPECT_EQ(j["fresnel"]["rgb"].size(), 90u);
   // The human form names the same things.
   const RunResult text = facetfit("info " + out.file("copper-beckmann-0.30.exr"));
-  EXPECT_NE(text.out.find("representation  beckmann"), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("recommended     beckmann (tolerance"), std::string::npos) << text.out;
+}
+
+// One truth for the recommended representation (fit/recommend.h): `fit`'s table and JSON, the bake's sidecar
+// and `info` of its LUT name the same representation with the same own parameters. red-plastic: a GGX fit
+// recommended (alpha 0.12, a body); black-glossy-ggx-0.08: the tabulated one (no alpha), whose distance is
+// near 0, so that even --tolerance 100 keeps it; with the paper's method alone the distances are measured too.
+TEST(Bake, RecommendedParametersAgreeEverywhere) {
+  for (const std::string flags : {"", " --refine none", " --tolerance 100"})
+    for (const std::string material : {"red-plastic", "black-glossy-ggx-0.08"}) {
+      SCOPED_TRACE(material + flags);
+      TempDir out;
+      const RunResult fit = facetfit("fit --json builtin:" + material + flags);
+      ASSERT_EQ(fit.status, 0) << fit.err;
+      const nlohmann::json from_fit = nlohmann::json::parse(fit.out)["recommended"];
+      ASSERT_EQ(facetfit("bake builtin:" + material + flags + " -o " + out.path().string()).status, 0);
+      const nlohmann::json sidecar = read_json(out.file(material + ".json"));
+      const RunResult info = facetfit("info --json " + out.file(material + ".exr"));
+      ASSERT_EQ(info.status, 0) << info.err;
+      const nlohmann::json from_info = nlohmann::json::parse(info.out)["metadata"]["recommended"];
+      EXPECT_EQ(sidecar["recommended"], from_fit);
+      EXPECT_EQ(sidecar["representation"], from_fit["representation"]);
+      EXPECT_EQ(from_info["representation"], from_fit["representation"]);
+      EXPECT_EQ(from_info["alpha"].is_null(), from_fit["representation"] == "tabulated");
+      // The one definition: the nearer parametric fit when within max((1 + T) d, d + 0.005) of the tabulated d.
+      const nlohmann::json record = nlohmann::json::parse(fit.out);
+      const double d = record["error"], ggx = record["ggx"]["error"], beckmann = record["beckmann"]["error"];
+      const double tolerance = flags == " --tolerance 100" ? 100.0 : 0.02;
+      const std::string expected = std::min(ggx, beckmann) > std::max((1.0 + tolerance) * d, d + 0.005) ? "tabulated"
+                                   : ggx <= beckmann                                                      ? "ggx"
+                                                                                                          : "beckmann";
+      EXPECT_EQ(from_fit["representation"], expected) << "d " << d << ", ggx " << ggx << ", beckmann " << beckmann;
+      // The LUT stores its attributes as floats.
+      const auto near = [](const nlohmann::json& a, const nlohmann::json& b) { EXPECT_NEAR(a.get<double>(), b.get<double>(), 1e-6 + 1e-6 * std::abs(b.get<double>())); };
+      if (!from_fit["alpha"].is_null()) near(from_info["alpha"], from_fit["alpha"]);
+      for (const char* key : {"f0", "f82", "body"})
+        for (int c = 0; c < 3; ++c) near(from_info[key][c], from_fit[key][c]);
+      near(from_info["error"], from_fit["error"]);
+      // The table prints the same representation and alpha.
+      const RunResult table = facetfit("fit builtin:" + material + flags);
+      char alpha[32] = "table";
+      if (!from_fit["alpha"].is_null()) std::snprintf(alpha, sizeof alpha, "%.4f", from_fit["alpha"].get<double>());
+      const std::string row = material + std::string(28 - material.size(), ' ') + "  " + from_fit["representation"].get<std::string>();
+      EXPECT_NE(table.out.find(row), std::string::npos) << table.out;
+      EXPECT_NE(table.out.find(std::string(alpha) + "  "), std::string::npos) << table.out;
+    }
 }
 
 TEST(Bake, SceneBakesOnlyWhatItReferences) {

@@ -168,8 +168,8 @@ TEST(Cli, JsonHasExactlyTheDocumentedKeys) {
   std::vector<std::string> keys;
   for (const auto& item : j.items()) keys.push_back(item.key());
   EXPECT_EQ(keys, (std::vector<std::string>{"alpha_beckmann", "alpha_ggx", "anisotropic", "beckmann", "body", "body_exponent", "closures", "coat", "error",
-                                            "error_extraction", "f0", "f82", "ggx", "iterations", "lsq", "refine",
-                                            "residual", "seconds", "source", "warnings"}));
+                                            "error_extraction", "f0", "f82", "ggx", "iterations", "lsq", "recommended",
+                                            "refine", "residual", "seconds", "source", "warnings"}));
   for (const char* fit : {"ggx", "beckmann", "lsq"}) {
     std::vector<std::string> sub;
     for (const auto& item : j[fit].items()) sub.push_back(item.key());

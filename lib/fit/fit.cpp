@@ -142,6 +142,15 @@ void Fitter::refine_on_measurement(const MerlTable& table, FitResult& result) co
   result.alpha_beckmann = alpha_beckmann_from_moments(result.ndf(), quadrature_);
 }
 
+// The paper's method fits nothing more: its representations are only measured, so that the one
+// recommended is chosen by distance from the measurement, as for a refined fit (fit/recommend.h).
+void Fitter::measure_paper_fits(const MerlTable& table, FitResult& result) const {
+  const MeasuredBins bins = error_bins(table);
+  if (bins.size() == 0) return;
+  result.error_extraction = result.error = measurement_error(bins, TabulatedMicrofacet(result.lobe.tables(options_.smith), {}));
+  for (ParametricFit* p : {&result.ggx, &result.beckmann, &result.lsq}) p->error = parametric_error(bins, options_.smith, *p);
+}
+
 void Fitter::fit_anisotropic_lobes(const MerlTable& table, const FresnelCurve& paper_fresnel, const FitResult& result,
                                    AnisotropicFit& a) const {
   const auto moments = [&](NdfType type, const AnisotropicAlpha& alpha) {
@@ -207,8 +216,10 @@ FitResult Fitter::fit(const MerlTable& table) const {
   result.beckmann = moments(NdfType::beckmann, result.alpha_beckmann, ParametricFit::FresnelForm::f82);
   result.lsq = moments(NdfType::ggx, result.alpha_ggx, ParametricFit::FresnelForm::schlick);
   result.closures.closures = closures_of(result.ggx);
-  // The paper's method alone measures nothing else: no bins, no errors (they stay 0).
-  if (refine) refine_on_measurement(table, result);
+  if (refine)
+    refine_on_measurement(table, result);
+  else
+    measure_paper_fits(table, result);
   result.f0 = result.fresnel().value[0];
   result.f82 = result.fresnel().eval(f82_theta());
 

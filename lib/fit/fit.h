@@ -28,8 +28,9 @@ namespace facetfit {
 // 3: the parametric fits solved by fit/small_problem.h; 4: the refinement solved to convergence in two
 // passes, a UTIA file's isotropic fits on its own nodes; 5: its anisotropic lobes on its node pairs;
 // 6: the grazing pairs' soft L1 loss (fit/measurement.h); 7: the tabulated body's Minnaert exponent (model/body.h);
-// 8: the closure representation (fit/closure_fit.h).
-constexpr int kFitRevision = 8;
+// 8: the closure representation (fit/closure_fit.h); 9: the paper's representations measured too
+// (their distances choose the recommended one, fit/recommend.h).
+constexpr int kFitRevision = 9;
 
 struct FitOptions {
   int resolution = 90;  // intervals of the u grid; R + 1 nodes
@@ -88,10 +89,11 @@ struct FitResult {
   // nearer of ggx and beckmann, for an anisotropic source its anisotropic GGX lobe; with Refine::none the
   // ggx moment fit as one lobe (error 0).
   ClosureFit closures;
-  // Distance from the measurement (fit/measurement.h) of the paper's pure fit and of `lobe`.
+  // Distance from the measurement (fit/measurement.h) of the paper's pure fit and of `lobe` (each
+  // representation's, ParametricFit::error, measured with either Refine).
   double error_extraction = 0.0, error = 0.0;
   Smith smith = Smith::correlated;  // the model the NDF is consistent with
-  bool refined = false;             // Refine::full: body, parametric fits and errors are measured
+  bool refined = false;             // Refine::full: body, lobe and parametric fits fitted on the measurement
   std::string problem;  // empty for a meaningful fit; otherwise why it is not one
   std::vector<std::string> warnings;  // implausible values in the measurement or the fit (fit/plausibility.h)
   // With a source that holds back-scattering along azimuths (MerlTable::source_backscatter); the rest of
@@ -120,6 +122,8 @@ class Fitter {
  private:
   // --refine full: the parametric fits and the body + tabulated lobe on the whole measurement.
   void refine_on_measurement(const MerlTable& table, FitResult& result) const;
+  // --refine none: the distances of the paper's representations from the measurement.
+  void measure_paper_fits(const MerlTable& table, FitResult& result) const;
   // The anisotropic GGX and Beckmann lobes of `a` (AnisotropicFit::ggx, beckmann) from its moment alphas.
   void fit_anisotropic_lobes(const MerlTable& table, const FresnelCurve& paper_fresnel, const FitResult& result, AnisotropicFit& a) const;
 

@@ -107,7 +107,7 @@ BakeOutcome bake_material(const std::string& source, const std::string& name, co
     out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
     nlohmann::json& r = out.record;
-    r = fit_record(source, fit, out.seconds);
+    r = fit_record(source, fit, out.seconds, options.tolerance);
     r["lut"] = lut_path.filename().string();
     r["representation"] = to_string(lut.meta.representation);
     r["ndf_error_ggx"] = lut.meta.ndf_error_ggx;

@@ -6,12 +6,13 @@
 #include <vector>
 
 #include "fit/fit.h"
+#include "fit/recommend.h"
 
 namespace facetfit {
 
 struct BakeOptions {
   FitOptions fit;
-  double tolerance = 0.02;  // NDF error a parametric fit may have and still be the recommended representation
+  double tolerance = kDefaultTolerance;  // how much farther a parametric fit may be and still be recommended (fit/recommend.h)
   bool with_sampling = true;
   bool force = false;  // bake even when the cache says the outputs are current
 };

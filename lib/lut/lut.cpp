@@ -115,21 +115,6 @@ void read_closures(const std::string& path, const ImageSpec& spec, LutMetadata& 
 
 }  // namespace
 
-const char* to_string(Representation r) {
-  switch (r) {
-    case Representation::tabulated: return "tabulated";
-    case Representation::ggx: return "ggx";
-    case Representation::beckmann: return "beckmann";
-  }
-  return "?";
-}
-
-std::optional<Representation> parse_representation(const std::string& name) {
-  for (Representation r : {Representation::tabulated, Representation::ggx, Representation::beckmann})
-    if (name == to_string(r)) return r;
-  return std::nullopt;
-}
-
 LutLayout LutLayout::of(int resolution, bool sampling, int anisotropic_resolution, int anisotropic_phi_count) {
   const int rows = kSamplingRow + (sampling ? resolution + 1 : 0);
   const int width = std::max({resolution + 1, FresnelCurve::kSize, anisotropic_phi_count > 0 ? anisotropic_resolution + 1 : 0});
@@ -168,18 +153,7 @@ Lut make_lut(const FitResult& fit, const Quadrature& quadrature, const std::stri
   m.ndf_error_ggx = ndf_distance(quadrature, fit.ndf(), Ndf::isotropic(NdfType::ggx, fit.ggx.alpha));
   m.ndf_error_beckmann = ndf_distance(quadrature, fit.ndf(), Ndf::isotropic(NdfType::beckmann, fit.beckmann.alpha));
   m.tolerance = tolerance;
-  // A parametric fit renders with the renderer's own closure: it is recommended when it is nearly as
-  // good. Refined fits compare distances from the measurement: the parametric one at most `tolerance`
-  // farther, relatively, or 0.005 (the metric is CIE L*'s lightness / 116: 0.005 is ~0.6 L* units, under
-  // a just-noticeable difference); the paper's fit compares NDFs (the parametric NDF within `tolerance`
-  // of the tabulated one).
-  const double error_ggx = fit.refined ? m.error_ggx : m.ndf_error_ggx;
-  const double error_beckmann = fit.refined ? m.error_beckmann : m.ndf_error_beckmann;
-  const double bar = fit.refined ? std::max(m.error * (1.0 + tolerance), m.error + 0.005) : tolerance;
-  const bool ggx_better = error_ggx <= error_beckmann;
-  m.representation = std::min(error_ggx, error_beckmann) <= bar
-                         ? (ggx_better ? Representation::ggx : Representation::beckmann)
-                         : Representation::tabulated;
+  m.representation = recommend(fit, tolerance);
   m.sampling = with_sampling;
   m.warnings = fit.warnings;
   if (fit.anisotropic) {
@@ -194,6 +168,14 @@ Lut make_lut(const FitResult& fit, const Quadrature& quadrature, const std::stri
   m.error_closures = fit.closures.error;
   if (!m.closures.empty()) m.format_version = kLutClosuresVersion;
   return lut;
+}
+
+RepresentationParameters recommended_parameters(const LutMetadata& m) {
+  const Representation r = m.representation;
+  if (r == Representation::tabulated) return {r, std::nullopt, m.f0, m.f82, m.body, m.coat, m.error};
+  const bool ggx = r == Representation::ggx;
+  const LutMetadata::Parametric& p = ggx ? m.ggx : m.beckmann;
+  return {r, p.alpha, p.f0, p.f82, p.body, p.coat, ggx ? m.error_ggx : m.error_beckmann};
 }
 
 void write_lut(const std::string& path, const Lut& lut) {

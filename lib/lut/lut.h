@@ -6,6 +6,7 @@
 #include <string>
 
 #include "fit/fit.h"
+#include "fit/recommend.h"
 #include "model/parametric.h"
 #include "model/tabulated.h"
 
@@ -25,10 +26,6 @@ constexpr int kLutAnisotropicVersion = 3;
 constexpr int kLutBodyExponentVersion = 4;
 constexpr int kLutClosuresVersion = 5;
 
-// Which model a renderer should use for this material.
-enum class Representation { tabulated, ggx, beckmann };
-const char* to_string(Representation r);
-std::optional<Representation> parse_representation(const std::string& name);
 
 struct LutMetadata {
   int format_version = kLutFormatVersion;
@@ -60,8 +57,8 @@ struct LutMetadata {
   double error = 0.0, error_ggx = 0.0, error_beckmann = 0.0, error_lsq = 0.0, error_extraction = 0.0;
   // Relative L1 distance (projected-area weighted) of each parametric NDF from the tabulated one.
   double ndf_error_ggx = 0.0, ndf_error_beckmann = 0.0;
-  Representation representation = Representation::tabulated;
-  double tolerance = 0.0;  // the NDF error a parametric fit was allowed when choosing the representation
+  Representation representation = Representation::tabulated;  // which model a renderer should use (fit/recommend.h)
+  double tolerance = 0.0;  // the --tolerance that chose it
   bool sampling = true;    // sampling tables present (absent with --eval-only)
   // The anisotropic lobe (version 3, or 4 where announced): its grid's resolution and azimuths (0: none), and the anisotropic
   // GGX fit (fit/fit.h, AnisotropicFit::ggx: principal alphas, axis, body, F82-tint Fresnel).
@@ -101,10 +98,11 @@ struct Lut {
   Closures closures() const;
 };
 
-// Builds the LUT of a fit and chooses its representation: the parametric NDF with the smaller error
-// when that error is within `tolerance`, the tabulated one otherwise.
-Lut make_lut(const FitResult& fit, const Quadrature& quadrature, const std::string& source, const std::string& sha256,
+// Builds the LUT of a fit, its representation recommended under `tolerance` (fit/recommend.h).
+Lut make_lut(const FitResult& fit, const Quadrature& quadrature, const std::string& source, const std::string& source_sha256,
              double tolerance, bool with_sampling);
+// The recommended representation's own parameters, as parameters_of() gives them for the fit it was baked from.
+RepresentationParameters recommended_parameters(const LutMetadata& meta);
 
 // Writes through a temporary file renamed into place. Throws Error naming `path`.
 void write_lut(const std::string& path, const Lut& lut);

@@ -28,6 +28,14 @@ nlohmann::json closures_json(const Closures& closures, double error) {
   return {{"body", rgb(closures.body)}, {"lobes", lobes}, {"coat", coat_json(closures.coat)}, {"error", error}};
 }
 
+nlohmann::json recommended_json(const RepresentationParameters& p, double tolerance) {
+  nlohmann::json j = parametric_json(p.alpha.value_or(0.0), p.body, p.f0, p.f82, p.coat, p.error);
+  if (!p.alpha) j["alpha"] = nullptr;
+  j["representation"] = to_string(p.representation);
+  j["tolerance"] = tolerance;
+  return j;
+}
+
 std::string json_text(const nlohmann::json& j, int indent) {
   return j.dump(indent, ' ', false, nlohmann::json::error_handler_t::replace);
 }
@@ -39,11 +47,12 @@ nlohmann::json read_json_file(const std::string& path) {
   return j.is_discarded() ? nlohmann::json(nullptr) : j;
 }
 
-nlohmann::json fit_record(const std::string& source, const FitResult& fit, double seconds) {
+nlohmann::json fit_record(const std::string& source, const FitResult& fit, double seconds, double tolerance) {
   const auto rgb = [](const Rgb& c) { return nlohmann::json{c.r, c.g, c.b}; };
   nlohmann::json j;
   j["source"] = source;
   if (fit.ok()) {
+    j["recommended"] = recommended_json(parameters_of(fit, recommend(fit, tolerance)), tolerance);
     j["alpha_ggx"] = fit.alpha_ggx;
     j["alpha_beckmann"] = fit.alpha_beckmann;
     j["f0"] = rgb(fit.f0);
@@ -73,7 +82,7 @@ nlohmann::json fit_record(const std::string& source, const FitResult& fit, doubl
                           {"iterations", a->iterations}, {"residual", a->residual}};
     }
   } else {
-    for (const char* k : {"alpha_ggx", "alpha_beckmann", "f0", "f82"}) j[k] = nullptr;
+    for (const char* k : {"recommended", "alpha_ggx", "alpha_beckmann", "f0", "f82"}) j[k] = nullptr;
   }
   j["iterations"] = fit.extraction.iterations;
   j["residual"] = fit.extraction.residual;

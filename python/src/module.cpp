@@ -359,8 +359,19 @@ PYBIND11_MODULE(_facetfit, m) {
       .def_property_readonly("body", [](const Fit& f) { return rgb_array(f.result.body()); }, "body albedo at normal incidence")
       .def_property_readonly("body_exponent", [](const Fit& f) { return f.result.lobe.body_exponent; },
                              "the body's Minnaert exponent (1: Lambert)")
-      .def_property_readonly("alpha_ggx", [](const Fit& f) { return f.result.alpha_ggx; })
-      .def_property_readonly("alpha_beckmann", [](const Fit& f) { return f.result.alpha_beckmann; })
+      .def_property_readonly("alpha_ggx", [](const Fit& f) { return f.result.alpha_ggx; },
+                             "the paper's moment estimate E|x~| of the tabulated NDF (not the ggx fit's alpha: see recommended)")
+      .def_property_readonly("alpha_beckmann", [](const Fit& f) { return f.result.alpha_beckmann; },
+                             "the paper's moment estimate sqrt(2 E[x~^2]) of the tabulated NDF")
+      .def(
+          "recommended",
+          [](const Fit& f, double tolerance) {
+            if (!f.result.ok()) throw Error(f.source + ": " + f.result.problem);
+            return to_python(recommended_json(parameters_of(f.result, recommend(f.result, tolerance)), tolerance));
+          },
+          py::arg("tolerance") = kDefaultTolerance,
+          "The representation a renderer should use and its own parameters, as `facetfit fit` shows them: "
+          "{representation, tolerance, alpha (None for tabulated), body, f0, f82, coat, error}")
       .def_property_readonly("error", [](const Fit& f) { return f.result.error; })
       .def_property_readonly("error_extraction", [](const Fit& f) { return f.result.error_extraction; })
       .def_property_readonly("eigenvalue", [](const Fit& f) { return f.result.extraction.eigenvalue; })
@@ -386,7 +397,7 @@ PYBIND11_MODULE(_facetfit, m) {
             py::gil_scoped_release release;
             write_lut(path, make_lut(f.result, f.fitter->quadrature(), f.source, source_sha256(f.source), tolerance, sampling));
           },
-          py::arg("path"), py::arg("tolerance") = 0.02, py::arg("sampling") = true, "Bakes the LUT texture (docs/lut-format.md).")
+          py::arg("path"), py::arg("tolerance") = kDefaultTolerance, py::arg("sampling") = true, "Bakes the LUT texture (docs/lut-format.md).")
       .def("__repr__", [](const Fit& f) {
         return "<facetfit.Fit " + f.source + (f.result.ok() ? " alpha_ggx=" + std::to_string(f.result.alpha_ggx) : " failed") + ">";
       });
@@ -413,8 +424,10 @@ PYBIND11_MODULE(_facetfit, m) {
       .def_property_readonly("body_exponent", [](const Lut& l) { return l.tables.body_exponent; })
       .def_property_readonly("source", [](const Lut& l) { return l.meta.source; })
       .def_property_readonly("representation", [](const Lut& l) { return std::string(to_string(l.meta.representation)); })
-      .def_property_readonly("alpha_ggx", [](const Lut& l) { return l.meta.alpha_ggx; })
-      .def_property_readonly("alpha_beckmann", [](const Lut& l) { return l.meta.alpha_beckmann; })
+      .def_property_readonly("recommended", [](const Lut& l) { return to_python(recommended_json(recommended_parameters(l.meta), l.meta.tolerance)); },
+                             "the recommended representation and its own parameters, as Fit.recommended() with the bake's tolerance")
+      .def_property_readonly("alpha_ggx", [](const Lut& l) { return l.meta.alpha_ggx; }, "the paper's moment estimate (see Fit.alpha_ggx)")
+      .def_property_readonly("alpha_beckmann", [](const Lut& l) { return l.meta.alpha_beckmann; }, "the paper's moment estimate")
       .def_property_readonly("warnings", [](const Lut& l) { return l.meta.warnings; })
       .def("model", [](const Lut& l) { return tabulated_model(l.tables); }, "The tabulated model.")
       .def_property_readonly("closures", [](const Lut& l) { return to_python(closures_json(l.closures(), l.meta.error_closures)); },
@@ -477,7 +490,7 @@ PYBIND11_MODULE(_facetfit, m) {
         for (const std::string& s : sources) out.append(bake_one(s, source_name(s)));
         return py::object(out);
       },
-      py::arg("source"), py::arg("out_dir"), py::arg("name") = "", py::arg("force") = false, py::arg("tolerance") = 0.02,
+      py::arg("source"), py::arg("out_dir"), py::arg("name") = "", py::arg("force") = false, py::arg("tolerance") = kDefaultTolerance,
       py::arg("sampling") = true, py::arg("refine") = "full", py::arg("resolution") = 90, py::arg("smith") = "correlated",
       py::arg("merl_bins") = "start", py::arg("closure_fresnel") = "f82",
       "Bakes OUT_DIR/NAME.exr and its JSON sidecar as `facetfit bake` does (cached by content, OUT_DIR created); "

@@ -56,6 +56,24 @@ def test_paper_fit_is_the_power_iteration_alone():
     assert np.allclose(f.ndf, f.ndf_extraction)
 
 
+def test_recommended_agrees_with_the_record_and_the_lut(tmp_path):
+    # fit/recommend.h: the same representation and parameters from Fit, its record, and the baked LUT.
+    f = facetfit.fit("builtin:red-plastic")
+    rec = f.recommended()
+    assert rec == f.record["recommended"]
+    assert rec["representation"] == "ggx" and rec["alpha"] == pytest.approx(f.record["ggx"]["alpha"])
+    assert rec["alpha"] != pytest.approx(f.alpha_ggx, rel=1e-3)  # the moment estimate is not the fit
+    f.write_lut(tmp_path / "red.exr")
+    lut = facetfit.read_lut(tmp_path / "red.exr")
+    assert lut.representation == rec["representation"] == lut.recommended["representation"]
+    for key in ("alpha", "error"):
+        assert lut.recommended[key] == pytest.approx(rec[key], rel=1e-6)
+    for key in ("f0", "f82", "body"):
+        assert lut.recommended[key] == pytest.approx(rec[key], rel=1e-6, abs=1e-7)
+    assert f.recommended(tolerance=0.0)["representation"] in ("ggx", "tabulated")
+    assert facetfit.fit("builtin:black-glossy-ggx-0.08").recommended()["alpha"] is None
+
+
 def test_fit_model_matches_the_measurement(gold_fit):
     m = facetfit.load(GOLD)
     model = gold_fit.model()
