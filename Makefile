@@ -45,7 +45,7 @@ asan: deps
 fuzz-build: deps
 	@cmake -S . -B $(FUZZ_BUILD) $(CMAKE_GEN) -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++ \
 	  -DFACETFIT_SANITIZE=ON -DFACETFIT_FUZZ=ON -DFACETFIT_BUILD_TOOLS=OFF -DFACETFIT_OSL_TESTS=OFF -DFACETFIT_MITSUBA_TESTS=OFF >/dev/null
-	@cmake --build $(FUZZ_BUILD) -j $(JOBS) --target fuzz_merl fuzz_rgl fuzz_utia fuzz_scene fuzz_obj fuzz_lut fuzz_env fuzz_deltae write_seeds
+	@cmake --build $(FUZZ_BUILD) -j $(JOBS) --target fuzz_all
 
 # Runs each fuzz target for FUZZ_SECONDS (default 600); fails on any finding (docs/reliability.md).
 fuzz: fuzz-build

@@ -1,5 +1,6 @@
 // LUT textures (OpenEXR, then facetfit's metadata and table checks), then an
 // evaluation and a sample of the model it accepted.
+// max_len: 262144 (a LUT with sampling tables is ~100 KB)
 #include "core/vec.h"
 #include "fuzz_input.h"
 #include "lut/lut.h"

@@ -1,4 +1,5 @@
 // RGL .bsdf tensor-file reader, then an evaluation of what it accepted.
+// max_len: 1048576 (a real RGL material is 0.66 MB)
 #include "fuzz_input.h"
 #include "core/vec.h"
 #include "io/rgl.h"

@@ -1,5 +1,6 @@
 // UTIA .bin reader: size, non-finite and negative values, then what the fits read of it (the azimuthal
 // mean and the back-scattering samples).
+// max_len: 1990656 (a UTIA file is 3 x 6 x 48 x 6 x 48 doubles)
 #include "fuzz_input.h"
 #include "io/utia.h"
 

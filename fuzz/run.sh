@@ -6,8 +6,8 @@
 set -euo pipefail
 build=$1; seconds=$2; shift 2
 here="$(cd "$(dirname "$0")" && pwd)"
-targets=("${@:-merl rgl utia scene obj lut env deltae}")
-targets=(${targets[@]})
+# Default: every harness of fuzz/ (fuzz_NAME.cpp).
+if [[ $# -gt 0 ]]; then targets=("$@"); else targets=(); for f in "$here"/fuzz_*.cpp; do n=$(basename "$f" .cpp); targets+=("${n#fuzz_}"); done; fi
 mkdir -p "$build/findings"
 python3 "$here/make_seeds.py" "$build/seeds"
 "$build/fuzz/write_seeds" "$build/seeds"
@@ -19,9 +19,8 @@ for t in "${targets[@]}"; do
   seeds=()
   for d in "$build/seeds/$t" "$here/seeds/$t"; do [[ -d "$d" ]] && seeds+=("$d"); done
   log="$build/fuzz_$t.log"
-  max_len=65536; [[ $t == rgl ]] && max_len=1048576  # a real RGL material is 0.66 MB
-  [[ $t == lut ]] && max_len=262144                   # a LUT with sampling tables is ~100 KB
-  [[ $t == utia ]] && max_len=1990656                 # a UTIA file is 3 x 6 x 48 x 6 x 48 doubles
+  # 64 KiB, or the harness's own `// max_len: N` line.
+  max_len=$(sed -n 's|^// max_len: \([0-9]*\).*|\1|p' "$here/fuzz_$t.cpp"); max_len=${max_len:-65536}
   run_target() {
     "$build/fuzz/fuzz_$t" "$corpus" "${seeds[@]}" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 \
       -max_len="$max_len" -artifact_prefix="$build/findings/$t-" -print_final_stats=1 >"$log" 2>&1
