@@ -95,9 +95,7 @@ void run_render(const RenderArgs& args, Context& ctx) {
       MaterialDesc subject;
       subject.type = args.material_type;
       subject.file = args.material;
-      const bool needs_lut = subject.type == "lut" || subject.type == "ggx" || subject.type == "beckmann" || subject.type == "lsq" ||
-                             subject.type == "closures";
-      if (needs_lut && fs::path(subject.file).extension() != ".exr") {
+      if (find_material_type(subject.type)->reads_lut && fs::path(subject.file).extension() != ".exr") {
         baked_dir.reset(new fs::path(fs::temp_directory_path() / ("facetfit-render-" + std::to_string(::getpid()))));
         fs::create_directories(*baked_dir);
         const BakeOptions bake_options;
@@ -166,9 +164,12 @@ void add_render_command(CLI::App& app, Context& ctx) {
   add_max_memory_option(cmd, args->max_memory);
   cmd->add_option("--material", args->material, "Default scene only: the sphere's material file (a LUT .exr renders as lut "
                   "unless --material-type says otherwise)")->capture_default_str();
-  cmd->add_option("--material-type", args->material_type, "Default scene only: measured, lut, ggx, beckmann, lsq or closures (a measurement is baked first for the last five), "
-                  "analytic (a built-in's analytic model) or lambert (albedo 0.8)")
-      ->check(CLI::IsMember({"measured", "lut", "ggx", "beckmann", "lsq", "closures", "analytic", "lambert"}))
+  std::vector<std::string> types;
+  for (const MaterialType& t : kMaterialTypes) types.push_back(t.name);
+  cmd->add_option("--material-type", args->material_type, "Default scene only: " + material_type_list() +
+                  " (docs/scene-format.md; a measurement is baked first for a type that reads a LUT; analytic: a built-in's "
+                  "analytic model; lambert: albedo 0.8)")
+      ->check(CLI::IsMember(types))
       ->capture_default_str();
   cmd->callback([args, cmd, &ctx] {
     // They shape the default scene only: with a scene of one's own they would be silently ignored.

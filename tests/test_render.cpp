@@ -645,6 +645,35 @@ TEST(Camera, SamplesInSimdLanesEqualOneAtATime) {
       }
 }
 
+// Every material type of the registry (render/scene.h) in its plain form runs on the stream path as it
+// declares: sampling and density in SIMD lanes, and f too where it says `all`. A type whose models leave the
+// lanes (a new model without kernels, a proposal they do not hold) fails here instead of rendering one
+// pair at a time unseen. The loop reads the registry, so a new type is tested as soon as it is listed.
+TEST(Shading, EveryMaterialTypeRunsInTheLanesItDeclares) {
+  test::TempDir dir;
+  const std::string lut = dir.file("gold.exr");
+  write_gold_lut(lut);
+  const SceneDesc scene;
+  for (const MaterialType& type : kMaterialTypes) {
+    MaterialDesc m;
+    m.type = type.name;
+    m.file = type.reads_lut ? lut : type.needs_file ? "builtin:gold-ggx-0.15" : "";
+    const std::shared_ptr<const ShadingModel> model = load_material(scene, m);
+    EXPECT_TRUE(model->has_lanes()) << type.name;
+    if (type.lanes == MaterialType::Lanes::all) {
+      EXPECT_TRUE(model->f_in_lanes()) << type.name;
+    }
+  }
+  // Controls: a stretched LUT draws from its own visible normals, one pair at a time; an RGL file's f is
+  // evaluated one pair at a time under its lanes' proposal.
+  MaterialDesc stretched;
+  stretched.type = "lut", stretched.file = lut, stretched.stretch = Stretch(2.0, 0.5, 0.0);
+  EXPECT_FALSE(load_material(scene, stretched)->has_lanes());
+  MaterialDesc ggx_of_lut;
+  ggx_of_lut.type = "ggx", ggx_of_lut.file = lut;
+  EXPECT_FALSE(load_material(scene, ggx_of_lut)->f_in_lanes());
+}
+
 TEST(Shading, GgxInSimdLanesEqualsOnePairAtATime) {
   // Every term the GGX kernels hold (render/ggx_batch.h): the three Smith forms, F82-tint and the Fresnel
   // curve, a body and a coat, from alpha 0.005 to 1.5, over pairs that include grazing and below-horizon

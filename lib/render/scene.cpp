@@ -116,10 +116,10 @@ void known_keys(const json& j, std::initializer_list<const char*> known, const s
 // The material's type, its file and its alpha; `what` is "material NAME".
 void parse_material_kind(const json& j, const std::string& what, const std::string& path, MaterialDesc& m) {
   m.type = get<std::string>(j, "type", "", path);
-  if (!one_of(m.type, {"measured", "lut", "ggx", "beckmann", "lsq", "closures", "lambert", "analytic"}))
-    fail(path, what + ": type must be measured, lut, ggx, beckmann, lsq, closures, lambert or analytic");
+  const MaterialType* type = find_material_type(m.type);
+  if (!type) fail(path, what + ": type must be " + material_type_list());
   m.file = get<std::string>(j, "file", "", path);
-  if (one_of(m.type, {"measured", "lut", "lsq", "closures", "analytic"}) && m.file.empty()) fail(path, what + " needs a \"file\"");
+  if (type->needs_file && m.file.empty()) fail(path, what + " needs a \"file\"");
   m.alpha = get<double>(j, "alpha", 0.0, path);
   if (!(m.alpha >= 0.0 && m.alpha <= 10.0)) fail(path, what + ": alpha must be in [0, 10]");
   if (one_of(m.type, {"ggx", "beckmann"}) && m.file.empty() && !(m.alpha > 0.0))
@@ -459,6 +459,19 @@ std::shared_ptr<const ShadingModel> lut_parametric_model(const Lut& lut, const s
   return std::make_shared<ShadingModel>(brdf, tabulated_proposal(ndf, p->f0, p->body, p->coat));
 }
 
+const MaterialType* find_material_type(const std::string& name) {
+  for (const MaterialType& t : kMaterialTypes)
+    if (name == t.name) return &t;
+  return nullptr;
+}
+
+std::string material_type_list() {
+  std::string list;
+  const std::size_t n = std::size(kMaterialTypes);
+  for (std::size_t k = 0; k < n; ++k) list += std::string(k == 0 ? "" : k + 1 == n ? " or " : ", ") + kMaterialTypes[k].name;
+  return list;
+}
+
 std::shared_ptr<const ShadingModel> load_material(const SceneDesc& scene, const MaterialDesc& m) {
   if (m.type == "lambert") return std::make_shared<ShadingModel>(std::make_shared<LambertBrdf>(m.albedo), nullptr);
   if (m.type == "analytic") {  // a built-in's analytic model itself: the ground truth
@@ -511,7 +524,7 @@ std::shared_ptr<const ShadingModel> load_material(const SceneDesc& scene, const 
       const auto model = std::make_shared<TabulatedMicrofacet>(sampled_lut_model(std::move(lut))->stretched(m.stretch));
       return std::make_shared<ShadingModel>(model, model);
     }
-    // Its own sampling tables too: a stretch_texture stretches it per point (render/renderer.cpp).
+    // Its own sampling tables too: a stretch_texture stretches it per point (render/integrator.cpp).
     const auto model = sampled_lut_model(std::move(lut));
     return std::make_shared<ShadingModel>(model, VisibleSlopeProposal::of(*model));
   }
@@ -530,7 +543,7 @@ std::shared_ptr<const ShadingModel> load_material(const SceneDesc& scene, const 
   }
   // ggx | beckmann | lsq (the LUT's classical baseline: Lambert + GGX + Schlick); nothing else renders as them
   if (m.type != "ggx" && m.type != "beckmann" && m.type != "lsq")
-    fail("material type '" + m.type + "'", "must be measured, lut, ggx, beckmann, lsq, closures, lambert or analytic");
+    fail("material type '" + m.type + "'", "must be " + material_type_list());
   if (!m.file.empty()) return lut_parametric_model(read_lut(resolve(scene, m.file)), m.type, m.smith, m.fresnel == "curve", m.anisotropic);
   const Ndf ndf = Ndf::isotropic(m.type == "beckmann" ? NdfType::beckmann : NdfType::ggx, m.alpha);
   // The proposal samples the lobe, weighted by f0: GGX's visible normals in closed form (model/proposal.h),

@@ -54,6 +54,8 @@ class ShadingModel {
   // Whether eval(EvaluationBatch&) and sample_directions() run in lanes (wholly or in part): a batch then
   // costs less than the pairs one by one.
   bool has_lanes() const { return batch_model_ || tabulated_batch_model_ || lambert_albedo_; }
+  // Whether f itself runs in them too, not one pair at a time inside eval(EvaluationBatch&).
+  bool f_in_lanes() const { return batch_model_ || lambert_albedo_ || (tabulated_batch_model_ && (tabulated_batch_model_->f || merl_batch_model_)); }
 
   using Sample = BrdfSample;
   std::optional<Sample> sample(const Vec3& o, double u1, double u2, double u3) const;
