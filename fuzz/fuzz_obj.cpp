@@ -2,7 +2,7 @@
 #include <vector>
 
 #include "fuzz_input.h"
-#include "render/renderer.h"
+#include "render/tracer.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   return facetfit::fuzz::run(data, size, ".obj", [](const std::string& path) {

@@ -10,7 +10,6 @@
 #include <vector>
 
 #include "render/scene.h"
-#include "render/tracer.h"  // read_obj, for the mesh fuzzer and tests
 
 namespace facetfit {
 

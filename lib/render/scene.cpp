@@ -1,4 +1,5 @@
 #include "render/scene.h"
+#include "render/shading.h"
 
 #include <algorithm>
 #include <cmath>

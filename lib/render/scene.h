@@ -11,9 +11,10 @@
 #include "core/vec.h"
 #include "model/smith.h"
 #include "model/stretch.h"
-#include "render/shading.h"
 
 namespace facetfit {
+
+class ShadingModel;  // render/shading.h
 
 struct CameraDesc {
   Vec3 position{0, 0, 4}, look_at{0, 0, 0}, up{0, 1, 0};

@@ -36,6 +36,7 @@
 #include "model/tabulated.h"
 #include "render/renderer.h"
 #include "render/scene.h"
+#include "render/shading.h"
 
 namespace facetfit::python {
 namespace {
