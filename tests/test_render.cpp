@@ -1,4 +1,5 @@
 // The reference renderer against answers known in closed form.
+#include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -649,6 +650,25 @@ TEST(Camera, SamplesInSimdLanesEqualOneAtATime) {
 // declares: sampling and density in SIMD lanes, and f too where it says `all`. A type whose models leave the
 // lanes (a new model without kernels, a proposal they do not hold) fails here instead of rendering one
 // pair at a time unseen. The loop reads the registry, so a new type is tested as soon as it is listed.
+// A render's EXR says in which colour space its pixels are: OpenEXR's chromaticities (Rec.709 primaries,
+// D65 white), which compositors read, and the name OpenImageIO reads.
+TEST(Render, ExrCarriesItsChromaticities) {
+  test::TempDir dir;
+  RenderedImage image;
+  image.width = image.height = 2;
+  image.rgba.assign(16, 0.5f);
+  write_exr(dir.file("x.exr"), image, {{"source", "test"}});
+  const auto in = OIIO::ImageInput::open(dir.file("x.exr"));
+  ASSERT_TRUE(in);
+  const OIIO::ImageSpec& spec = in->spec();
+  const OIIO::ParamValue* c = spec.find_attribute("chromaticities", OIIO::TypeDesc(OIIO::TypeDesc::FLOAT, 8));
+  ASSERT_NE(c, nullptr);
+  const float rec709[8] = {0.64f, 0.33f, 0.30f, 0.60f, 0.15f, 0.06f, 0.3127f, 0.3290f};
+  for (int k = 0; k < 8; ++k) EXPECT_NEAR(static_cast<const float*>(c->data())[k], rec709[k], 1e-6) << k;
+  EXPECT_EQ(spec.get_string_attribute("oiio:ColorSpace"), "lin_rec709");
+  EXPECT_EQ(spec.get_string_attribute("facetfit:source"), "test");
+}
+
 TEST(Shading, EveryMaterialTypeRunsInTheLanesItDeclares) {
   test::TempDir dir;
   const std::string lut = dir.file("gold.exr");

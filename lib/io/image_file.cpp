@@ -8,6 +8,7 @@
 #include <OpenEXR/ImfIntAttribute.h>
 #include <OpenEXR/ImfOutputFile.h>
 #include <OpenEXR/ImfPartType.h>
+#include <OpenEXR/ImfStandardAttributes.h>
 #include <OpenEXR/ImfStringAttribute.h>
 #include <OpenEXR/ImfVecAttribute.h>
 #include <dlfcn.h>
@@ -319,6 +320,10 @@ void write_exr_file(const std::string& path, const std::string& target, const Im
     else if (const float* f = std::get_if<float>(&value)) header.insert(name, Imf::FloatAttribute(*f));
     else if (const std::string* t = std::get_if<std::string>(&value)) header.insert(name, Imf::StringAttribute(*t));
     else if (const auto* v = std::get_if<std::array<float, 3>>(&value)) header.insert(name, Imf::V3fAttribute(Imath::V3f((*v)[0], (*v)[1], (*v)[2])));
+  }
+  if (spec.linear_rec709) {
+    Imf::addChromaticities(header, Imf::Chromaticities());  // OpenEXR's default: Rec.709 primaries, D65
+    header.insert("oiio:ColorSpace", Imf::StringAttribute("lin_rec709"));
   }
   Imf::OutputFile out(path.c_str(), header);
   out.setFrameBuffer(exr_frame_buffer(spec, header.dataWindow(), static_cast<const float*>(pixels)));

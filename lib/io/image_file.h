@@ -30,6 +30,9 @@ struct ImageSpec {
   enum class Format { float32, uint8 } format = Format::float32;
   // Code values of a display (8- and 16-bit PNG, JPEG: what OpenImageIO calls "sRGB"), not scene-linear.
   bool display_referred = false;
+  // Scene-linear Rec.709 colour (a render): an OpenEXR file then carries the standard `chromaticities`
+  // attribute (Rec.709 primaries, D65 white) and the colour space's name, for compositors and image tools.
+  bool linear_rec709 = false;
   std::map<std::string, ImageAttribute> attributes;
 
   ImageSpec() = default;

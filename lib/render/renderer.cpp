@@ -23,6 +23,7 @@ std::vector<float> RenderedImage::rgb() const {
 
 void write_exr(const std::string& path, const RenderedImage& image, const std::vector<std::pair<std::string, std::string>>& metadata) {
   ImageSpec spec(image.width, image.height, {"R", "G", "B", "A"});
+  spec.linear_rec709 = true;
   for (const auto& [k, v] : metadata) spec.set("facetfit:" + k, v);
   write_image_atomic(path, spec, image.rgba.data());
 }

@@ -40,7 +40,8 @@ struct RenderedImage {
 // Throws Error for anything it cannot load, and for a scene over settings.max_memory.
 RenderedImage render(const SceneDesc& scene, const RenderSettings& settings = {});
 
-// Linear EXR (R, G, B, A, float) with the given string metadata, through a temporary file.
+// Linear EXR (R, G, B, A, float) with the given string metadata (as facetfit:KEY), its chromaticities
+// (Rec.709, D65) and colour space (oiio:ColorSpace lin_rec709), through a temporary file.
 void write_exr(const std::string& path, const RenderedImage& image, const std::vector<std::pair<std::string, std::string>>& metadata);
 
 }  // namespace facetfit
