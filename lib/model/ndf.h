@@ -12,6 +12,7 @@
 #include <string>
 
 #include "core/vec.h"
+#include "model/ggx_terms.h"
 
 namespace facetfit {
 
@@ -38,12 +39,8 @@ struct Ndf {
   double D(const Vec3& h) const {
     if (h.z <= 0.0) return 0.0;
     if (type == NdfType::ggx) {
-      // slope_pdf / cos^4 with the slopes multiplied out: one division instead of four,
-      // 1 / (pi ax ay (hx^2 / ax^2 + hy^2 / ay^2 + hz^2)^2) = ax^3 ay^3 / (pi e^2) (both homogeneous of
-      // degree -4 in h; this one stays finite where hz^4 underflows).
       const double ax2 = alpha_x * alpha_x, ay2 = alpha_y * alpha_y;
-      const double e = h.x * h.x * ay2 + h.y * h.y * ax2 + h.z * h.z * ax2 * ay2;
-      return ax2 * alpha_x * ay2 * alpha_y / (kPi * e * e);
+      return ggx::D(ggx::ScalarOps{}, h.x, h.y, h.z, ax2, ay2, ax2 * alpha_x * ay2 * alpha_y / kPi);
     }
     const double c2 = h.z * h.z;
     return slope_pdf(-h.x / h.z, -h.y / h.z) / (c2 * c2);
@@ -51,11 +48,7 @@ struct Ndf {
   // Smith's Lambda for direction w; sigma(w) = cos(theta_w) (1 + Lambda(w)) is the projected area.
   double lambda(const Vec3& w) const {
     if (w.z <= 0.0) return std::numeric_limits<double>::infinity();
-    // GGX: sigma / cos - 1 = (sqrt(1 + alpha^2 tan^2) - 1) / 2, alpha^2 sin^2 = w_x^2 alpha_x^2 + w_y^2 alpha_y^2.
-    if (type == NdfType::ggx) {
-      const double a2t2 = (w.x * w.x * alpha_x * alpha_x + w.y * w.y * alpha_y * alpha_y) / (w.z * w.z);
-      return a2t2 > 0.0 ? 0.5 * (std::sqrt(1.0 + a2t2) - 1.0) : 0.0;  // also 0 / 0 at a denormal normal
-    }
+    if (type == NdfType::ggx) return ggx::lambda(ggx::ScalarOps{}, w.x, w.y, w.z, alpha_x * alpha_x, alpha_y * alpha_y);
     return std::max(0.0, sigma(w) / w.z - 1.0);
   }
   double sigma(const Vec3& w) const;

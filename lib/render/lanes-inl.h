@@ -247,20 +247,32 @@ HWY_INLINE CosSinOf<VT> cos_sin_turn(DT d, VT u) {
   return cos_sin(d, set(d, 2.0 * kPi) * hn::IfThenElse(u >= set(d, 0.5), u - one, u));
 }
 
-// Smith's Lambda of GGX for w above the horizon: (sqrt(1 + alpha^2 tan^2) - 1) / 2, with
-// alpha^2 sin^2 = wx^2 ax^2 + wy^2 ay^2; zero where that is (as for a denormal normal).
+// GGX's D and Lambda, the library's text (model/ggx_terms-inl.h) compiled for this target.
+namespace ggx {
+#include "model/ggx_terms-inl.h"
+}  // namespace ggx
+
+// What ggx::D and ggx::lambda need of DT's vectors: the lanes' division, the square root, constants and a
+// choice by sign.
+template <class DT, class VT = hn::Vec<DT>>
+struct LaneOps {
+  DT d;
+  VT divide(VT a, VT b) const { return lanes::divide(d, a, b); }
+  VT sqrt(VT x) const { return hn::Sqrt(x); }
+  VT constant(double c) const { return set(d, c); }
+  VT where_positive(VT x, VT v) const { return hn::IfThenElseZero(x > hn::Zero(d), v); }
+};
+
+// Smith's Lambda of GGX for w above the horizon (ggx::lambda).
 template <class DT, class VT = hn::Vec<DT>>
 HWY_INLINE VT ggx_lambda(DT d, VT wx, VT wy, VT wz, VT ax2, VT ay2) {
-  const VT a2t2 = divide(d, wx * wx * ax2 + wy * wy * ay2, wz * wz);
-  const VT one = set(d, 1.0), half = set(d, 0.5);
-  return hn::IfThenElseZero(a2t2 > hn::Zero(d), half * (hn::Sqrt(one + a2t2) - one));
+  return ggx::lambda(LaneOps<DT>{d}, wx, wy, wz, ax2, ay2);
 }
 
-// D(h) of GGX for h above the horizon: ax^3 ay^3 / (pi e^2), e = hx^2 ay^2 + hy^2 ax^2 + hz^2 ax^2 ay^2.
+// D(h) of GGX for h above the horizon (ggx::D).
 template <class DT, class VT = hn::Vec<DT>>
 HWY_INLINE VT ggx_ndf(DT d, VT hx, VT hy, VT hz, VT ax2, VT ay2, VT numerator_over_pi) {
-  const VT e = hx * hx * ay2 + hy * hy * ax2 + hz * hz * ax2 * ay2;
-  return divide(d, numerator_over_pi, e * e);
+  return ggx::D(LaneOps<DT>{d}, hx, hy, hz, ax2, ay2, numerator_over_pi);
 }
 
 // (1 - mu)^5 of Schlick's approximation, mu clamped to [0, 1] as fresnel_schlick does.
