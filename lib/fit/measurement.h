@@ -91,7 +91,7 @@ inline double metric_transform(double x, double* slope = nullptr) {
   const double t = kPi * std::abs(x);
   double lightness, d;
   if (t > kDelta3) {
-    lightness = cube_root(t);  // a third of a fit's time went to the C library's cbrt
+    lightness = cube_root(t);  // core/vec.h's, not the C library's slower cbrt: the fits call this per residual
     d = kPi / (3.0 * lightness * lightness);
   } else {
     lightness = t * kLinear + 4.0 / 29.0;

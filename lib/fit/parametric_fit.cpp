@@ -176,7 +176,7 @@ double anisotropic_lobe(NdfType type, Smith smith, double alpha_x, double alpha_
 // The anisotropic model's residuals over one row of bins (3 per bin). Parameter blocks: body (3), shape
 // (log alpha_x, log alpha_y, angle), f0 (3), f82 (3). The colour parameters enter the model linearly and
 // are differentiated by hand (as RowCost); the shape by central differences of the lobe, which is common
-// to the three channels: 7 lobe evaluations per bin, where differencing all 12 unknowns took 25.
+// to the three channels: 7 lobe evaluations per bin, where differencing all 12 unknowns would take 25.
 class AnisotropicRowCost final : public ceres::CostFunction {
  public:
   AnisotropicRowCost(const MeasuredBins& bins, const MeasuredBins::Row& row, NdfType type, Smith smith)

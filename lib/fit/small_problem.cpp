@@ -144,7 +144,7 @@ void gather_rows(const std::vector<Block>& blocks, const std::vector<int>& used,
 // The gathered rows' J^T J and J^T r, added into the normal equations.
 void add_to_normal_equations(Workspace& w, int m, Matrix& jtj, Vector& jtr) {
   // Coefficient-wise for a few unknowns, where GEMM's packing costs more; GEMM past 20 (the closure fit's
-  // 13 to 29), where its blocking wins (a symmetric rank update, half the products, took longer).
+  // 13 to 29), where its blocking wins (a symmetric rank update, half the products, is slower).
   if (w.columns.size() < 20)
     w.local.noalias() = w.rows.transpose().lazyProduct(w.rows);
   else

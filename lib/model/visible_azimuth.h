@@ -13,9 +13,8 @@ namespace facetfit {
 // phi / phi_max where the CDF reaches u, tabulated at s = a / (a + b) = i / kSize and u = j / kSize,
 // i, j = 0..kSize; bilinear between nodes. Its guess is within 1e-4 radians for half of the draws and
 // within 0.05 for 99% (random views and normals): Newton then stops after two steps for most draws where
-// the start u phi_max took four. It
-// only sets where Newton starts: the result moves within the steps' stop (1e-7 radians). Immutable, built
-// on first use (0.1 ms).
+// the start u phi_max would take four. It only sets where Newton starts: the result moves within the
+// steps' stop (1e-7 radians). Immutable, built on first use (0.1 ms).
 class AzimuthGuess {
  public:
   static constexpr int kSize = 32;

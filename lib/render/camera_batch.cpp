@@ -24,7 +24,7 @@ using VU = hn::Vec<DU>;
 
 // The low 64 bits of a x c: AVX2 multiplies 32 x 32 bits, so from the halves (the high halves' product
 // lies above bit 63). One lane (the baseline) multiplies them whole, and so does AVX-512 (vpmullq: 3 uops
-// against the halves' 8; perf: the camera samples 9 -> 7% of a Lambertian sphere's render).
+// against the halves' 8).
 VU mul(VU a, std::uint64_t c) {
   const DU du;
 #if HWY_TARGET == HWY_SCALAR

@@ -1,6 +1,6 @@
 // A tile's camera samples in SIMD lanes (Google Highway, as render/ggx_batch.h): each pixel's numbers for
-// one sample index and its camera ray's direction. Drawn one sample at a time inside the tile loop, their
-// 64-bit hashes, square roots and divisions took 40% of a render that traces camera rays only (perf).
+// one sample index and its camera ray's direction. In lanes because, one sample at a time inside the tile
+// loop, their 64-bit hashes, square roots and divisions would be a large share of every sample's work.
 #pragma once
 
 #include <cstdint>
@@ -30,8 +30,8 @@ struct SampleSequence {
   // Number j of the sequence from `start`: state j / 2 + 1, mixed, gives numbers j and j + 1 (even j), its
   // top 32 bits and its low 32 bits; a double in [0, 1) as the mantissa of a number in [1, 2) less 1 (exact;
   // the lanes form it with an or, where AVX2 has no conversion of 64-bit integers). 32 bits a number, not
-  // 52: two numbers per mix took the camera samples' hashes from five to three a sample, on AVX2 two
-  // emulated 64-bit multiplications each (perf: a seventh of a Lambertian sphere's render).
+  // 52: two numbers per mix make a sample's hashes three, not five, each two 64-bit multiplications,
+  // emulated on AVX2.
   static std::uint64_t state(std::uint64_t start, int pair) {
     std::uint64_t z = start + std::uint64_t(pair + 1) * kStep;
     z = (z ^ (z >> 30)) * kMix1;
@@ -55,7 +55,7 @@ struct PinholeCamera {
   Vec3 position, forward, right, up;
   double tan_half = 1.0, aspect = 1.0;
   double to_sx = 1.0, to_sy = 1.0;  // 2 / width, 2 / height: products, not quotients (a division per axis
-                                    // and sample waited on the last: perf)
+                                    // and sample would wait on the one before)
   Vec3 direction(double x, double y, double u0, double u1) const {
     const double sx = ((x + u0) * to_sx - 1.0) * tan_half * aspect;
     const double sy = (1.0 - (y + u1) * to_sy) * tan_half;

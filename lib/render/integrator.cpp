@@ -106,7 +106,7 @@ void Integrator::LoadEnvironment() {
   // A map gets a light sample per hit, weighted against the BRDF's by multiple importance sampling. A
   // constant environment is lit by the BRDF sample alone: a light sample, uniform over the sphere, adds
   // nothing the BRDF's proposal does not already draw better (every model's proposal holds the cosine, so
-  // the estimate stays unbiased), and weighted against it, it added noise (docs/render-speed.md).
+  // the estimate stays unbiased), and weighted against it, it adds noise (docs/render-speed.md).
   light_sampled_ = env_ && !env_->is_constant();
   constant_radiance_ = env_ && env_->is_constant() ? env_->radiance(Vec3(0.0, 0.0, 1.0)) : Rgb(0.0);
   numbers_read_ = sample_numbers_read(env_.has_value(), light_sampled_);

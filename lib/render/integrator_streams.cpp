@@ -124,9 +124,9 @@ void Integrator::ShadeInLanes(TileSpace& space) {
 
 // The shadow rays that nothing blocks, added to their pixels. The lanes' rays slot by slot, in each hit's
 // order of slots (environment light, BRDF sample, lights); a blocked ray or one cast for nothing adds
-// zero with no branch: its bits and-ed with none (GCC made a choice a branch, mispredicted at the edges of
-// shadows). A pixel has at most one entry per slot, so the additions of one slot do not wait on one
-// another. Then the pixels Plan() shaded, with their own rays.
+// zero with no branch: its bits and-ed with none (GCC may compile a choice to a branch, which mispredicts
+// at the edges of shadows). A pixel has at most one entry per slot, so the additions of one slot do not
+// wait on one another. Then the pixels Plan() shaded, with their own rays.
 void Integrator::AddShadows(TileSpace& space) const {
   for (const Wave& w : space.waves) {
     if (w.hits.size() == 0) continue;

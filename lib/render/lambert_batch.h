@@ -1,7 +1,7 @@
 // A Lambertian surface's f(o, i), density and cosine sampling over a batch, in SIMD lanes (Google Highway,
 // as render/ggx_batch.h): ShadingModel's eval and sample_direction with a LambertBrdf and no proposal
-// (render/shading.h), term for term. One pair at a time, a Lambertian sphere rendered slower than a GGX one
-// in lanes (docs/benchmarks.md, BM_RenderSphere).
+// (render/shading.h), term for term. In lanes because, one pair at a time, a Lambertian sphere would render
+// slower than a GGX one in lanes (docs/benchmarks.md, BM_RenderSphere).
 #pragma once
 
 #include "core/vec.h"

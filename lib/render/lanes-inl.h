@@ -136,10 +136,8 @@ inline VF divide(DF, VF a, VF b) { return a / b; }
 inline VF inverse_sqrt(DF d, VF x) { return hn::Set(d, 1.0f) / hn::Sqrt(x); }
 inline VF sqrt(DF, VF x) { return hn::Sqrt(x); }
 
-// base[index] in each lane: Highway's gather, except for AVX2's eight 32-bit lanes, which load one by one.
-// On an AMD EPYC of family 23 (Zen), whose vgatherdps is microcoded, that took the LUT sphere's render
-// from 1052 to 954 ms of one CPU (medians of seven alternated runs; 857 -> 809 the fastest); a gather is
-// eight loads on other x86 cores too.
+// base[index] in each lane: Highway's gather, except for AVX2's eight 32-bit lanes, which load one by one:
+// AMD's Zen (family 23) microcodes vgatherdps, and a gather is eight loads on other x86 cores too.
 template <class DT, typename T>
 HWY_INLINE hn::Vec<DT> gather(DT d, const T* base, hn::Vec<hn::RebindToSigned<DT>> index) {
 #if HWY_TARGET == HWY_AVX2

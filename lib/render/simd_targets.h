@@ -17,7 +17,7 @@ namespace facetfit {
 
 // Whether the CPU has every feature Highway compiles its AVX2 code for. Highway's own run-time dispatch
 // (HWY_DYNAMIC_DISPATCH) lives in libhwy.so, whose static initializer times a clock in every process that
-// loads it: 4 ms more for every command's start-up (perf stat). With two targets the CPU's features pick.
+// loads it, which delays every command's start-up. With two targets the CPU's features pick.
 bool cpu_has_avx2();
 // And every feature of its AVX3 (AVX-512: F, VL, DQ, BW) code, unless the environment variable
 // FACETFIT_NO_AVX3 is set: a benchmark's way to time the AVX2 code on the same CPU (bench/render_compare.py).

@@ -1,8 +1,8 @@
 // Rays in columns, and the scene's spheres tested against many of them at once in SIMD lanes (Google
 // Highway, as render/ggx_batch.h): intersect_sphere (render/tracer.h) in every lane, with the same
 // operations in the same order, so that each answer equals the one-ray query's to rounding (the compiler
-// fuses multiply-adds in the AVX2 code). One ray at a time, the closed form and the rays' copies took a
-// fifth of a GGX sphere's render (docs/render-speed.md).
+// fuses multiply-adds in the AVX2 code). Many at once because, one ray at a time, the closed form and the
+// rays' copies would be a large share of a sphere's render (docs/render-speed.md).
 #pragma once
 
 #include <cstddef>

@@ -24,8 +24,8 @@ class TabulatedMicrofacet;
 class VisibleSlopeProposal;
 
 // The lanes work in single precision, as a renderer's SIMD kernels commonly do: twice a double vector's
-// lanes for the same instructions (the tabulated lobe's draws and evaluations took 58% of the LUT
-// sphere's render in double, docs/render-speed.md). Their tables are the model's, rounded to float.
+// lanes for the same instructions, in the costliest kernels of a LUT sphere's render (the tabulated lobe's
+// draws and evaluations, docs/render-speed.md). Their tables are the model's, rounded to float.
 struct TabulatedBatchModel {
   // f's tables, set where `f` (the BRDF is the lobe itself, unstretched): the theta grid
   // (model/theta_grid.h) and D at its resolution + 1 nodes, the four a grid interval's spline reads

@@ -1,10 +1,10 @@
 // The scene's geometry and its two ray queries: the closest hit, and whether anything blocks a segment.
 //
 // Spheres are intersected in closed form, in double precision; planes and meshes are triangles in an
-// Embree scene, which is not built at all when a scene has none. Per shadow ray leaving a sphere, Embree's
-// sphere primitive took about 4x the closed form's time (BM_ShadowRay in bench/bench_fit.cpp: 81 against
-// 18 ns of CPU on a loaded two-core machine). A scene holds a handful of spheres (look development: a
-// subject, maybe a few props), so they are tested one after the other rather than through a hierarchy.
+// Embree scene, which is not built at all when a scene has none. Per shadow ray leaving a sphere, the
+// closed form is several times faster than Embree's sphere primitive (BM_ShadowRay in bench/bench_fit.cpp).
+// A scene holds a handful of spheres (look development: a subject, maybe a few props), so they are tested
+// one after the other rather than through a hierarchy.
 #pragma once
 
 #include <limits>
@@ -24,7 +24,7 @@ struct Ray {
   Ray() = default;
   // A constructor rather than an aggregate, so that a vector builds a ray in place (emplace_back): a ray
   // built whole and copied in is written in 8-byte and read in 16-byte pieces, which stalls store
-  // forwarding (perf: 11% of a GGX render on one load).
+  // forwarding.
   Ray(const Vec3& o, const Vec3& d, double t0 = 0.0, double t1 = std::numeric_limits<double>::infinity())
       : origin(o), dir(d), tnear(t0), tfar(t1) {}
 };

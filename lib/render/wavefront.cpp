@@ -58,7 +58,7 @@ struct Entry {
 // Stores vectors with the lanes of a mask moved to the front, from position `at` of a column: a whole
 // vector is written, the columns have room past their entries.
 #if HWY_TARGET == HWY_AVX3
-// AVX-512 compresses in a register (vcompresspd to memory was slower), then stores the whole vector.
+// AVX-512 compresses in a register (vcompresspd to memory is slower), then stores the whole vector.
 struct ToFront {
   M mask;
   std::size_t at;
@@ -70,7 +70,7 @@ HWY_INLINE ToFront to_front(D, M m, std::size_t at) { return {m, at}; }
 #else
 // Elsewhere vectors hold at most 4 doubles (render/simd_targets.h): the lanes of mask bits m in order,
 // from a table of our own (Highway's CompressStore copies a 256-byte table onto the stack at every call,
-// hwy 1.0.3; perf: half of a render).
+// hwy 1.0.3).
 static_assert(hn::MaxLanes(D()) <= 4, "the compression table holds 4 lanes");
 struct CompressTable {
   std::int64_t index[16][4];

@@ -1,7 +1,7 @@
 // Direct lighting of many hits on one material at once, in SIMD lanes (Google Highway, as
 // render/ggx_batch.h): the shadow rays a hit casts and their values, made slot by slot over a tile's hits
-// instead of one hit at a time. One hit at a time, making the requests, the BRDF samples' directions and the
-// shadow rays' values took half of a GGX sphere's render (docs/render-speed.md).
+// instead of one hit at a time, which would spend a large share of a sphere's render on making the
+// requests, the BRDF samples' directions and the shadow rays' values (docs/render-speed.md).
 //
 // Per hit the slots are, in this order: the environment's light sample (a map's; a constant environment
 // has none, render/integrator.cpp), the BRDF sample (with an environment), then each light. A slot that
@@ -26,8 +26,8 @@ namespace facetfit {
 struct TileHits : Columns {
   std::vector<double> t, material, inv_radius, gx, gy, gz;
   std::vector<double> lx, ly, lz, light_pdf, light_r, light_g, light_b;
-  // The directions and numbers: columns the caller owns (the camera samples', read in place: copying them
-  // here took 1.9% of a LUT sphere's render), readable to padded_size().
+  // The directions and numbers: columns the caller owns (the camera samples', read in place, not copied
+  // here), readable to padded_size().
   const double *dx = nullptr, *dy = nullptr, *dz = nullptr, *u1 = nullptr, *u2 = nullptr, *u3 = nullptr;
   // Whether the environment's light sample columns (lx ... light_b) hold one: a map's. Without, they are
   // not read, and place_hits() does not pass them on.
@@ -88,10 +88,8 @@ struct HitBatch : Columns {
 // places a hit: p = camera + t d; the normal from the sphere's centre or the triangle's, turned toward the
 // camera; the frame of core/frame.h about it (along `tangent` where given); o the direction toward the
 // camera in it; the shadow rays' origin p + eps n. p itself only with `positions` (point lights read it):
-// each column a hit carries costs its compaction, and skipping those a scene does not read (p; the light
-// sample's direction, density and radiance where the environment has none) took a Lambertian sphere's
-// render from 243 to 234 ms on one CPU (the mean of five alternated runs, within the machine's noise that
-// day).
+// each column a hit carries costs its compaction, so those a scene does not read are skipped (p; the light
+// sample's direction, density and radiance where the environment has none).
 void place_hits(const TileHits& tile, const Vec3& camera, double eps, double material, const Vec3* tangent, bool positions,
                 HitBatch& out, SimdTarget target = SimdTarget::best);
 
