@@ -80,6 +80,17 @@ const MerlTable* rgl_material(const char* name) {
   return it->second ? &*it->second : nullptr;
 }
 
+// Loading an RGL file as the fits read it (load_table: the tensor file, its one-sided estimates, the
+// MERL-layout table), one thread: the part of a whole `facetfit fit` that BM_FitRgl does not time.
+void BM_LoadRgl(benchmark::State& state) {
+  const char* env = std::getenv("FACETFIT_RGL_DIR");
+  const std::filesystem::path file = std::filesystem::path(env ? env : "../shared/data/rgl") / "ilm_l3_37_metallic_rgb.bsdf";
+  if (!std::filesystem::exists(file)) return state.SkipWithError("no RGL data: set FACETFIT_RGL_DIR");
+  const auto threads = limit_threads(state);
+  for (auto _ : state) benchmark::DoNotOptimize(load_table(file.string()));
+}
+BENCHMARK(BM_LoadRgl)->ArgName("threads")->Arg(1)->Unit(benchmark::kMillisecond);
+
 // The default fit (--refine full) of real materials against the paper's method alone on the same
 // table (the anchor): extraction, parametric fits, refinement, every distance.
 // The RGL material the benchmark's second argument names (0: acrylic_felt_green_rgb, 1:

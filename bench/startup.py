@@ -1,10 +1,11 @@
 #!/usr/bin/env python3
 """Whole-process wall time and peak memory of facetfit commands (make bench; docs/benchmarks.md).
 
-usage: startup.py FACETFIT OUT.md [RUNS]
+usage: startup.py FACETFIT OUT.md [RUNS] [RGL_FILE]
 
 Each command runs RUNS times under /usr/bin/time; the table gives the median wall time (by the clock,
-around the whole run) and the median of the peak resident set sizes. The MERL file is written by facetfit itself (builtin:red-plastic).
+around the whole run) and the median of the peak resident set sizes. The MERL file is written by facetfit itself (builtin:red-plastic);
+with RGL_FILE, one real RGL material is fitted and re-baked from the cache as whole processes on one thread.
 """
 import json
 import os
@@ -28,7 +29,7 @@ def measure(cmd, runs):
     return statistics.median(walls), statistics.median(rss)
 
 
-def main(facetfit, dst, runs=10):
+def main(facetfit, dst, runs=10, rgl=None):
     with tempfile.TemporaryDirectory() as tmp:
         merl = os.path.join(tmp, "red-plastic.binary")
         subprocess.run([facetfit, "convert", "builtin:red-plastic", "-o", merl], check=True, stdout=subprocess.DEVNULL)
@@ -52,6 +53,17 @@ def main(facetfit, dst, runs=10):
             ("`facetfit render SCENE -o X.exr`: bench/render_compare.py's GGX sphere at 8 x 8, 1 spp (start-up alone)", render),
             ("the same render `--png X.png` (also loads facetfit-oiio.so: OpenImageIO)", render + ["--png", os.path.join(tmp, "x.png")]),
         ]
+        if rgl and os.path.exists(rgl):
+            name = os.path.basename(rgl)
+            luts = os.path.join(tmp, "rgl-luts")
+            bake = [facetfit, "-q", "--threads", "1", "bake", rgl, "-o", luts]
+            subprocess.run(bake, check=True, stdout=subprocess.DEVNULL)  # the cache the re-bake reads
+            cases += [
+                (f"`facetfit --threads 1 fit {name}` (a real RGL file: load, refinement, parametric and closure fits)",
+                 [facetfit, "--threads", "1", "fit", rgl]),
+                (f"`facetfit --threads 1 fit {name} --refine none`", [facetfit, "--threads", "1", "fit", rgl, "--refine", "none"]),
+                (f"`facetfit --threads 1 bake {name}` again (cached: its hash and sidecar checked, nothing fitted)", bake),
+            ]
         lines = ["| command | wall (median) | peak memory (median) |", "|---|---|---|"]
         for what, cmd in cases:
             wall, rss = measure(cmd, runs)
@@ -61,4 +73,4 @@ def main(facetfit, dst, runs=10):
 
 
 if __name__ == "__main__":
-    main(sys.argv[1], sys.argv[2], int(sys.argv[3]) if len(sys.argv) > 3 else 10)
+    main(sys.argv[1], sys.argv[2], int(sys.argv[3]) if len(sys.argv) > 3 else 10, sys.argv[4] if len(sys.argv) > 4 else None)

@@ -9,7 +9,7 @@ trap 'rm -f "$json"' EXIT
   --benchmark_min_time=0.3 --benchmark_out="$json" --benchmark_out_format=json
 startup="$(mktemp --suffix=.md)"
 trap 'rm -f "$json" "$startup"' EXIT
-python3 "$root/bench/startup.py" "$build/bin/facetfit" "$startup"
+python3 "$root/bench/startup.py" "$build/bin/facetfit" "$startup" 10 "$root/../shared/data/rgl/ilm_l3_37_metallic_rgb.bsdf"
 python3 "$root/scripts/bench_to_md.py" "$json" "$root/docs/benchmarks.md" "$startup"
 "$build/bench/facetfit_pareto" "$root/docs"
 # Cycles through Blender's bpy wheel, in a venv of the build.
