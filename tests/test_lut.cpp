@@ -267,6 +267,18 @@ TEST(Lut, AnisotropicLobeRoundTrip) {
   }
   EXPECT_NE(error_of([&] { read_lut(dir.file("bad.exr")); }).find("bad.exr: facetfit:anisotropic_resolution or facetfit:anisotropic_phi_count"),
             std::string::npos);
+  // A resolution in range but not the one the rows were written on: refused, not read as another grid.
+  {
+    auto in = OIIO::ImageInput::open(dir.file("a.exr"));
+    OIIO::ImageSpec spec = in->spec();
+    std::vector<float> px(std::size_t(spec.width) * std::size_t(spec.height) * std::size_t(spec.nchannels));
+    ASSERT_TRUE(in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, px.data()));
+    spec.attribute("facetfit:anisotropic_resolution", 10);
+    auto out = OIIO::ImageOutput::create(dir.file("grid.exr"));
+    ASSERT_TRUE(out->open(dir.file("grid.exr"), spec) && out->write_image(OIIO::TypeDesc::FLOAT, px.data()) && out->close());
+  }
+  EXPECT_NE(error_of([&] { read_lut(dir.file("grid.exr")); }).find("grid.exr: facetfit:anisotropic_resolution is 10, not min(facetfit:resolution, 90)"),
+            std::string::npos);
 }
 
 TEST(Lut, ABodyExponentMakesVersionFour) {

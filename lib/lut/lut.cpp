@@ -426,6 +426,11 @@ void read_anisotropic_attributes(const std::string& path, const ImageSpec& spec,
       m.anisotropic_phi_count > 4096 || m.anisotropic_phi_count % 2 != 0)
     fail(path, "facetfit:anisotropic_resolution or facetfit:anisotropic_phi_count is missing or out of range (" +
                    std::to_string(m.anisotropic_resolution) + ", " + std::to_string(m.anisotropic_phi_count) + ")");
+  // The 2D extraction runs on min(resolution, 90) intervals (fit/fit.cpp): another count reads the rows'
+  // texels as the wrong grid's nodes, a lobe of the right range and the wrong shape.
+  if (m.anisotropic_resolution != std::min(m.resolution, 90))
+    fail(path, "facetfit:anisotropic_resolution is " + std::to_string(m.anisotropic_resolution) + ", not min(facetfit:resolution, 90) = " +
+                   std::to_string(std::min(m.resolution, 90)));
   AnisotropicParametricFit& g = m.anisotropic_ggx;
   g.alpha = {spec.get_float(key("anisotropic_ggx_alpha_x")), spec.get_float(key("anisotropic_ggx_alpha_y")),
              spec.get_float(key("anisotropic_ggx_angle"))};
