@@ -68,26 +68,13 @@ BakeOutcome bake_material(const std::string& source, const std::string& name, co
   try {
     if (const std::string problem = output_name_problem(name); !problem.empty())
       fail(source, "output name \"" + excerpt(name, 60) + "\" " + problem);
-    // A cache hit: the record of a sidecar whose key (the source's SHA-256 and the options) is current.
-    const auto cached = [&](const std::string& sha) -> std::optional<nlohmann::json> {
-      if (options.force) return std::nullopt;
-      return cached_record(json_path, lut_path, bake_cache_key(sha, options));
-    };
-    const auto hit = [&](nlohmann::json record) {
-      out.status = BakeOutcome::Status::cached;
-      out.record = std::move(record);
-      out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      return out;
-    };
+    // With a sidecar there, a hit is likely: the hash alone first (an RGL file's table costs a second to
+    // make, the hash of its 0.7 MB milliseconds), the table only on a miss. Without one, the SHA-256 of a
+    // 35 MB MERL table costs as much CPU as reading and fitting it: hash on one core while the other reads.
     std::string sha;
     std::optional<MerlTable> table;
-    // With a sidecar there, a hit is likely: the hash alone first (an RGL file's table costs a second to
-    // make, the hash of its 0.7 MB milliseconds). Without one, the SHA-256 of a 35 MB MERL table costs as
-    // much CPU as reading and fitting it: hash on one core while the other reads.
     if (!options.force && fs::exists(json_path)) {
       sha = source_sha256(source);
-      if (auto record = cached(sha)) return hit(std::move(*record));
-      table = load_table(source, options.fit.merl_bins);
     } else {
       std::string hash_error;
       tbb::task_group hashing;
@@ -106,9 +93,17 @@ BakeOutcome bake_material(const std::string& source, const std::string& name, co
       }
       hashing.wait();
       if (!hash_error.empty()) throw Error(hash_error);
-      if (auto record = cached(sha)) return hit(std::move(*record));
     }
     const std::string key = bake_cache_key(sha, options);
+    if (!options.force) {
+      if (auto cached = cached_record(json_path, lut_path, key)) {
+        out.status = BakeOutcome::Status::cached;
+        out.record = std::move(*cached);
+        out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        return out;
+      }
+    }
+    if (!table) table = load_table(source, options.fit.merl_bins);
     const FitResult fit = fitter.fit(*table);
     if (!fit.ok()) fail(source, "meaningless fit: " + fit.problem);
     const Lut lut = make_lut(fit, fitter.quadrature(), source, sha, options.tolerance, options.with_sampling);
