@@ -18,6 +18,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <random>
 #include <regex>
@@ -542,6 +543,7 @@ class OslSphere : public ::testing::Test {
   static void SetUpTestSuite() {
     work_ = new TempDir;
     shaders_ = new SharedFolder(FACETFIT_OSL_FIXTURE, OslModel::make_luts);
+    rendered_ = new std::map<std::string, std::pair<std::string, double>>;
     write_test_environment(work_->file("sky.exr"));
   }
   static void TearDownTestSuite() {
@@ -549,6 +551,8 @@ class OslSphere : public ::testing::Test {
     work_ = nullptr;
     delete shaders_;
     shaders_ = nullptr;
+    delete rendered_;
+    rendered_ = nullptr;
   }
 
   static std::string bake(const std::string& material) {
@@ -569,12 +573,20 @@ class OslSphere : public ::testing::Test {
     return render_scene(name, scene, seconds);
   }
 
+  // A scene rendered before in this suite (the preview and the material shader share references) is
+  // not rendered again: its image and time are the earlier render's.
   static std::string render_scene(const std::string& name, const nlohmann::json& scene, double* seconds) {
+    const std::string key = scene.dump();
+    if (const auto done = rendered_->find(key); done != rendered_->end()) {
+      *seconds = done->second.second;
+      return done->second.first;
+    }
     std::ofstream(work_->file(name + ".json")) << scene.dump(2);
     const RunResult r = facetfit("render " + work_->file(name + ".json") + " -o " + work_->file(name + ".exr"));
     EXPECT_EQ(r.status, 0) << r.err;
     std::smatch m;
     if (std::regex_search(r.out, m, std::regex("spp, ([0-9.]+) s\\)"))) *seconds = std::stod(m[1]);
+    if (r.status == 0) (*rendered_)[key] = {work_->file(name + ".exr"), *seconds};
     return work_->file(name + ".exr");
   }
 
@@ -591,13 +603,26 @@ class OslSphere : public ::testing::Test {
     return render_scene(name, scene, seconds);
   }
 
-  static std::string cycles_sphere(const std::string& name, const std::string& shader, int spp, const std::string& params,
-                                   double* seconds) {
+  // Cycles renders of the sphere in one Blender process (its start-up and the shader's compilation are
+  // much of a small render's time): one job each, {"command": "sphere" or "sun", "shader", "out", "size",
+  // "spp", "environment", "params"} (tests/osl/cycles_render.py). Returns the seconds per render.
+  static double cycles_batch(const nlohmann::json& jobs, const std::string& name) {
+    std::ofstream(work_->file(name + "-jobs.json")) << jobs.dump(1);
     const auto start = std::chrono::steady_clock::now();
-    cycles("sphere " + shaders_->file(shader + ".oso") + " " + work_->file(name + ".exr") + " " + std::to_string(sphere_size()) + " " +
-           std::to_string(spp) + " " + work_->file("sky.exr") + " " + params);
-    *seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    return work_->file(name + ".exr");
+    cycles("batch " + work_->file(name + "-jobs.json"));
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    std::cout << jobs.size() << " Cycles renders in one process: " << seconds << " s\n";
+    return seconds / double(std::max<std::size_t>(1, jobs.size()));
+  }
+
+  // A Cycles job of the sphere: NAME=VALUE words of `params` as the shader's parameters.
+  static nlohmann::json cycles_job(const std::string& command, const std::string& shader, const std::string& out, int spp,
+                                   const std::string& params) {
+    nlohmann::json p = nlohmann::json::object();
+    std::istringstream words(params);
+    for (std::string item; words >> item;) p[item.substr(0, item.find('='))] = item.substr(item.find('=') + 1);
+    return {{"command", command}, {"shader", shaders_->file(shader + ".oso")}, {"out", out}, {"size", sphere_size()},
+            {"spp", spp}, {"environment", work_->file("sky.exr")}, {"params", p}};
   }
 
   // Mean Delta E 2000 over the pixels both renders cover fully (alpha > 0.999: the silhouette's pixels
@@ -634,26 +659,44 @@ class OslSphere : public ::testing::Test {
 
   static TempDir* work_;
   static SharedFolder* shaders_;  // the compiled shaders (and OslModel's LUTs)
+  static std::map<std::string, std::pair<std::string, double>>* rendered_;  // scene JSON -> (image, seconds)
 };
 TempDir* OslSphere::work_ = nullptr;
 SharedFolder* OslSphere::shaders_ = nullptr;
+std::map<std::string, std::pair<std::string, double>>* OslSphere::rendered_ = nullptr;
 
-// One comparison: `material` rendered by the reference renderer (`reference_material`, a scene-format
-// material, at `reference_spp`) and by Cycles through `shader` (`cycles_spp` samples per pixel, shader
-// parameters `params`); the mean Delta E 2000 must stay below the 1.0. `what` names the
-// comparison in the log and in docs/osl.md's figures.
-void check_sphere(const std::string& material, const std::string& what, const nlohmann::json& reference_material, int reference_spp,
-                  const std::string& shader, int cycles_spp, const std::string& params) {
-  double ref_s = 0.0, cyc_s = 0.0;
-  const std::string name = shader + "-" + material;
-  const std::string ref = OslSphere::reference("reference-" + name, reference_material, reference_spp, &ref_s);
-  const std::string cyc = OslSphere::cycles_sphere("cycles-" + name, shader, cycles_spp, params, &cyc_s);
-  const ImageDiff d = OslSphere::compare(ref, cyc, shader.substr(shader.find('_') + 1) + "-" + material);
-  EXPECT_LT(d.mean, 1.0) << material << ": max " << d.max;
-  std::cout << material << ", " << what << ": mean Delta E " << d.mean << ", max " << d.max << " over " << d.pixels << " pixels; Cycles "
-            << cyc_s << " s, reference " << ref_s << " s (" << reference_spp << " spp)\n";
-  OslSphere::record("| " + material + " | " + what + " | " + std::to_string(d.mean) + " | " + std::to_string(d.max) + " | " +
-                    std::to_string(cyc_s) + " |");
+// One comparison: `material` rendered by the reference renderer (`reference`, a scene-format material, at
+// `reference_spp`) and by Cycles through `shader` (`cycles_spp` samples per pixel, shader parameters
+// `params` as NAME=VALUE words); `what` names it in the log and in docs/osl.md's figures.
+struct SphereCase {
+  std::string material, what;
+  nlohmann::json reference;
+  int reference_spp;
+  std::string shader;
+  int cycles_spp;
+  std::string params;
+};
+
+// Every case's Cycles render in one Blender process, then each reference render; the mean Delta E 2000 of
+// each must stay below the 1.0.
+void check_spheres(const std::vector<SphereCase>& cases, const std::string& suite) {
+  nlohmann::json jobs = nlohmann::json::array();
+  for (std::size_t k = 0; k < cases.size(); ++k)
+    jobs.push_back(OslSphere::cycles_job("sphere", cases[k].shader, OslSphere::work_->file(suite + "-cycles-" + std::to_string(k) + ".exr"),
+                                         cases[k].cycles_spp, cases[k].params));
+  const double cycles_seconds = OslSphere::cycles_batch(jobs, suite);
+  for (std::size_t k = 0; k < cases.size(); ++k) {
+    const SphereCase& c = cases[k];
+    double ref_s = 0.0;
+    const std::string name = c.shader + "-" + c.material;
+    const std::string ref = OslSphere::reference("reference-" + name, c.reference, c.reference_spp, &ref_s);
+    const ImageDiff d = OslSphere::compare(ref, jobs[k]["out"].get<std::string>(), c.shader.substr(c.shader.find('_') + 1) + "-" + c.material);
+    EXPECT_LT(d.mean, 1.0) << c.material << ": max " << d.max;
+    std::cout << c.material << ", " << c.what << ": mean Delta E " << d.mean << ", max " << d.max << " over " << d.pixels
+              << " pixels; reference " << ref_s << " s (" << c.reference_spp << " spp)\n";
+    OslSphere::record("| " + c.material + " | " + c.what + " | " + std::to_string(d.mean) + " | " + std::to_string(d.max) + " | " +
+                      std::to_string(cycles_seconds) + " |");
+  }
 }
 
 // The preview shader integrates the environment against the tabulated model with facetfit.h's sampling;
@@ -662,12 +705,14 @@ void check_sphere(const std::string& material, const std::string& what, const nl
 TEST_F(OslSphere, PreviewShaderMatchesReferenceTabulated) {
   constexpr int kPasses = 8, kSamples = 64;  // Cycles samples per pixel x the shader's own samples
   // red-plastic and blue-clearcoat-paint: a body and a coat, sampled by the mixture.
+  std::vector<SphereCase> cases;
   for (const std::string material : {"gold-ggx-0.15", "silver-ggx-0.60", "copper-beckmann-0.30", "red-plastic", "blue-clearcoat-paint"}) {
     const std::string lut = bake(material);
-    check_sphere(material, "preview (tabulated, " + std::to_string(kPasses) + " x " + std::to_string(kSamples) + " samples)",
-                 {{"type", "lut"}, {"file", lut}}, 4096, "facetfit_preview", kPasses,
-                 "lut=" + lut + " environment_map=" + work_->file("sky.exr") + " samples=" + std::to_string(kSamples));
+    cases.push_back({material, "preview (tabulated, " + std::to_string(kPasses) + " x " + std::to_string(kSamples) + " samples)",
+                     {{"type", "lut"}, {"file", lut}}, 4096, "facetfit_preview", kPasses,
+                     "lut=" + lut + " environment_map=" + work_->file("sky.exr") + " samples=" + std::to_string(kSamples)});
   }
+  check_spheres(cases, "preview");
 }
 
 // The artist's stretch (model/stretch.h) through the preview shader's parameters, along a tangent that
@@ -677,16 +722,16 @@ TEST_F(OslSphere, StretchedPreviewMatchesReference) {
   const std::string lut = bake("gold-ggx-0.15");
   // facetfit's world up (0, 1, 0) is Blender's (0, 0, 1).
   // Named apart from the unstretched spheres: make osl-docs keeps both pictures.
-  check_sphere("gold-ggx-0.15-stretched", "preview stretched (3, 0.5) at 30 degrees",
-               {{"type", "lut"}, {"file", lut}, {"stretch", {3.0, 0.5}}, {"rotation", 30.0}, {"tangent", {0.0, 1.0, 0.0}}}, 4096,
-               "facetfit_preview", kPasses,
-               "lut=" + lut + " environment_map=" + work_->file("sky.exr") + " samples=" + std::to_string(kSamples) +
-                   " roughness_scale_x=3.0 roughness_scale_y=0.5 rotation=30.0 tangent=0,0,1");
+  const nlohmann::json reference = {{"type", "lut"}, {"file", lut}, {"stretch", {3.0, 0.5}}, {"rotation", 30.0}, {"tangent", {0.0, 1.0, 0.0}}};
+  std::vector<SphereCase> cases;
+  cases.push_back({"gold-ggx-0.15-stretched", "preview stretched (3, 0.5) at 30 degrees", reference, 4096, "facetfit_preview", kPasses,
+                   "lut=" + lut + " environment_map=" + work_->file("sky.exr") + " samples=" + std::to_string(kSamples) +
+                       " roughness_scale_x=3.0 roughness_scale_y=0.5 rotation=30.0 tangent=0,0,1"});
   // The material shader's closure with its alphas scaled: for a GGX material the stretched tabulated lobe
   // is the anisotropic GGX (tests/test_stretch.cpp), so the same reference holds, F82-tint against the curve.
-  check_sphere("gold-ggx-0.15-stretched", "material stretched (3, 0.5) at 30 degrees",
-               {{"type", "lut"}, {"file", lut}, {"stretch", {3.0, 0.5}}, {"rotation", 30.0}, {"tangent", {0.0, 1.0, 0.0}}}, 4096,
-               "facetfit_material", 512, "lut=" + lut + " roughness_scale_x=3.0 roughness_scale_y=0.5 rotation=30.0 tangent=0,0,1");
+  cases.push_back({"gold-ggx-0.15-stretched", "material stretched (3, 0.5) at 30 degrees", reference, 4096, "facetfit_material", 512,
+                   "lut=" + lut + " roughness_scale_x=3.0 roughness_scale_y=0.5 rotation=30.0 tangent=0,0,1"});
+  check_spheres(cases, "stretched");
 }
 
 // A roughness texture for the spheres: from sharper to much rougher around the sphere and between the
@@ -718,10 +763,11 @@ TEST_F(OslSphere, TextureDrivenStretchMatchesReference) {
   const nlohmann::json reference = {{"type", "lut"},     {"file", lut},         {"stretch", {2.0, 1.0}},
                                     {"rotation", 30.0},  {"tangent", {0, 1, 0}}, {"stretch_texture", texture}};
   const std::string stretch = " roughness_scale_x=2.0 roughness_scale_y=1.0 rotation=30.0 tangent=0,0,1 stretch_texture=" + texture;
-  check_sphere("gold-ggx-0.15-textured", "preview, stretch (2, 1) times a texture, at 30 degrees", reference, 4096, "facetfit_preview",
-               kPasses, "lut=" + lut + " environment_map=" + work_->file("sky.exr") + " samples=" + std::to_string(kSamples) + stretch);
-  check_sphere("gold-ggx-0.15-textured", "material, stretch (2, 1) times a texture, at 30 degrees", reference, 4096, "facetfit_material",
-               512, "lut=" + lut + stretch);
+  check_spheres({{"gold-ggx-0.15-textured", "preview, stretch (2, 1) times a texture, at 30 degrees", reference, 4096, "facetfit_preview",
+                  kPasses, "lut=" + lut + " environment_map=" + work_->file("sky.exr") + " samples=" + std::to_string(kSamples) + stretch},
+                 {"gold-ggx-0.15-textured", "material, stretch (2, 1) times a texture, at 30 degrees", reference, 4096, "facetfit_material",
+                  512, "lut=" + lut + stretch}},
+                "textured");
 }
 
 // The artist's control on a real measurement (the paper's figure of an edited measured material): one
@@ -740,6 +786,7 @@ TEST_F(OslSphere, StretchSeriesOfAMeasuredMaterialMatchesReference) {
     double x, y, degrees;
     bool textured;
   };
+  std::vector<SphereCase> cases;
   for (const Case& c : {Case{"sharper", 0.5, 0.5, 0.0, false}, Case{"rougher", 2.0, 2.0, 0.0, false},
                         Case{"anisotropic", 4.0, 0.5, 45.0, false}, Case{"textured", 1.0, 1.0, 0.0, true}}) {
     nlohmann::json reference = {{"type", "lut"}, {"file", lut}, {"stretch", {c.x, c.y}}, {"rotation", c.degrees}, {"tangent", {0, 1, 0}}};
@@ -751,8 +798,9 @@ TEST_F(OslSphere, StretchSeriesOfAMeasuredMaterialMatchesReference) {
     what << "preview, " << (c.textured ? "the roughness texture" : "stretch (" + std::to_string(c.x).substr(0, 3) + ", " +
                                                                      std::to_string(c.y).substr(0, 3) + ")")
          << (c.degrees != 0.0 ? " at " + std::to_string(int(c.degrees)) + " degrees" : "");
-    check_sphere("ilm_l3_37_metallic-" + c.name, what.str(), reference, 4096, "facetfit_preview", kPasses, params);
+    cases.push_back({"ilm_l3_37_metallic-" + c.name, what.str(), reference, 4096, "facetfit_preview", kPasses, params});
   }
+  check_spheres(cases, "series");
 }
 
 // The material shader emits a format 5 LUT's closures (lib/model/closures.h) as Cycles' own: diffuse,
@@ -802,18 +850,9 @@ TEST_F(OslSphere, MaterialShaderEmitsTheClosures) {
   cases.push_back({"aniso-ggx-turned", aniso, artist + "110", turned});  // the control: a quarter more
 
   nlohmann::json jobs = nlohmann::json::array();
-  for (const Case& c : cases) {
-    nlohmann::json params = {{"lut", c.lut}};
-    std::istringstream extra(c.params);
-    for (std::string item; extra >> item;) params[item.substr(0, item.find('='))] = item.substr(item.find('=') + 1);
-    jobs.push_back({{"command", "sun"}, {"shader", shaders_->file("facetfit_material.oso")}, {"out", work_->file("cycles-closures-" + c.name + ".exr")},
-                    {"size", sphere_size()}, {"spp", kCyclesSpp}, {"params", params}});
-  }
-  std::ofstream(work_->file("closure-jobs.json")) << jobs.dump(1);
-  const auto start = std::chrono::steady_clock::now();
-  cycles("batch " + work_->file("closure-jobs.json"));
-  const double cycles_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  std::cout << cases.size() << " Cycles renders in one process: " << cycles_seconds << " s\n";
+  for (const Case& c : cases)
+    jobs.push_back(cycles_job("sun", "facetfit_material", work_->file("cycles-closures-" + c.name + ".exr"), kCyclesSpp, "lut=" + c.lut + c.params));
+  const double cycles_seconds = cycles_batch(jobs, "closures");
   for (const Case& c : cases) {
     double ref_s = 0.0;
     const std::string ref = reference_sun("reference-closures-" + c.name, c.reference, kReferenceSpp, &ref_s);
@@ -827,7 +866,7 @@ TEST_F(OslSphere, MaterialShaderEmitsTheClosures) {
     const std::size_t lobes = read_lut(c.lut).closures().lobes.size();
     record("| " + c.name + " | material (closures: " + std::to_string(lobes) + (lobes > 1 ? " lobes" : " lobe") + ", " +
            std::to_string(kCyclesSpp) + " spp, sun) | " + std::to_string(d.mean) + " | " + std::to_string(d.max) + " | " +
-           std::to_string(cycles_seconds / double(cases.size())) + " |");
+           std::to_string(cycles_seconds) + " |");
   }
 }
 
