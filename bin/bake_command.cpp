@@ -35,6 +35,7 @@ struct BakeArgs {
   double tolerance = kDefaultTolerance;
   bool eval_only = false;
   FitSettings settings;
+  ColorSettings color;
 };
 
 void report_outcome(Progress& progress, const BakeOutcome& o) {
@@ -185,9 +186,11 @@ void run_bake(const BakeArgs& args, Context& ctx) {
     status = 2;
     return;
   }
+  BakeOptions options;
+  options.colorspace = args.color.working_space;
+  if (!run_step(status, [&] { options.from_rec709 = args.color.from_rec709(); })) return;
   if (!run_step(status, [&] { prepare_output_folder(args.out_dir); })) return;
 
-  BakeOptions options;
   options.fit = *fit;
   options.tolerance = args.tolerance;
   options.with_sampling = !args.eval_only;
@@ -226,6 +229,7 @@ void add_bake_command(CLI::App& app, Context& ctx) {
   cmd->add_option("--scene", args->scene, "Bake only the materials this scene references");
   add_tolerance_option(cmd, args->tolerance);
   cmd->add_flag("--eval-only", args->eval_only, "Leave out the sampling tables");
+  add_working_space_options(cmd, args->color);
   add_fit_settings(cmd, args->settings);
   cmd->callback([args, &ctx] { run_bake(*args, ctx); });
 }

@@ -1,5 +1,6 @@
 // facetfit deltae : CIEDE2000 of Lab pairs read on stdin.
 // facetfit diff A.exr B.exr : mean and max ΔE00 between two renders through the display chain, and a heatmap.
+// The colour options of bake, render and report: --working-space, --display, --view, --ocio-config.
 
 #include <array>
 #include <charconv>
@@ -13,6 +14,7 @@
 #include <vector>
 
 #include "color/ciede2000.h"
+#include "color/colorspace.h"
 #include "color/display.h"
 #include "color/image_diff.h"
 #include "commands.h"
@@ -21,6 +23,41 @@
 #include "io/image_file.h"
 
 namespace facetfit::cli {
+
+namespace {
+
+void add_ocio_config_option(CLI::App* cmd, ColorSettings& s) {
+  if (!cmd->get_option_no_throw("--ocio-config"))
+    cmd->add_option("--ocio-config", s.ocio_config, "OpenColorIO config of the working space and the views (default: $OCIO)");
+}
+
+}  // namespace
+
+void add_working_space_options(CLI::App* cmd, ColorSettings& s) {
+  cmd->add_option("--working-space", s.working_space,
+                  "Linear colour space of the LUT's colours or the render (a name of the OpenColorIO config, e.g. ACEScg)")
+      ->capture_default_str();
+  add_ocio_config_option(cmd, s);
+}
+
+void add_view_options(CLI::App* cmd, ColorSettings& s) {
+  cmd->add_option("--display", s.display, "Pictures through this display of the OpenColorIO config (default: sRGB of Rec.709)");
+  cmd->add_option("--view", s.view, "With --display: its view (default: the display's default view)");
+  add_ocio_config_option(cmd, s);
+}
+
+ColorMatrix ColorSettings::from_rec709() const {
+  const ColorConfig config(ocio_config);  // a config named by $OCIO is read, and refused when broken, even if unused
+  return config.from_rec709(working_space);
+}
+
+DisplayTransform ColorSettings::pictures(const std::string& space, const ColorMatrix& space_from_rec709) const {
+  if (display.empty()) {
+    if (!view.empty()) fail("--view " + view, "needs --display");
+    return DisplayTransform(glm::inverse(space_from_rec709));
+  }
+  return DisplayTransform(ColorConfig(ocio_config), space, display, view);
+}
 
 namespace {
 
@@ -85,6 +122,13 @@ Image read_image(const std::string& path, std::uint64_t& left) {
   image.display_referred = spec.display_referred;
   // A NaN or infinite pixel has no colour difference: refused, not averaged into a score.
   image.rgb = rgb_of(all, spec, path, OneChannel::refused);
+  // A render in another working space (facetfit render --working-space) goes back to lin_rec709 by the
+  // inverse of the matrix it records: Delta E is measured on the sRGB display of Rec.709 colour.
+  if (const std::string m = spec.get_string("facetfit:colorspace_matrix"); !m.empty()) {
+    const std::optional<ColorMatrix> from_rec709 = parse_matrix(m);
+    if (!from_rec709) fail(path, "facetfit:colorspace_matrix is not nine numbers of an invertible matrix");
+    convert_pixels(image.rgb.data(), image.pixels(), 3, glm::inverse(*from_rec709));
+  }
   if (a >= 0) {
     const std::size_t n = image.pixels(), nch = spec.channels.size();
     image.alpha.resize(n);

@@ -8,6 +8,8 @@
 #include <optional>
 #include <string>
 
+#include "color/display.h"
+#include "core/color_space.h"
 #include "fit/fit.h"
 
 namespace facetfit::cli {
@@ -40,6 +42,22 @@ void add_fit_settings(CLI::App* cmd, FitSettings& settings);
 void add_tolerance_option(CLI::App* cmd, double& tolerance);
 // The FitOptions they name, or nullopt after reporting a usage error (status 2).
 std::optional<FitOptions> fit_options(const FitSettings& settings, int& status);
+
+// The working colour space of a bake or a render (core/color_space.h): --working-space, from the config of
+// --ocio-config or $OCIO. In the command module (bin/color_commands.cpp): it reads OpenColorIO.
+// And the pictures' display and view (--display, --view: render --png, the report's pictures).
+struct ColorSettings {
+  std::string working_space = kRec709Space;
+  std::string ocio_config;
+  std::string display, view;
+  // The space's matrix from lin_rec709; throws Error (one line) for a bad config or an unknown space.
+  ColorMatrix from_rec709() const;
+  // The pictures of pixels in `space` (matrix `from_rec709`): the config's display and view, or without
+  // --display the sRGB display of their Rec.709 colour. Throws Error (one line).
+  DisplayTransform pictures(const std::string& space, const ColorMatrix& from_rec709) const;
+};
+void add_working_space_options(CLI::App* cmd, ColorSettings& settings);
+void add_view_options(CLI::App* cmd, ColorSettings& settings);
 
 // A check for a real-valued option: a finite number in [lo, hi] (CLI::Range lets NaN through: every
 // comparison with it is false).

@@ -24,7 +24,7 @@ nlohmann::json info_json(const Lut& lut) {
                    {"representation", to_string(m.representation)}, {"tolerance", m.tolerance}, {"sampling", m.sampling},
                    {"body", rgb(m.body)}, {"body_exponent", m.body_exponent}, {"coat", coat_json(m.coat)}, {"error", m.error},
                    {"error_extraction", m.error_extraction}, {"warnings", m.warnings},
-                   {"recommended", recommended_json(recommended_parameters(m), m.tolerance)}};
+                   {"recommended", recommended_json(recommended_parameters(m), m.tolerance)}, {"colorspace", m.colorspace}};
   const auto parametric = [](const LutMetadata::Parametric& p, double error) {
     return parametric_json(p.alpha, p.body, p.f0, p.f82, p.coat, error);
   };
@@ -107,6 +107,7 @@ void print_info(const Lut& lut) {
   parametric("lsq", m.lsq);
   print_closures(lut.closures(), m.error_closures, m.format_version >= kLutClosuresVersion);
   std::printf("sampling tables %s\n", m.sampling ? "yes" : "no (--eval-only)");
+  std::printf("colour space    %s (of every colour above)\n", m.colorspace.c_str());
   for (const std::string& w : m.warnings) std::printf("warning         %s\n", w.c_str());
   std::printf("\n");
   std::printf("%4s %8s %10s %14s %14s %10s\n", "node", "u", "theta_deg", "ndf", "slope_pdf", "sigma");

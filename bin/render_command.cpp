@@ -33,6 +33,7 @@ struct RenderArgs {
   std::string material_type = "measured";
   int width = 0, height = 0;
   std::uint64_t max_memory = 0;
+  ColorSettings color;
 };
 
 // The file a path names, for comparing two paths: a link and its target, "a/../b" and "b" are one file.
@@ -84,6 +85,9 @@ void run_render(const RenderArgs& args, Context& ctx) {
     const std::vector<std::pair<std::string, std::string>> outputs = {
         {"-o", args.output}, {"--png", args.png}, {"--save-sky", args.save_sky}};
     check_outputs(outputs);
+    const ColorMatrix from_rec709 = args.color.from_rec709();
+    // Before the render, which can take minutes: the --png's display and view must exist.
+    const DisplayTransform pictures = args.color.pictures(args.color.working_space, from_rec709);
     SceneDesc scene;
     // A measurement rendered as one of the LUT's representations is baked first, into a temporary folder.
     std::unique_ptr<fs::path, void (*)(fs::path*)> baked_dir(nullptr, [](fs::path* p) {
@@ -117,6 +121,8 @@ void run_render(const RenderArgs& args, Context& ctx) {
         img.rgba.insert(img.rgba.end(), {sky.pixels()[3 * p], sky.pixels()[3 * p + 1], sky.pixels()[3 * p + 2], 1.0f});
       write_exr(args.save_sky, img, {{"environment", "builtin sky"}});
     }
+    scene.working_space = args.color.working_space;
+    scene.from_rec709 = from_rec709;
     if (args.width > 0) scene.camera.width = args.width;
     if (args.height > 0) scene.camera.height = args.height;
     RenderSettings settings;
@@ -140,7 +146,7 @@ void run_render(const RenderArgs& args, Context& ctx) {
     write_exr(args.output, image,
               {{"scene", args.scene.empty() ? "default" : args.scene}, {"spp", std::to_string(image.spp)},
                {"seconds", std::to_string(image.seconds)}});
-    if (!args.png.empty()) write_display_png(args.png, image.rgba.data(), image.width, image.height, 4, DisplayTransform());
+    if (!args.png.empty()) write_display_png(args.png, image.rgba.data(), image.width, image.height, 4, pictures);
     if (!ctx.quiet()) std::printf("%s (%dx%d, %d spp, %.3f s)\n", args.output.c_str(), image.width, image.height, image.spp, image.seconds);
   } catch (const Error& e) {
     report_error(e.what());
@@ -155,13 +161,15 @@ void add_render_command(CLI::App& app, Context& ctx) {
   CLI::App* cmd = app.add_subcommand("render", "Render a scene (or the embedded default) with the reference renderer");
   cmd->add_option("scene", args->scene, "Scene JSON (docs/scene-format.md); omitted: a sphere under the built-in sky");
   cmd->add_option("-o,--output", args->output, "Linear EXR to write")->required();
-  cmd->add_option("--png", args->png, "Also write a display-referred sRGB PNG (OpenColorIO display transform)");
+  cmd->add_option("--png", args->png, "Also write a display-referred PNG (sRGB, or --display and --view)");
   cmd->add_option("--save-sky", args->save_sky, "Also write the built-in sky as a lat-long EXR (for other renderers)");
   cmd->add_option("--spp", args->spp, "Samples per pixel (default: the scene's)")->check(CLI::Range(1, 1 << 20));
   cmd->add_option("--seed", args->seed, "Random seed (default: the scene's)")->check(uint64_text());
   cmd->add_option("--width", args->width, "Image width (default: the scene's)")->check(CLI::Range(1, 16384));
   cmd->add_option("--height", args->height, "Image height (default: the scene's)")->check(CLI::Range(1, 16384));
   add_max_memory_option(cmd, args->max_memory);
+  add_working_space_options(cmd, args->color);
+  add_view_options(cmd, args->color);
   cmd->add_option("--material", args->material, "Default scene only: the sphere's material file (a LUT .exr renders as lut "
                   "unless --material-type says otherwise)")->capture_default_str();
   std::vector<std::string> types;

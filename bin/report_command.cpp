@@ -29,6 +29,7 @@ struct ReportArgs {
   double tolerance = kDefaultTolerance;
   std::uint64_t max_memory = 0;
   FitSettings settings;
+  ColorSettings color;  // the pictures' --display and --view
   // --farm local|slurm: the report as a plan of shards (report/farm.h) run by an adapter (bin/farm.h).
   std::string farm;
   int shards = 4;
@@ -53,6 +54,8 @@ std::vector<std::string> shard_settings(const ReportArgs& a) {
                                 "--iteration-tolerance", exact(a.settings.iteration_tolerance)};
   if (a.max_memory > 0) s.insert(s.end(), {"--max-memory", std::to_string(a.max_memory)});
   if (a.force) s.push_back("--force");
+  for (const auto& [flag, value] : {std::pair{"--display", &a.color.display}, {"--view", &a.color.view}, {"--ocio-config", &a.color.ocio_config}})
+    if (!value->empty()) s.insert(s.end(), {flag, *value});
   return s;
 }
 
@@ -129,6 +132,16 @@ void run_report_command(const ReportArgs& args, Context& ctx) {
   o.force = args.force;
   o.bake.fit = *fit;
   o.bake.tolerance = args.tolerance;
+  if (!args.color.display.empty() || !args.color.view.empty()) {
+    try {
+      o.pictures = std::make_shared<const DisplayTransform>(args.color.pictures(kRec709Space, ColorMatrix(1.0)));
+    } catch (const Error& e) {
+      report_error(e.what());
+      status = 1;
+      return;
+    }
+    o.pictures_name = "display " + args.color.display + ", view " + (args.color.view.empty() ? "(its default)" : args.color.view);
+  }
   int used = 0;  // the whole text is K/N: "1/2/3" is not 1/2
   if (std::sscanf(args.shard.c_str(), "%d/%d%n", &o.shard, &o.shards, &used) != 2 || used != int(args.shard.size()) || o.shards < 1 ||
       o.shard < 1 || o.shard > o.shards) {
@@ -165,6 +178,7 @@ void add_report_command(CLI::App& app, Context& ctx) {
   cmd->add_option("--luts", args->luts_dir, "Bake cache folder (default REPORT/luts; the shards of a farm share one)");
   cmd->add_option("--size", args->size, "Image side in pixels")->capture_default_str();
   cmd->add_option("--spp", args->spp, "Samples per pixel")->capture_default_str();
+  add_view_options(cmd, args->color);
   add_max_memory_option(cmd, args->max_memory);
   cmd->add_option("--shard", args->shard, "K/N: render the K-th of N deterministic subsets (merge them with report merge)")
       ->capture_default_str();

@@ -5,6 +5,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <regex>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <vector>
@@ -326,6 +331,154 @@ TEST(DiffCli, Heatmap) {
   int files = 0;
   for (const auto& entry : std::filesystem::directory_iterator(dir.path())) files += entry.is_regular_file();
   EXPECT_EQ(files, 3);
+}
+
+}  // namespace
+}  // namespace facetfit
+
+// ---- working colour spaces (bake and render --working-space, through a studio's OCIO config) -------------
+
+namespace facetfit {
+namespace {
+
+using test::run_command;
+
+// The ACES studio config (cg-config-v1.0.0_aces-v1.3_ocio-v2.1, OCIO profile 2.1) as PyPI's OpenColorIO
+// writes its built-in one: the config a studio runs, readable by Debian's OpenColorIO 2.1. Empty when the
+// venv of the Python tests has no PyOpenColorIO.
+std::string aces_config(const TempDir& dir) {
+  const std::string path = dir.file("aces-cg.ocio");
+  const std::string script = "import PyOpenColorIO as o, sys; open(sys.argv[1], 'w').write("
+                             "o.Config.CreateFromBuiltinConfig('cg-config-v1.0.0_aces-v1.3_ocio-v2.1').serialize())";
+  const RunResult r = test::run_command("'" + std::string(FACETFIT_PY_PYTHON) + "' -c \"" + script + "\" " + path + " 2>&1");
+  return r.status == 0 ? path : "";
+}
+
+// The bar: a LUT baked in ACEScg through the ACES config, rendered in ACEScg and taken back to
+// Rec.709 (diff reads the render's matrix), within a mean Delta E of 0.2 of the Rec.709 bake's render, in
+// the scene of ../shared/data/realref (a grey world and a white sun). With white light a render is linear
+// in the material's colours, so the two agree but for noise: the proposal weighs a body against a lobe
+// by their colours, and different weights draw different directions (a lobe alone: 2e-6). Under coloured
+// lights they differ for good: a product of two colours is not the same in two sets of primaries
+// (docs/colour.md).
+TEST(WorkingSpace, AnAcesCgBakeRendersAsTheRec709Bake) {
+  TempDir dir;
+  const std::string config = aces_config(dir);
+  if (config.empty()) GTEST_SKIP() << "no PyOpenColorIO in " << FACETFIT_PY_PYTHON << " (make python installs it): no ACES config";
+  const std::string aces = " --working-space ACEScg --ocio-config " + config;
+  const std::string materials = " builtin:gold-ggx-0.15 builtin:red-plastic builtin:blue-clearcoat-paint";
+  ASSERT_EQ(facetfit("bake" + materials + " -o " + dir.file("rec709")).status, 0);
+  const RunResult baked = facetfit("bake" + materials + " -o " + dir.file("acescg") + aces);
+  ASSERT_EQ(baked.status, 0) << baked.err;
+  const auto render = [&](const std::string& lut, const std::string& out, const std::string& options) {
+    const nlohmann::json scene = {
+        {"camera", {{"position", {0, 0.6, 4}}, {"look_at", {0, 0, 0}}, {"up", {0, 1, 0}}, {"fov", 30}, {"width", 64}, {"height", 64}}},
+        {"render", {{"spp", 256}, {"seed", 1}}},
+        {"environment", {{"constant", {0.3, 0.3, 0.3}}}},
+        {"lights", {{{"type", "directional"}, {"direction", {0.3, 1, 0.5}}, {"irradiance", {3, 3, 3}}}}},
+        {"materials", {{"m", {{"type", "lut"}, {"file", lut}}}}},
+        {"objects", {{{"type", "sphere"}, {"center", {0, 0, 0}}, {"radius", 1}, {"material", "m"}}}}};
+    std::ofstream(out + ".json") << scene.dump();
+    const RunResult r = facetfit("render " + out + ".json -o " + out + options);
+    EXPECT_EQ(r.status, 0) << r.err;
+  };
+  const auto mean_delta_e = [](const std::string& a, const std::string& b) {
+    const RunResult d = facetfit("diff --json " + a + " " + b);
+    EXPECT_EQ(d.status, 0) << d.err;
+    return d.status == 0 ? nlohmann::json::parse(d.out)["mean"].get<double>() : 1e9;
+  };
+  for (const std::string m : {"gold-ggx-0.15", "red-plastic", "blue-clearcoat-paint"}) {
+    const std::string rec709 = dir.file(m + "-rec709.exr"), acescg = dir.file(m + "-acescg.exr");
+    render(dir.file("rec709/" + m + ".exr"), rec709, "");
+    render(dir.file("acescg/" + m + ".exr"), acescg, aces);
+    const double mean = mean_delta_e(rec709, acescg);
+    std::cout << m << ": ACEScg bake and render against Rec.709, mean Delta E " << mean << "\n";
+    EXPECT_LE(mean, 0.2) << m;
+    // The control: the ACEScg render read as if it were Rec.709 is far off.
+    const std::string raw = dir.file(m + "-acescg-raw.exr");
+    ASSERT_EQ(run_command("oiiotool " + acescg + " --eraseattrib facetfit:colorspace_matrix -o " + raw).status, 0);
+    EXPECT_GT(mean_delta_e(rec709, raw), 1.0) << m << ": the conversion back is not what closes the gap";
+  }
+  // The LUT says its space; the render's EXR names it and carries its chromaticities as the config's
+  // conversion places them: AP1's primaries adapted to the D65 white (core/color_space.h).
+  EXPECT_NE(facetfit("info " + dir.file("acescg/red-plastic.exr")).out.find("colour space    ACEScg"), std::string::npos);
+  std::unique_ptr<OIIO::ImageInput> in = OIIO::ImageInput::open(dir.file("red-plastic-acescg.exr"));
+  ASSERT_TRUE(in);
+  EXPECT_EQ(in->spec().get_string_attribute("oiio:ColorSpace"), "ACEScg");
+  const OIIO::ParamValue* c = in->spec().find_attribute("chromaticities");
+  ASSERT_TRUE(c);
+  const float* xy = static_cast<const float*>(c->data());
+  const float ap1[6] = {0.713f, 0.293f, 0.165f, 0.830f, 0.128f, 0.044f};
+  for (int k = 0; k < 6; ++k) EXPECT_NEAR(xy[k], ap1[k], 0.012) << k;
+  EXPECT_NEAR(xy[6], 0.3127, 1e-4);
+  EXPECT_NEAR(xy[7], 0.3290, 1e-4);
+}
+
+// Pictures through a studio's view: the ACES config's un-tone-mapped sRGB view is our sRGB display (a
+// render in ACEScg included, the view taking it from its own space), to the code value; its default view
+// (the ACES tone map) is not. The report's pictures go through the view too, and it says which.
+TEST(WorkingSpace, PicturesThroughTheConfigsDisplayAndView) {
+  TempDir dir;
+  const std::string config = aces_config(dir);
+  if (config.empty()) GTEST_SKIP() << "no PyOpenColorIO in " << FACETFIT_PY_PYTHON << " (make python installs it): no ACES config";
+  // Gold under a white sun: no sampling, so a render in ACEScg is the Rec.709 one to rounding.
+  const nlohmann::json scene = {
+      {"camera", {{"position", {0, 0.6, 4}}, {"look_at", {0, 0, 0}}, {"up", {0, 1, 0}}, {"fov", 30}, {"width", 48}, {"height", 48}}},
+      {"render", {{"spp", 4}, {"seed", 1}}},
+      {"lights", {{{"type", "directional"}, {"direction", {0.3, 1, 0.5}}, {"irradiance", {3, 3, 3}}}}},
+      {"materials", {{"m", {{"type", "measured"}, {"file", "builtin:gold-ggx-0.15"}}}}},
+      {"objects", {{{"type", "sphere"}, {"center", {0, 0, 0}}, {"radius", 1}, {"material", "m"}}}}};
+  std::ofstream(dir.file("sun.json")) << scene.dump();
+  const std::string view = " --ocio-config " + config + " --display 'sRGB - Display'";
+  const auto render = [&](const std::string& name, const std::string& options) {
+    const RunResult r = facetfit("render " + dir.file("sun.json") + " -o " + dir.file(name + ".exr") + " --png " + dir.file(name + ".png") + options);
+    EXPECT_EQ(r.status, 0) << r.err;
+    return dir.file(name + ".png");
+  };
+  const std::string srgb = render("srgb", "");
+  const std::string untonemapped = render("untonemapped", view + " --view Un-tone-mapped");
+  const std::string acescg = render("acescg", view + " --view Un-tone-mapped --working-space ACEScg");
+  const std::string aces = render("aces", view);
+  const auto max_difference = [](const std::string& a, const std::string& b) {
+    const RunResult d = run_command("oiiotool " + a + " " + b + " --diff 2>&1");
+    std::smatch m;
+    return std::regex_search(d.out, m, std::regex("Max error\\s*=\\s*([0-9.e+-]+)")) ? std::stod(m[1]) * 255.0 : 0.0;
+  };
+  EXPECT_LE(max_difference(srgb, untonemapped), 1.0);
+  EXPECT_LE(max_difference(srgb, acescg), 1.0);
+  EXPECT_GT(max_difference(srgb, aces), 10.0);
+  const RunResult report = facetfit("report builtin:gold-ggx-0.15 --size 16 --spp 2 -o " + dir.file("report") + " --ocio-config " +
+                                    config + " --display 'sRGB - Display'");
+  ASSERT_EQ(report.status, 0) << report.err;
+  std::ifstream html(dir.file("report/index.html"));
+  const std::string text((std::istreambuf_iterator<char>(html)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("Pictures: display sRGB - Display, view (its default)"), std::string::npos);
+}
+
+// Every way a working space can be wrong is one line naming what is wrong, and nothing is written.
+TEST(WorkingSpace, BadConfigsAndSpacesAreOneLineErrors) {
+  TempDir dir;
+  const std::string config = aces_config(dir);
+  const std::string out = " -o " + dir.file("x.exr") + " --spp 1 --width 8 --height 8";
+  const RunResult env = run_command("OCIO=/nonexistent.ocio " + std::string(FACETFIT_CLI) + " render" + out);
+  EXPECT_EQ(env.status, 1);
+  EXPECT_NE(env.err.find("/nonexistent.ocio: no such OpenColorIO config"), std::string::npos) << env.err;
+  const RunResult none = facetfit("render --working-space ACEScg" + out);
+  EXPECT_EQ(none.status, 1);
+  EXPECT_NE(none.err.find("ACEScg: a colour space other than lin_rec709 needs an OpenColorIO config"), std::string::npos) << none.err;
+  const RunResult bake = facetfit("bake builtin:gold-ggx-0.15 -o " + dir.file("luts") + " --working-space ACEScg");
+  EXPECT_EQ(bake.status, 1);
+  EXPECT_FALSE(std::filesystem::exists(dir.file("luts/gold-ggx-0.15.exr")));
+  if (config.empty()) GTEST_SKIP() << "no PyOpenColorIO in " << FACETFIT_PY_PYTHON << ": the config's own errors are not tried";
+  const RunResult unknown = facetfit("render --working-space Nowhere --ocio-config " + config + out);
+  EXPECT_NE(unknown.err.find("the config has no colour space 'Nowhere'"), std::string::npos) << unknown.err;
+  const RunResult log = facetfit("render --working-space ACEScct --ocio-config " + config + out);
+  EXPECT_NE(log.err.find("'ACEScct' is not linear"), std::string::npos) << log.err;
+  for (const RunResult* r : {&unknown, &log}) {
+    EXPECT_EQ(r->status, 1);
+    EXPECT_EQ(std::count(r->err.begin(), r->err.end(), '\n'), 1) << r->err;
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir.file("x.exr")));
 }
 
 }  // namespace

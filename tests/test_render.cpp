@@ -694,6 +694,42 @@ TEST(Shading, EveryMaterialTypeRunsInTheLanesItDeclares) {
   EXPECT_FALSE(load_material(scene, ggx_of_lut)->f_in_lanes());
 }
 
+// A render in another working space converts every colour a material has: the scene's (lambert, plain
+// GGX), a measurement's and each colour of a LUT (Fresnel curve, body, each fit's f0 and f82, the
+// closures' lobes). With a permutation of the channels for the space, every material type's f must be
+// the Rec.709 f permuted, pair by pair: a colour left out shows as an unpermuted channel. A LUT of a body
+// under a coat, with closures.
+TEST(WorkingSpace, EveryMaterialTypeConvertsEveryColour) {
+  test::TempDir dir;
+  const std::string lut = dir.file("paint.exr");
+  const Fitter fitter{FitOptions{}};
+  write_lut(lut, make_lut(fitter.fit(load_table("builtin:blue-clearcoat-paint")), fitter.quadrature(), "builtin:blue-clearcoat-paint",
+                          "x", 0.02, true));
+  ASSERT_FALSE(read_lut(lut).meta.closures.empty());
+  SceneDesc rec709, permuted;
+  permuted.working_space = "gbr";
+  permuted.from_rec709 = ColorMatrix(Vec3(0, 0, 1), Vec3(1, 0, 0), Vec3(0, 1, 0));  // (r, g, b) -> (g, b, r)
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (const MaterialType& type : kMaterialTypes) {
+    for (const std::string fresnel : {"f82", "curve"}) {
+      MaterialDesc m;
+      m.type = type.name;
+      m.file = type.reads_lut ? lut : type.needs_file ? "builtin:blue-clearcoat-paint" : "";
+      m.f0 = Rgb(0.9, 0.5, 0.2), m.albedo = Rgb(0.7, 0.3, 0.1), m.fresnel = fresnel;
+      const auto a = load_material(rec709, m), b = load_material(permuted, m);
+      for (int k = 0; k < 50; ++k) {
+        const Vec3 o = spherical_direction(1.4 * u(rng), 6.28 * u(rng)), i = spherical_direction(1.4 * u(rng), 6.28 * u(rng));
+        const std::optional<Rgb> fa = a->brdf().eval(o, i), fb = b->brdf().eval(o, i);
+        ASSERT_EQ(fa.has_value(), fb.has_value()) << type.name;
+        if (!fa) continue;
+        const Rgb want = permuted.from_rec709 * *fa;
+        for (int c = 0; c < 3; ++c) ASSERT_NEAR((*fb)[c], want[c], 1e-6 * (1.0 + want[c])) << type.name << " " << fresnel << " channel " << c;
+      }
+    }
+  }
+}
+
 TEST(Shading, GgxInSimdLanesEqualsOnePairAtATime) {
   // Every term the GGX kernels hold (render/ggx_batch.h): the three Smith forms, F82-tint and the Fresnel
   // curve, a body and a coat, from alpha 0.005 to 1.5, over pairs that include grazing and below-horizon

@@ -6,9 +6,8 @@
 #include <cmath>
 #include <string>
 
+#include "color/colorspace_ocio.h"
 #include "core/error.h"
-
-namespace OCIO = OCIO_NAMESPACE;
 
 namespace facetfit {
 
@@ -40,12 +39,6 @@ double srgb_decode(double encoded) {
   return encoded >= kEncodedBreak ? std::pow((encoded + kOffset) / (1 + kOffset), kGamma) : encoded / kSlope;
 }
 
-Vec3 rec709_to_xyz(const Rgb& c) {
-  const auto& m = kRec709ToXyz;
-  return {m[0][0] * c.r + m[0][1] * c.g + m[0][2] * c.b, m[1][0] * c.r + m[1][1] * c.g + m[1][2] * c.b,
-          m[2][0] * c.r + m[2][1] * c.g + m[2][2] * c.b};
-}
-
 Lab xyz_to_lab(const Vec3& xyz) {
   const double fx = lab_f(xyz.x / kD65White[0]), fy = lab_f(xyz.y / kD65White[1]), fz = lab_f(xyz.z / kD65White[2]);
   return {116 * fy - 16, 500 * (fx - fy), 200 * (fy - fz)};
@@ -55,42 +48,87 @@ Lab display_to_lab(const Rgb& s) {
   return xyz_to_lab(rec709_to_xyz(Rgb(srgb_decode(s.r), srgb_decode(s.g), srgb_decode(s.b))));
 }
 
+namespace {
+
+// [0, 1] in every channel.
+OCIO::RangeTransformRcPtr unit_clamp() {
+  auto clamp = OCIO::RangeTransform::Create();
+  clamp->setStyle(OCIO::RANGE_CLAMP);
+  clamp->setMinInValue(0.0);
+  clamp->setMinOutValue(0.0);
+  clamp->setMaxInValue(1.0);
+  clamp->setMaxOutValue(1.0);
+  return clamp;
+}
+
+// Scene-linear Rec.709 to sRGB code values: clamp first (the encoding is monotonic and maps 0 to 0 and 1
+// to 1, so clamping before it is the same as clamping the display values, and it keeps pow() away from
+// negative and huge inputs), then encode.
+OCIO::GroupTransformRcPtr srgb_display(const ColorMatrix& to_rec709) {
+  auto group = OCIO::GroupTransform::Create();
+  if (to_rec709 != ColorMatrix(1.0)) {
+    auto matrix = OCIO::MatrixTransform::Create();
+    double m44[16] = {0.0};
+    for (int row = 0; row < 3; ++row)
+      for (int column = 0; column < 3; ++column) m44[4 * row + column] = to_rec709[column][row];
+    m44[15] = 1.0;
+    matrix->setMatrix(m44);
+    group->appendTransform(matrix);
+  }
+  group->appendTransform(unit_clamp());
+  // OCIO's forward direction decodes (encoded to linear); inverse encodes.
+  auto encode = OCIO::ExponentWithLinearTransform::Create();
+  const double gamma[4] = {kGamma, kGamma, kGamma, 1.0};
+  const double offset[4] = {kOffset, kOffset, kOffset, 0.0};
+  encode->setGamma(gamma);
+  encode->setOffset(offset);
+  encode->setDirection(OCIO::TRANSFORM_DIR_INVERSE);
+  group->appendTransform(encode);
+  return group;
+}
+
+}  // namespace
+
 struct DisplayTransform::Processor {
   OCIO::ConstCPUProcessorRcPtr cpu;
+  // Lossless optimization: the default level (VERY_GOOD) permits fast approximations of pow().
+  Processor(const OCIO::ConstConfigRcPtr& config, const OCIO::ConstTransformRcPtr& transform)
+      : cpu(config->getProcessor(transform)->getOptimizedCPUProcessor(OCIO::BIT_DEPTH_F32, OCIO::BIT_DEPTH_F32,
+                                                                        OCIO::OPTIMIZATION_LOSSLESS)) {}
 };
 
-DisplayTransform::DisplayTransform() {
+DisplayTransform::DisplayTransform() : DisplayTransform(ColorMatrix(1.0)) {}
+
+DisplayTransform::DisplayTransform(const ColorMatrix& to_rec709) {
   try {
-    // Clamp first: the encoding is monotonic and maps 0 to 0 and 1 to 1, so clamping before it is the
-    // same as clamping the display values, and it keeps pow() away from negative and huge inputs.
-    auto clamp = OCIO::RangeTransform::Create();
-    clamp->setStyle(OCIO::RANGE_CLAMP);
-    clamp->setMinInValue(0.0);
-    clamp->setMinOutValue(0.0);
-    clamp->setMaxInValue(1.0);
-    clamp->setMaxOutValue(1.0);
-
-    // OCIO's forward direction decodes (encoded to linear); inverse encodes.
-    auto encode = OCIO::ExponentWithLinearTransform::Create();
-    const double gamma[4] = {kGamma, kGamma, kGamma, 1.0};
-    const double offset[4] = {kOffset, kOffset, kOffset, 0.0};
-    encode->setGamma(gamma);
-    encode->setOffset(offset);
-    encode->setDirection(OCIO::TRANSFORM_DIR_INVERSE);
-
-    auto group = OCIO::GroupTransform::Create();
-    group->appendTransform(clamp);
-    group->appendTransform(encode);
-
     // A raw config: nothing read from $OCIO or disk, so every machine computes the same numbers.
-    const OCIO::ConstConfigRcPtr config = OCIO::Config::CreateRaw();
-    const OCIO::ConstProcessorRcPtr processor = config->getProcessor(group);
-    // Lossless optimization: the default level (VERY_GOOD) permits fast approximations of pow().
-    auto p = std::make_shared<Processor>();
-    p->cpu = processor->getOptimizedCPUProcessor(OCIO::BIT_DEPTH_F32, OCIO::BIT_DEPTH_F32, OCIO::OPTIMIZATION_LOSSLESS);
-    processor_ = std::move(p);
+    processor_ = std::make_shared<Processor>(OCIO::Config::CreateRaw(), srgb_display(to_rec709));
   } catch (const OCIO::Exception& e) {
     fail("OpenColorIO", std::string("cannot build the sRGB display transform: ") + e.what());
+  }
+}
+
+DisplayTransform::DisplayTransform(const ColorConfig& config, const std::string& space, const std::string& display,
+                                   const std::string& view) {
+  if (!config.has_config()) fail("--display " + display, "a display needs an OpenColorIO config (--ocio-config or $OCIO)");
+  const OCIO::ConstConfigRcPtr& c = config.opaque()->config;
+  if (!c->getColorSpace(space.c_str())) fail(config.path(), "the config has no colour space '" + excerpt(space, 80) + "'");
+  const char* chosen = view.empty() ? c->getDefaultView(display.c_str()) : view.c_str();
+  bool known = false;
+  for (int k = 0; k < c->getNumViews(display.c_str()); ++k) known = known || std::string(c->getView(display.c_str(), k)) == chosen;
+  if (!known)
+    fail(config.path(), "the config has no display '" + excerpt(display, 80) + "'" + (view.empty() ? "" : " with a view '" + excerpt(view, 80) + "'"));
+  try {
+    auto picture = OCIO::DisplayViewTransform::Create();
+    picture->setSrc(space.c_str());
+    picture->setDisplay(display.c_str());
+    picture->setView(chosen);
+    auto group = OCIO::GroupTransform::Create();
+    group->appendTransform(picture);
+    group->appendTransform(unit_clamp());  // a view may leave [0, 1] (the ACES views do)
+    processor_ = std::make_shared<Processor>(c, group);
+  } catch (const OCIO::Exception& e) {
+    fail(config.path(), "cannot build the view '" + excerpt(chosen, 80) + "' of display '" + excerpt(display, 80) + "': " + excerpt(e.what(), 200));
   }
 }
 

@@ -9,27 +9,19 @@
 
 #include <cstddef>
 #include <memory>
+#include <string>
 
 #include "color/ciede2000.h"
+#include "core/color_space.h"
 #include "core/vec.h"
 
 namespace facetfit {
-
-// Rec.709 / sRGB primaries and the D65 white (x, y) = (0.3127, 0.3290), to XYZ with Y(white) = 1. Derived
-// exactly from the chromaticities, not the 4-digit table of IEC 61966-2-1, so that the white maps to
-// kD65White to the last digit and lands on L* = 100, a* = b* = 0.
-constexpr double kRec709ToXyz[3][3] = {{0.4123907993, 0.3575843394, 0.1804807884},
-                                       {0.2126390059, 0.7151686788, 0.0721923154},
-                                       {0.0193308187, 0.1191947798, 0.9505321522}};
-// XYZ of the D65 white from its chromaticity: the row sums of kRec709ToXyz.
-constexpr double kD65White[3] = {0.9504559270516717, 1.0, 1.0890577507598784};
 
 // The sRGB encoding as OCIO's ExponentWithLinearTransform computes it (gamma 2.4, offset 0.055, linear
 // segment joined with a continuous slope), and its inverse. Both extend their linear segment below zero.
 double srgb_encode(double linear);
 double srgb_decode(double encoded);
 
-Vec3 rec709_to_xyz(const Rgb& linear);
 Lab xyz_to_lab(const Vec3& xyz);  // relative to kD65White
 
 // Display-referred sRGB code values (0..1) to CIELAB: decode, Rec.709 to XYZ, XYZ to Lab.
@@ -38,11 +30,19 @@ Lab display_to_lab(const Rgb& srgb_display);
 // The OpenColorIO processor from scene-linear Rec.709 to display-referred sRGB, built once. Copies share
 // the processor. Every member is const and safe to call from many threads at once (OCIO's CPU processors
 // are).
+class ColorConfig;
+
 class DisplayTransform {
  public:
   // Builds the processor in code on a raw OCIO config ($OCIO and config files play no part). Throws
   // Error if OpenColorIO refuses it.
   DisplayTransform();
+  // The same display for pixels of another linear space, taken to Rec.709 by `to_rec709` first.
+  explicit DisplayTransform(const ColorMatrix& to_rec709);
+  // A studio's picture instead: `display` and `view` of `config` (an empty view: the display's default)
+  // for pixels in the config's colour space `space`, then clamped to [0, 1]. Throws Error naming what the
+  // config lacks. For pictures only: Delta E is measured through the sRGB display above.
+  DisplayTransform(const ColorConfig& config, const std::string& space, const std::string& display, const std::string& view);
 
   // In place, `pixels` interleaved RGB triples: scene-linear in, display-referred sRGB in [0, 1] out.
   // Each channel is clamped on its own, so an out-of-gamut colour shifts hue as it does on screen.

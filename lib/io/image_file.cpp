@@ -321,9 +321,10 @@ void write_exr_file(const std::string& path, const std::string& target, const Im
     else if (const std::string* t = std::get_if<std::string>(&value)) header.insert(name, Imf::StringAttribute(*t));
     else if (const auto* v = std::get_if<std::array<float, 3>>(&value)) header.insert(name, Imf::V3fAttribute(Imath::V3f((*v)[0], (*v)[1], (*v)[2])));
   }
-  if (spec.linear_rec709) {
-    Imf::addChromaticities(header, Imf::Chromaticities());  // OpenEXR's default: Rec.709 primaries, D65
-    header.insert("oiio:ColorSpace", Imf::StringAttribute("lin_rec709"));
+  if (!spec.linear_space.empty()) {
+    const auto& c = spec.linear_chromaticities;
+    Imf::addChromaticities(header, Imf::Chromaticities({c[0], c[1]}, {c[2], c[3]}, {c[4], c[5]}, {c[6], c[7]}));
+    header.insert("oiio:ColorSpace", Imf::StringAttribute(spec.linear_space));
   }
   Imf::OutputFile out(path.c_str(), header);
   out.setFrameBuffer(exr_frame_buffer(spec, header.dataWindow(), static_cast<const float*>(pixels)));

@@ -30,9 +30,10 @@ struct ImageSpec {
   enum class Format { float32, uint8 } format = Format::float32;
   // Code values of a display (8- and 16-bit PNG, JPEG: what OpenImageIO calls "sRGB"), not scene-linear.
   bool display_referred = false;
-  // Scene-linear Rec.709 colour (a render): an OpenEXR file then carries the standard `chromaticities`
-  // attribute (Rec.709 primaries, D65 white) and the colour space's name, for compositors and image tools.
-  bool linear_rec709 = false;
+  // Scene-linear colour (a render): an OpenEXR file then carries the space's standard `chromaticities`
+  // attribute and its name (oiio:ColorSpace), for compositors and image tools. Empty name: neither.
+  std::string linear_space;
+  std::array<float, 8> linear_chromaticities{};  // red, green, blue, white (x, y): core/color_space.h
   std::map<std::string, ImageAttribute> attributes;
 
   ImageSpec() = default;

@@ -41,6 +41,11 @@ std::string bake_cache_key(const std::string& sha256, const BakeOptions& o) {
   k["closure_fresnel"] = to_string(o.fit.closure_fresnel);
   k["tolerance"] = o.tolerance;
   k["sampling"] = o.with_sampling;
+  if (o.colorspace != kRec709Space) {
+    k["colorspace"] = o.colorspace;
+    for (int column = 0; column < 3; ++column)
+      for (int row = 0; row < 3; ++row) k["colorspace_matrix"].push_back(o.from_rec709[column][row]);
+  }
   const std::string text = json_text(k);
   return sha256_hex(text.data(), text.size());
 }
@@ -106,7 +111,8 @@ BakeOutcome bake_material(const std::string& source, const std::string& name, co
     if (!table) table = load_table(source, options.fit.merl_bins);
     const FitResult fit = fitter.fit(*table);
     if (!fit.ok()) fail(source, "meaningless fit: " + fit.problem);
-    const Lut lut = make_lut(fit, fitter.quadrature(), source, sha, options.tolerance, options.with_sampling);
+    const Lut lut = in_colorspace(make_lut(fit, fitter.quadrature(), source, sha, options.tolerance, options.with_sampling),
+                                  options.colorspace, options.from_rec709);
     // The LUT and its sidecar are written as a pair: another bake of the same name into this folder (another
     // process, other settings) waits, so the two never come from different bakes.
     const FolderLock lock(out_dir);
@@ -126,6 +132,10 @@ BakeOutcome bake_material(const std::string& source, const std::string& name, co
     r["source_sha256"] = sha;
     r["facetfit_version"] = FACETFIT_VERSION;
     r["cache_key"] = key;
+    if (lut.meta.colorspace != kRec709Space) {  // the recommended parameters in the LUT's space, as info shows them
+      r["colorspace"] = lut.meta.colorspace;
+      r["recommended"] = recommended_json(recommended_parameters(lut.meta), options.tolerance);
+    }
     // The sidecar goes last: its presence with this key is what marks the bake complete.
     write_file_atomic(json_path.string(), json_text(r, 2) + "\n");
     out.status = BakeOutcome::Status::baked;

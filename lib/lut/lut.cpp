@@ -4,6 +4,8 @@
 #include <limits>
 #include <sstream>
 
+#include <glm/matrix.hpp>
+
 #include "core/error.h"
 #include "fit/roughness.h"
 #include "io/image_file.h"
@@ -170,6 +172,26 @@ Lut make_lut(const FitResult& fit, const Quadrature& quadrature, const std::stri
   return lut;
 }
 
+Lut in_colorspace(Lut lut, const std::string& space, const ColorMatrix& from_rec709) {
+  LutMetadata& m = lut.meta;
+  if (m.colorspace == space) return lut;
+  const ColorMatrix to = from_rec709 * glm::inverse(m.from_rec709);
+  const auto convert = [&](Rgb& c) { c = to * c; };
+  for (Rgb& v : lut.tables.fresnel.value) convert(v);
+  if (lut.anisotropic)
+    for (Rgb& v : lut.anisotropic->fresnel.value) convert(v);
+  for (Rgb* c : {&lut.tables.body, &m.f0, &m.f82, &m.body, &m.anisotropic_ggx.body, &m.anisotropic_ggx.f0, &m.anisotropic_ggx.f82,
+                 &m.closures.body})
+    convert(*c);
+  for (LutMetadata::Parametric* p : {&m.ggx, &m.beckmann, &m.lsq})
+    for (Rgb* c : {&p->body, &p->f0, &p->f82}) convert(*c);
+  for (ClosureLobe& lobe : m.closures.lobes)
+    for (Rgb* c : {&lobe.f0, &lobe.f82, &lobe.f90}) convert(*c);
+  m.colorspace = space;
+  m.from_rec709 = from_rec709;
+  return lut;
+}
+
 RepresentationParameters recommended_parameters(const LutMetadata& m) {
   const Representation r = m.representation;
   if (r == Representation::tabulated) return {r, std::nullopt, m.f0, m.f82, m.body, m.coat, m.error};
@@ -258,6 +280,10 @@ void write_lut(const std::string& path, const Lut& lut) {
     spec.set(key("anisotropic_ggx_error"), float(g.error));
   }
   if (m.format_version >= kLutClosuresVersion) write_closures(spec, m);
+  if (m.colorspace != kRec709Space) {
+    spec.set(key("colorspace"), m.colorspace);
+    spec.set(key("colorspace_matrix"), matrix_text(m.from_rec709));
+  }
   // One line per warning; absent when there is none.
   if (!m.warnings.empty()) {
     std::string text;
@@ -329,6 +355,18 @@ void validate(const std::string& path, const LutMetadata& m) {
                                 {"error_extraction", m.error_extraction}, {"ndf_error_ggx", m.ndf_error_ggx},
                                 {"ndf_error_beckmann", m.ndf_error_beckmann}, {"anisotropic_ggx_error", m.anisotropic_ggx.error}})
     in_range(name, v, 0.0, 1e30);
+}
+
+// facetfit:colorspace and its matrix from lin_rec709; lin_rec709 when absent.
+void read_colorspace(const std::string& path, const ImageSpec& spec, LutMetadata& m) {
+  const std::string name = spec.get_string(key("colorspace"));
+  if (name.empty() || name == kRec709Space) return;
+  const std::optional<ColorMatrix> from_rec709 = parse_matrix(spec.get_string(key("colorspace_matrix")));
+  if (!from_rec709)
+    fail(path, "facetfit:colorspace_matrix is missing or not nine numbers of an invertible matrix (from lin_rec709 to " +
+                   excerpt(name, 40) + ")");
+  m.colorspace = name;
+  m.from_rec709 = *from_rec709;
 }
 
 // The format version, one this facetfit reads.
@@ -456,6 +494,7 @@ LutMetadata read_lut_attributes(const std::string& path, const ImageSpec& spec, 
   }
   if (version >= kLutClosuresVersion) read_closures(path, spec, m);
   if (has_anisotropic_rows(spec, version)) read_anisotropic_attributes(path, spec, m);
+  read_colorspace(path, spec, m);
   return m;
 }
 

@@ -5,6 +5,7 @@
 #include <optional>
 #include <string>
 
+#include "core/color_space.h"
 #include "fit/fit.h"
 #include "fit/recommend.h"
 #include "model/parametric.h"
@@ -68,6 +69,10 @@ struct LutMetadata {
   Closures closures;
   double error_closures = 0.0;
   std::vector<std::string> warnings;  // implausible values found when fitting (fit/plausibility.h)
+  // The linear space every colour above and every Fresnel row is in (core/color_space.h), and its matrix
+  // from lin_rec709. Written only when it is another space (facetfit:colorspace, facetfit:colorspace_matrix).
+  std::string colorspace = kRec709Space;
+  ColorMatrix from_rec709{1.0};
 };
 
 // Row layout of the texture; texel x of row y is at s = (x + 0.5) / width, t = (y + 0.5) / height.
@@ -103,6 +108,10 @@ Lut make_lut(const FitResult& fit, const Quadrature& quadrature, const std::stri
              double tolerance, bool with_sampling);
 // The recommended representation's own parameters, as parameters_of() gives them for the fit it was baked from.
 RepresentationParameters recommended_parameters(const LutMetadata& meta);
+
+// The LUT with every colour (Fresnel curves, bodies, f0 and f82 of each fit, the closures' lobes) taken from
+// its space to `space`, whose matrix from lin_rec709 is `from_rec709`; as it is when already there.
+Lut in_colorspace(Lut lut, const std::string& space, const ColorMatrix& from_rec709);
 
 // Writes through a temporary file renamed into place. Throws Error naming `path`.
 void write_lut(const std::string& path, const Lut& lut);

@@ -42,6 +42,14 @@ std::uint64_t image_bytes(const CameraDesc& camera) {
   return std::uint64_t(camera.width) * std::uint64_t(camera.height) * (16u + 32u + 12u);
 }
 
+// The environment's radiance (lin_rec709) in the working space: L = M L_rec709.
+Environment in_working_space(const Environment& env, const ColorMatrix& from_rec709) {
+  if (env.is_constant()) return Environment::constant(from_rec709 * env.radiance(Vec3(0.0, 0.0, 1.0)));
+  std::vector<float> px = env.pixels();
+  convert_pixels(px.data(), px.size() / 3, 3, from_rec709);
+  return Environment::from_pixels(env.width(), env.height(), std::move(px));
+}
+
 }  // namespace
 
 Integrator::Integrator(const SceneDesc& desc, const RenderSettings& settings)
@@ -56,6 +64,7 @@ Integrator::Integrator(const SceneDesc& desc, const RenderSettings& settings)
   check_memory("render", "a " + std::to_string(width_) + " x " + std::to_string(height_) + " image", image_bytes(desc.camera),
                budget);
   memory_left_ = budget - image_bytes(desc.camera);
+  for (LightDesc light : desc.lights) lights_.push_back((light.value = desc.from_rec709 * light.value, light));
   LoadMaterials();
   LoadEnvironment();
   referenced_by(desc_, "a mesh object", [&] { return &tracer_.emplace(desc_); });
@@ -103,6 +112,7 @@ void Integrator::LoadEnvironment() {
       break;
     }
   }
+  if (env_ && desc_.working_space != kRec709Space) env_ = in_working_space(*env_, desc_.from_rec709);
   // A map gets a light sample per hit, weighted against the BRDF's by multiple importance sampling. A
   // constant environment is lit by the BRDF sample alone: a light sample, uniform over the sphere, adds
   // nothing the BRDF's proposal does not already draw better (every model's proposal holds the cosine, so
@@ -132,7 +142,7 @@ void Integrator::PlanLanes() {
     objects_.material.push_back(in_lanes_[std::size_t(m)] ? double(m) : -1.0);
     one_at_a_time_ = one_at_a_time_ || !in_lanes_[std::size_t(m)];
   }
-  for (const LightDesc& light : desc_.lights) {
+  for (const LightDesc& light : lights_) {
     lane_lights_.push_back({light.kind == LightDesc::Kind::directional, light.vector.x, light.vector.y, light.vector.z,
                             light.value.r, light.value.g, light.value.b});
     point_lights_ = point_lights_ || light.kind != LightDesc::Kind::directional;
@@ -238,7 +248,7 @@ void Integrator::EnvironmentSlots(const ShadingModel& model, const Planned& plan
 // One slot per light that lights the hit's side (the lanes' twin: light_slots).
 void Integrator::LightSlots(const ShadingModel& model, const Planned& planned, Shadows& shadows) const {
   const Vec3& o = planned.o;
-  for (const LightDesc& light : desc_.lights) {
+  for (const LightDesc& light : lights_) {
     Vec3 d;
     double dist = kInfinity;
     Rgb e = light.value;
@@ -288,6 +298,7 @@ RenderedImage Integrator::Render() {
 RenderedImage Integrator::Finish(int done) const {
   RenderedImage image;
   image.width = width_, image.height = height_, image.spp = spp_;
+  image.colorspace = desc_.working_space, image.from_rec709 = desc_.from_rec709;
   image.rgba.assign(accum_.size(), 0.0f);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, accum_.size(), 1 << 14), [&](const tbb::blocked_range<std::size_t>& part) {
     for (std::size_t k = part.begin(); k < part.end(); ++k) image.rgba[k] = float(accum_[k] / done);

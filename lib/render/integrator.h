@@ -128,6 +128,7 @@ class Integrator {
   RenderedImage Finish(int done) const;
 
   const SceneDesc& desc_;
+  std::vector<LightDesc> lights_;  // the scene's, in its working space
   const RenderSettings& settings_;
   int width_, height_, spp_;
   std::uint64_t seed_;

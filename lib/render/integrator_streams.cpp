@@ -41,7 +41,7 @@ void Integrator::BeginTile(const Tile& tile, TileSpace& space) {
   space.planned.resize(n), space.waves.resize(materials_.size());
   // At most two environment rays and one per light per sample: room for all from the start, so that the
   // first sample of a tile does not grow them piece by piece.
-  const std::size_t most = n * (2 + desc_.lights.size());
+  const std::size_t most = n * (2 + lights_.size());
   space.shadows.rays.reserve(most), space.shadows.values.reserve(most), space.blocked.reserve(most);
   // Each pixel's coordinates and its part of the sequences once per tile; per sample index, the numbers
   // and camera rays of all in SIMD lanes.

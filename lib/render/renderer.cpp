@@ -23,7 +23,10 @@ std::vector<float> RenderedImage::rgb() const {
 
 void write_exr(const std::string& path, const RenderedImage& image, const std::vector<std::pair<std::string, std::string>>& metadata) {
   ImageSpec spec(image.width, image.height, {"R", "G", "B", "A"});
-  spec.linear_rec709 = true;
+  spec.linear_space = image.colorspace;
+  spec.linear_chromaticities = chromaticities(image.from_rec709);
+  // The matrix too: chromaticities alone do not say how the white was adapted (ACEScg's from D65 to D60).
+  if (image.colorspace != kRec709Space) spec.set("facetfit:colorspace_matrix", matrix_text(image.from_rec709));
   for (const auto& [k, v] : metadata) spec.set("facetfit:" + k, v);
   write_image_atomic(path, spec, image.rgba.data());
 }

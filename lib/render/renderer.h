@@ -29,7 +29,9 @@ struct RenderSettings {
 
 struct RenderedImage {
   int width = 0, height = 0;
-  std::vector<float> rgba;  // linear Rec.709, alpha = coverage of the objects
+  std::vector<float> rgba;  // linear, in `colorspace`; alpha = coverage of the objects
+  std::string colorspace = kRec709Space;  // the scene's working space, and its matrix from lin_rec709
+  ColorMatrix from_rec709{1.0};
   int spp = 0;
   double seconds = 0.0;
 
@@ -40,8 +42,8 @@ struct RenderedImage {
 // Throws Error for anything it cannot load, and for a scene over settings.max_memory.
 RenderedImage render(const SceneDesc& scene, const RenderSettings& settings = {});
 
-// Linear EXR (R, G, B, A, float) with the given string metadata (as facetfit:KEY), its chromaticities
-// (Rec.709, D65) and colour space (oiio:ColorSpace lin_rec709), through a temporary file.
+// Linear EXR (R, G, B, A, float) with the given string metadata (as facetfit:KEY), the chromaticities of
+// its colour space and the space's name (oiio:ColorSpace), through a temporary file.
 void write_exr(const std::string& path, const RenderedImage& image, const std::vector<std::pair<std::string, std::string>>& metadata);
 
 }  // namespace facetfit

@@ -433,6 +433,33 @@ std::shared_ptr<const Proposal> tabulated_proposal(const Ndf& ndf, const Rgb& f0
   return std::make_shared<VisibleSlopeProposal>(tabulate_ndf(ndf), ProposalParts(f0, body, coat));
 }
 
+// A LUT of the scene, its colours in the scene's working space.
+Lut scene_lut(const SceneDesc& scene, const std::string& file) {
+  return in_colorspace(read_lut(resolve(scene, file)), scene.working_space, scene.from_rec709);
+}
+
+// A measurement's RGB (lin_rec709) in the working space: f = M f_rec709.
+class InWorkingSpace final : public Brdf {
+ public:
+  InWorkingSpace(std::shared_ptr<const Brdf> measurement, const ColorMatrix& from_rec709)
+      : measurement_(std::move(measurement)), from_rec709_(from_rec709) {}
+  std::optional<Rgb> eval(const Vec3& o, const Vec3& i) const override {
+    const std::optional<Rgb> f = measurement_->eval(o, i);
+    return f ? std::optional<Rgb>(from_rec709_ * *f) : std::nullopt;
+  }
+
+ private:
+  std::shared_ptr<const Brdf> measurement_;
+  ColorMatrix from_rec709_;
+};
+
+// The shading model of a measurement, rendered in the scene's working space.
+std::shared_ptr<const ShadingModel> measured_model(const SceneDesc& scene, std::shared_ptr<const Brdf> brdf,
+                                                   std::shared_ptr<const Proposal> proposal) {
+  if (scene.working_space != kRec709Space) brdf = std::make_shared<InWorkingSpace>(std::move(brdf), scene.from_rec709);
+  return std::make_shared<ShadingModel>(std::move(brdf), std::move(proposal));
+}
+
 }  // namespace
 
 std::shared_ptr<const ShadingModel> lut_parametric_model(const Lut& lut, const std::string& family, Smith smith, bool fresnel_curve,
@@ -474,7 +501,7 @@ std::string material_type_list() {
 }
 
 std::shared_ptr<const ShadingModel> load_material(const SceneDesc& scene, const MaterialDesc& m) {
-  if (m.type == "lambert") return std::make_shared<ShadingModel>(std::make_shared<LambertBrdf>(m.albedo), nullptr);
+  if (m.type == "lambert") return std::make_shared<ShadingModel>(std::make_shared<LambertBrdf>(scene.from_rec709 * m.albedo), nullptr);
   if (m.type == "analytic") {  // a built-in's analytic model itself: the ground truth
     const std::string name = is_builtin(m.file) ? source_name(m.file) : m.file;
     const auto builtin = find_builtin(name);
@@ -482,7 +509,7 @@ std::shared_ptr<const ShadingModel> load_material(const SceneDesc& scene, const 
     std::shared_ptr<const Proposal> proposal;  // tabulated, as lut_parametric_model says why
     if (const auto* mf = dynamic_cast<const MicrofacetBrdf*>(builtin->brdf.get()))
       proposal = std::make_shared<VisibleSlopeProposal>(tabulate_ndf(mf->ndf()), ProposalParts{});
-    return std::make_shared<ShadingModel>(builtin->brdf, proposal);
+    return measured_model(scene, builtin->brdf, proposal);
   }
   if (m.type == "measured") {
     // The measurement is what is rendered; a fit only proposes directions: the given LUT's (a bake
@@ -498,7 +525,7 @@ std::shared_ptr<const ShadingModel> load_material(const SceneDesc& scene, const 
     if (!table && (!(rgl || utia) || m.proposal.empty())) table = std::make_shared<MerlTable>(table_of(*measurement));
     std::shared_ptr<const Proposal> proposal;
     if (!m.proposal.empty()) {
-      proposal = std::make_shared<VisibleSlopeProposal>(read_lut(resolve(scene, m.proposal)).tables);
+      proposal = std::make_shared<VisibleSlopeProposal>(scene_lut(scene, m.proposal).tables);
     } else {
       const FitResult fit = Fitter{FitOptions::paper()}.fit(*table);
       if (fit.ok()) proposal = std::make_shared<VisibleSlopeProposal>(MicrofacetTables{fit.ndf(), fit.smith, fit.fresnel(), {}, {}});
@@ -508,15 +535,14 @@ std::shared_ptr<const ShadingModel> load_material(const SceneDesc& scene, const 
     if (rgl) {
       auto brdf = std::make_shared<RglBsdf>(*rgl);  // a copy shares the file's tables; the slices are its own
       brdf->set_slices(*parse_slices(m.slices));
-      return std::make_shared<ShadingModel>(brdf, proposal);
+      return measured_model(scene, brdf, proposal);
     }
     // UTIA files too, anisotropic as they are (the table and the proposal's fit see their azimuthal mean).
-    if (utia) return std::make_shared<ShadingModel>(measurement, proposal);
-    return std::make_shared<ShadingModel>(table, proposal);
+    if (utia) return measured_model(scene, measurement, proposal);
+    return measured_model(scene, table, proposal);
   }
   if (m.type == "lut") {
-    const std::string path = resolve(scene, m.file);
-    Lut lut = read_lut(path);
+    Lut lut = scene_lut(scene, m.file);
     if (m.anisotropic && lut.anisotropic) {
       const auto lobe = std::make_shared<TabulatedAnisotropic>(std::move(*lut.anisotropic), m.stretch);
       return std::make_shared<ShadingModel>(lobe, lobe);
@@ -536,7 +562,7 @@ std::shared_ptr<const ShadingModel> load_material(const SceneDesc& scene, const 
     // then give nearly the same directions, and most of the noise cancels in their differences (the
     // report's; with its own proposal, the closures of gold at the report test's 4 spp stood 5.4 from the
     // measurement where the ggx fit stood 0.3).
-    Lut lut = read_lut(resolve(scene, m.file));
+    Lut lut = scene_lut(scene, m.file);
     const Closures closures = lut.closures().stretched(m.stretch.x, m.stretch.y, m.stretch.rotation());
     const auto brdf = std::make_shared<ClosureBrdf>(closures);
     if (!m.stretch.unscaled()) return std::make_shared<ShadingModel>(brdf, std::make_shared<ClosureProposal>(closures));
@@ -545,13 +571,14 @@ std::shared_ptr<const ShadingModel> load_material(const SceneDesc& scene, const 
   // ggx | beckmann | lsq (the LUT's classical baseline: Lambert + GGX + Schlick); nothing else renders as them
   if (m.type != "ggx" && m.type != "beckmann" && m.type != "lsq")
     fail("material type '" + m.type + "'", "must be " + material_type_list());
-  if (!m.file.empty()) return lut_parametric_model(read_lut(resolve(scene, m.file)), m.type, m.smith, m.fresnel == "curve", m.anisotropic);
+  if (!m.file.empty()) return lut_parametric_model(scene_lut(scene, m.file), m.type, m.smith, m.fresnel == "curve", m.anisotropic);
   const Ndf ndf = Ndf::isotropic(m.type == "beckmann" ? NdfType::beckmann : NdfType::ggx, m.alpha);
   // The proposal samples the lobe, weighted by f0: GGX's visible normals in closed form (model/proposal.h),
   // Beckmann's tabulated.
-  const auto brdf = std::make_shared<ParametricBrdf>(ndf, m.smith, m.f0, m.f82);
-  if (ndf.type == NdfType::ggx) return std::make_shared<ShadingModel>(brdf, std::make_shared<GgxProposal>(m.alpha, m.f0, Rgb(0.0), Coat{}));
-  return std::make_shared<ShadingModel>(brdf, tabulated_proposal(ndf, m.f0));
+  const Rgb f0 = scene.from_rec709 * m.f0, f82 = scene.from_rec709 * m.f82;
+  const auto brdf = std::make_shared<ParametricBrdf>(ndf, m.smith, f0, f82);
+  if (ndf.type == NdfType::ggx) return std::make_shared<ShadingModel>(brdf, std::make_shared<GgxProposal>(m.alpha, f0, Rgb(0.0), Coat{}));
+  return std::make_shared<ShadingModel>(brdf, tabulated_proposal(ndf, f0));
 }
 
 }  // namespace facetfit

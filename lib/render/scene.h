@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "core/color_space.h"
 #include "core/vec.h"
 #include "model/smith.h"
 #include "model/stretch.h"
@@ -109,6 +110,11 @@ struct SceneDesc {
   std::vector<ObjectDesc> objects;
   std::string base_dir = ".";  // where relative file names resolve
   std::string source;          // the scene file (or what stands for it), named in errors; empty: made in code
+  // The linear space the render is in (core/color_space.h) and its matrix from lin_rec709. The scene's
+  // colours (lights, environment, plain materials) and measurements are lin_rec709 and converted by it;
+  // a LUT from the space it records.
+  std::string working_space = kRec709Space;
+  ColorMatrix from_rec709{1.0};
 };
 
 // Throws Error("<path>: <problem>") for unreadable or inconsistent scenes.

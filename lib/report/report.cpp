@@ -186,7 +186,8 @@ std::string report_html(const json& report) {
   h << "<p>facetfit " << html_escape(report["facetfit_version"].get<std::string>()) << ", "
     << report["materials"].size() << " materials, " << report["settings"]["size"] << "&sup2; pixels, "
     << report["settings"]["spp"] << " spp. Mean CIE Delta E 2000 over the sphere between the render of the measurement "
-    << "and of each representation (display-referred sRGB; docs/colour.md).</p><h2>Database mean</h2><table><tr>";
+    << "and of each representation, on the sRGB display of their Rec.709 colour (docs/colour.md). Pictures: "
+    << html_escape(report["settings"].value("pictures", std::string("the same sRGB display"))) << ".</p><h2>Database mean</h2><table><tr>";
   for (const std::string& r : report_representations()) h << "<th>" << r << "</th>";
   h << "<th></th></tr>";
   for (const auto& [key, label] : {std::pair{"database_mean_delta_e", "mean &Delta;E"}, {"database_mean_render_seconds", "mean render s"}}) {
@@ -336,11 +337,13 @@ json run_report(const ReportOptions& o) {
   report["facetfit_version"] = FACETFIT_VERSION;
   report["settings"] = {{"size", o.size}, {"spp", o.spp}, {"smith", to_string(o.bake.fit.smith)}, {"resolution", o.bake.fit.resolution},
                         {"tolerance", o.bake.tolerance}};
+  if (o.pictures) report["settings"]["pictures"] = o.pictures_name;
   report["shard"] = std::to_string(o.shard) + "/" + std::to_string(o.shards);
   report["materials"] = json::array();
   report["failures"] = json::array();
   const Fitter fitter(o.bake.fit);
   const DisplayTransform display;
+  const DisplayTransform& pictures = o.pictures ? *o.pictures : display;
   std::size_t done = 0;
   for (const std::string& source : mine) {
     const std::string name = source_name(source);
@@ -380,13 +383,13 @@ json run_report(const ReportOptions& o) {
         };
         const RenderedImage measured = render_as("measured", source);
         entry["seconds"]["render"]["measured"] = measured.seconds;
-        write_display_png((images / "measured.png").string(), measured.rgba.data(), measured.width, measured.height, 4, display);
+        write_display_png((images / "measured.png").string(), measured.rgba.data(), measured.width, measured.height, 4, pictures);
         std::vector<bool> mask(std::size_t(measured.width) * measured.height);
         for (std::size_t p = 0; p < mask.size(); ++p) mask[p] = measured.rgba[p * 4 + 3] >= 1.0f;  // the sphere
         for (const std::string& r : report_representations()) {
           const RenderedImage img = render_as(r == "tabulated" ? "lut" : r, lut);
           entry["seconds"]["render"][r] = img.seconds;
-          write_display_png((images / (r + ".png")).string(), img.rgba.data(), img.width, img.height, 4, display);
+          write_display_png((images / (r + ".png")).string(), img.rgba.data(), img.width, img.height, 4, pictures);
           const ImageDiff diff = image_delta_e(measured.rgb(), false, img.rgb(), false, mask, display);
           entry["delta_e"][r] = diff.mean;
           entry["max_delta_e"][r] = diff.max;

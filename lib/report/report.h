@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "color/display.h"
 #include "lut/bake.h"
 
 namespace facetfit {
@@ -22,6 +23,10 @@ struct ReportOptions {
   int shard = 1, shards = 1;  // this run renders materials k with k % shards == shard - 1
   bool force = false;
   BakeOptions bake;
+  // The pictures' display and view (a studio's, color/display.h) and its name; null: the sRGB display,
+  // through which Delta E is measured whatever the pictures show.
+  std::shared_ptr<const DisplayTransform> pictures;
+  std::string pictures_name;
   std::function<void(const std::string& name, std::size_t done, std::size_t total)> progress;
 };
 

@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "arrays.h"
+#include "color/colorspace.h"
 #include "color/image_diff.h"
 #include "core/error.h"
 #include "core/memory_budget.h"
@@ -430,6 +431,7 @@ PYBIND11_MODULE(_facetfit, m) {
       .def_property_readonly("alpha_ggx", [](const Lut& l) { return l.meta.alpha_ggx; }, "the paper's moment estimate (see Fit.alpha_ggx)")
       .def_property_readonly("alpha_beckmann", [](const Lut& l) { return l.meta.alpha_beckmann; }, "the paper's moment estimate")
       .def_property_readonly("warnings", [](const Lut& l) { return l.meta.warnings; })
+      .def_property_readonly("colorspace", [](const Lut& l) { return l.meta.colorspace; }, "the linear space of its colours (docs/colour.md)")
       .def("model", [](const Lut& l) { return tabulated_model(l.tables); }, "The tabulated model.")
       .def_property_readonly("closures", [](const Lut& l) { return to_python(closures_json(l.closures(), l.meta.error_closures)); },
                              "the closures the material shader emits (format 5; an older LUT's one lobe), as Fit.closures")
@@ -459,10 +461,12 @@ PYBIND11_MODULE(_facetfit, m) {
       "bake",
       [](const py::object& source_arg, const py::object& out_dir_arg, std::string name, bool force, double tolerance, bool sampling,
          const std::string& refine, int resolution, const std::string& smith, const std::string& merl_bins,
-         const std::string& closure_fresnel) {
+         const std::string& closure_fresnel, const std::string& working_space, const std::string& ocio_config) {
         const std::string source = fs_path(source_arg), out_dir = fs_path(out_dir_arg);
         BakeOptions o;
         o.fit = fit_options(refine, resolution, smith, merl_bins, closure_fresnel);
+        o.colorspace = working_space;
+        o.from_rec709 = ColorConfig(ocio_config).from_rec709(working_space);
         o.force = force;
         o.tolerance = tolerance;
         o.with_sampling = sampling;
@@ -493,8 +497,10 @@ PYBIND11_MODULE(_facetfit, m) {
       },
       py::arg("source"), py::arg("out_dir"), py::arg("name") = "", py::arg("force") = false, py::arg("tolerance") = kDefaultTolerance,
       py::arg("sampling") = true, py::arg("refine") = "full", py::arg("resolution") = 90, py::arg("smith") = "correlated",
-      py::arg("merl_bins") = "start", py::arg("closure_fresnel") = "f82",
-      "Bakes OUT_DIR/NAME.exr and its JSON sidecar as `facetfit bake` does (cached by content, OUT_DIR created); "
+      py::arg("merl_bins") = "start", py::arg("closure_fresnel") = "f82", py::arg("working_space") = kRec709Space,
+      py::arg("ocio_config") = "",
+      "Bakes OUT_DIR/NAME.exr and its JSON sidecar as `facetfit bake` does (cached by content, OUT_DIR created; "
+      "working_space: the LUT's colours in that space of the OpenColorIO config ocio_config, else $OCIO); "
       "returns the sidecar, or for a folder, glob or 'builtin:' a list of them (a failed one as {source, status: "
       "'failed', error}).");
 

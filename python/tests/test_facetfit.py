@@ -219,6 +219,24 @@ def test_bake_caches(tmp_path):
     assert os.path.exists(tmp_path / "gold-ggx-0.15.exr")
 
 
+def test_bake_in_a_working_space(tmp_path):
+    """Issue 48: bake(working_space=...) as bake --working-space: the LUT records its space and holds its
+    colours converted (the Rec.709 to ACEScg matrix of the ACES config); a space without a config raises."""
+    ocio = pytest.importorskip("PyOpenColorIO")
+    config = tmp_path / "aces.ocio"
+    config.write_text(ocio.Config.CreateFromBuiltinConfig("cg-config-v1.0.0_aces-v1.3_ocio-v2.1").serialize())
+    facetfit.bake(GOLD, str(tmp_path / "a"), refine="none")
+    rec709 = facetfit.read_lut(tmp_path / "a" / "gold-ggx-0.15.exr")
+    facetfit.bake(GOLD, str(tmp_path / "b"), refine="none", working_space="ACEScg", ocio_config=str(config))
+    acescg = facetfit.read_lut(tmp_path / "b" / "gold-ggx-0.15.exr")
+    assert rec709.colorspace == "lin_rec709" and acescg.colorspace == "ACEScg"
+    to_acescg = np.array([[0.6130974293, 0.3395231366, 0.0473794527], [0.0701937228, 0.9163538814, 0.0134523986],
+                          [0.0206155926, 0.1095697731, 0.8698146343]])
+    assert np.allclose(acescg.fresnel, rec709.fresnel @ to_acescg.T, atol=1e-5)
+    with pytest.raises(facetfit.Error, match="needs an OpenColorIO config"):
+        facetfit.bake(GOLD, str(tmp_path / "c"), working_space="ACEScg")
+
+
 def test_bake_takes_what_the_command_takes(tmp_path):
     """Issue 48: a folder (the command bakes it; Python said it held no supported file) and a missing output
     folder (created, not 'cannot lock'); a batch goes on past a bad file."""
