@@ -63,22 +63,23 @@ Integrator::Integrator(const SceneDesc& desc, const RenderSettings& settings)
   const std::uint64_t budget = settings.max_memory > 0 ? settings.max_memory : default_memory_budget();
   check_memory("render", "a " + std::to_string(width_) + " x " + std::to_string(height_) + " image", image_bytes(desc.camera),
                budget);
-  memory_left_ = budget - image_bytes(desc.camera);
+  std::uint64_t memory_left = budget - image_bytes(desc.camera);
   for (LightDesc light : desc.lights) lights_.push_back((light.value = desc.from_rec709 * light.value, light));
-  LoadMaterials();
-  LoadEnvironment();
+  const std::map<std::string, int> material_index = LoadMaterials(memory_left);
+  LoadEnvironment(memory_left);
   referenced_by(desc_, "a mesh object", [&] { return &tracer_.emplace(desc_); });
-  PlanObjects();
+  PlanObjects(material_index);
   PlanLanes();
   SetCamera();
   accum_.assign(std::size_t(width_) * std::size_t(height_) * 4, 0.0);
 }
 
 // Only the materials the objects use, each once, with its tangent and stretch texture.
-void Integrator::LoadMaterials() {
+std::map<std::string, int> Integrator::LoadMaterials(std::uint64_t& memory_left) {
+  std::map<std::string, int> material_index;
   for (const ObjectDesc& o : desc_.objects) {
-    if (material_index_.count(o.material)) continue;
-    material_index_[o.material] = int(materials_.size());
+    if (material_index.count(o.material)) continue;
+    material_index[o.material] = int(materials_.size());
     const MaterialDesc& m = desc_.materials.at(o.material);
     const std::string key = "material \"" + o.material + "\"";
     materials_.push_back(referenced_by(desc_, key, [&] { return load_material(desc_, m); }));
@@ -89,20 +90,21 @@ void Integrator::LoadMaterials() {
     const auto* anisotropic = dynamic_cast<const TabulatedAnisotropic*>(&materials_.back()->brdf());
     if (!lobe && !anisotropic) fail(m.file, "a stretch_texture needs a tabulated lobe");
     Texture texture = referenced_by(desc_, key + " stretch_texture",
-                                    [&] { return Texture::load(resolve(desc_, m.stretch_texture), memory_left_); });
-    memory_left_ -= texture.bytes();
+                                    [&] { return Texture::load(resolve(desc_, m.stretch_texture), memory_left); });
+    memory_left -= texture.bytes();
     stretch_textures_.back() = StretchTexture{std::move(texture), lobe, anisotropic, m.stretch};
   }
+  return material_index;
 }
 
-void Integrator::LoadEnvironment() {
+void Integrator::LoadEnvironment(std::uint64_t& memory_left) {
   const EnvironmentDesc& e = desc_.environment;
   switch (e.kind) {
     case EnvironmentDesc::Kind::none: break;
     case EnvironmentDesc::Kind::builtin_sky: env_ = Environment::sky(); break;
     case EnvironmentDesc::Kind::constant: env_ = Environment::constant(e.constant * e.scale); break;
     case EnvironmentDesc::Kind::file: {
-      Environment loaded = referenced_by(desc_, "environment file", [&] { return Environment::load(resolve(desc_, e.file), memory_left_); });
+      Environment loaded = referenced_by(desc_, "environment file", [&] { return Environment::load(resolve(desc_, e.file), memory_left); });
       if (e.scale != 1.0) {
         std::vector<float> px = loaded.pixels();
         for (float& v : px) v *= float(e.scale);
@@ -124,9 +126,9 @@ void Integrator::LoadEnvironment() {
 
 // Per object, its material and what the lanes read of it per hit (a sphere's centre and the reciprocal of
 // its radius, 0 for a mesh), so that the tile loops do not reach into the scene's description.
-void Integrator::PlanObjects() {
+void Integrator::PlanObjects(const std::map<std::string, int>& material_index) {
   for (const ObjectDesc& o : desc_.objects) {
-    object_material_.push_back(material_index_.at(o.material));
+    object_material_.push_back(material_index.at(o.material));
     const bool sphere = o.kind == ObjectDesc::Kind::sphere;
     const Vec3 c = sphere ? o.center : Vec3(0.0);
     objects_.cx.push_back(c.x), objects_.cy.push_back(c.y), objects_.cz.push_back(c.z);

@@ -98,9 +98,11 @@ class Integrator {
   using Tile = tbb::blocked_range2d<int>;
 
   // Construction.
-  void LoadMaterials();
-  void LoadEnvironment();
-  void PlanObjects();
+  // `memory_left`: what the image buffers leave of the budget, for the textures and the environment map.
+  // LoadMaterials returns each used material's index in materials_, by name.
+  std::map<std::string, int> LoadMaterials(std::uint64_t& memory_left);
+  void LoadEnvironment(std::uint64_t& memory_left);
+  void PlanObjects(const std::map<std::string, int>& material_index);
   void PlanLanes();
   void SetCamera();
 
@@ -132,10 +134,8 @@ class Integrator {
   const RenderSettings& settings_;
   int width_, height_, spp_;
   std::uint64_t seed_;
-  std::uint64_t memory_left_;  // for the textures and the environment map together
 
   std::vector<std::shared_ptr<const ShadingModel>> materials_;  // only those the objects use
-  std::map<std::string, int> material_index_;
   std::vector<std::optional<Vec3>> tangents_;  // per material: the world direction its tangent follows
   std::vector<std::optional<StretchTexture>> stretch_textures_;
   std::optional<Environment> env_;
