@@ -757,7 +757,7 @@ TEST(Shading, GgxInSimdLanesEqualsOnePairAtATime) {
           const auto brdf = with_curve ? std::make_shared<ParametricBrdf>(ndf, smith, curve, body, coat)
                                        : std::make_shared<ParametricBrdf>(ndf, smith, f0, Rgb(0.8, 0.7, 0.5), body, coat);
           const ShadingModel model(brdf, std::make_shared<GgxProposal>(alpha, f0, body, coat));
-          ASSERT_TRUE(model.batch_model());
+          ASSERT_TRUE(model.lanes<GgxLanes>());
           const std::string where = "alpha " + std::to_string(alpha) + " variant " + std::to_string(variant) + " " + simd_target_name(target);
           EvaluationBatch lanes, reference;
           SampleBatch drawn, one_by_one;
@@ -768,8 +768,8 @@ TEST(Shading, GgxInSimdLanesEqualsOnePairAtATime) {
             const double u1 = u(rng), u2 = u(rng), u3 = u(rng);
             drawn.push(o, u1, u2, u3), one_by_one.push(o, u1, u2, u3);
           }
-          eval_ggx_batch(*model.batch_model(), lanes, target), model.eval(reference, false);
-          sample_ggx_batch(*model.batch_model(), drawn, target), model.sample_directions(one_by_one, false);
+          eval_ggx_batch(model.lanes<GgxLanes>()->model, lanes, target), model.eval(reference, false);
+          sample_ggx_batch(model.lanes<GgxLanes>()->model, drawn, target), model.sample_directions(one_by_one, false);
           for (std::size_t k = 0; k < n; ++k) {
             const double values[4][2] = {{lanes.r[k], reference.r[k]}, {lanes.g[k], reference.g[k]}, {lanes.b[k], reference.b[k]},
                                          {lanes.pdf[k], reference.pdf[k]}};
@@ -872,8 +872,8 @@ TEST(Shading, TabulatedInSimdLanesEqualsOnePairAtATime) {
                                   layered ? Coat{0.05, 0.04} : Coat{}, layered ? 1.4 : 1.0};  // 1.4: Minnaert's body
           const auto lobe = std::make_shared<TabulatedMicrofacet>(tables);
           const ShadingModel model(lobe, VisibleSlopeProposal::of(*lobe));
-          ASSERT_TRUE(model.tabulated_batch_model());
-          ASSERT_TRUE(model.tabulated_batch_model()->f);
+          ASSERT_TRUE(model.lanes<TabulatedLanes>());
+          ASSERT_TRUE(model.lanes<TabulatedLanes>()->model.f);
           ASSERT_TRUE(model.has_lanes());
           const std::string where = "alpha " + std::to_string(alpha) + (layered ? " layered" : "") + " " + simd_target_name(target);
           EvaluationBatch lanes, reference;
@@ -887,12 +887,12 @@ TEST(Shading, TabulatedInSimdLanesEqualsOnePairAtATime) {
             const double u1 = single(u(rng)), u2 = single(u(rng)), u3 = single(u(rng));
             drawn.push(o, u1, u2, u3), one_by_one.push(o, u1, u2, u3);
           }
-          eval_tabulated_batch(*model.tabulated_batch_model(), lanes, target), model.eval(reference, false);
-          sample_tabulated_batch(*model.tabulated_batch_model(), drawn, target), model.sample_directions(one_by_one, false);
+          eval_tabulated_batch(model.lanes<TabulatedLanes>()->model, lanes, target), model.eval(reference, false);
+          sample_tabulated_batch(model.lanes<TabulatedLanes>()->model, drawn, target), model.sample_directions(one_by_one, false);
           // Pairs that ask for f alone (a light's): the same f, and no density.
           EvaluationBatch f_only;
           for (std::size_t k = 0; k < n; ++k) f_only.push(lanes.o(k), lanes.i(k), false);
-          eval_tabulated_batch(*model.tabulated_batch_model(), f_only, target);
+          eval_tabulated_batch(model.lanes<TabulatedLanes>()->model, f_only, target);
           for (std::size_t k = 0; k < n; ++k) {
             ASSERT_EQ(f_only.pdf[k], 0.0) << where << " pair " << k;
             ASSERT_EQ(f_only.r[k], lanes.r[k]) << where << " pair " << k;
@@ -956,7 +956,7 @@ TEST(Shading, TabulatedProposalInSimdLanesEqualsOnePairAtATime) {
     const auto proposal = std::make_shared<VisibleSlopeProposal>(tabulate_ndf(ndf), ProposalParts(Rgb(1.0), body, coat));
     const ShadingModel model(brdf, proposal);
     ASSERT_TRUE(model.has_lanes());
-    ASSERT_FALSE(model.tabulated_batch_model()->f);
+    ASSERT_FALSE(model.lanes<TabulatedLanes>()->model.f);
     EvaluationBatch lanes, reference;
     SampleBatch drawn, one_by_one;
     for (std::size_t k = 0; k < 403; ++k) {

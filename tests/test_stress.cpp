@@ -203,7 +203,7 @@ TEST(GgxLanes, EveryBatchLengthAndDegenerateDirectionStayFiniteAndInBounds) {
       const Coat coat = layered ? Coat{0.005, 0.04} : Coat{};
       const ShadingModel model(std::make_shared<ParametricBrdf>(ndf, Smith::correlated, curve, body, coat),
                                std::make_shared<GgxProposal>(alpha, Rgb(0.5), body, coat));
-      ASSERT_TRUE(model.batch_model());
+      ASSERT_TRUE(model.lanes<GgxLanes>());
       for (std::size_t n = 0; n <= 40; ++n)
         for (const SimdTarget target : kSimdTargets) {
           EvaluationBatch e;
@@ -213,8 +213,8 @@ TEST(GgxLanes, EveryBatchLengthAndDegenerateDirectionStayFiniteAndInBounds) {
             e.push(o, i);
             s.push(o, double(k % 5) / 5.0, double(k % 7) / 7.0, double(k % 3) / 3.0);
           }
-          eval_ggx_batch(*model.batch_model(), e, target);
-          sample_ggx_batch(*model.batch_model(), s, target);
+          eval_ggx_batch(model.lanes<GgxLanes>()->model, e, target);
+          sample_ggx_batch(model.lanes<GgxLanes>()->model, s, target);
           for (std::size_t k = 0; k < n; ++k) {
             for (const double v : {e.r[k], e.g[k], e.b[k], e.pdf[k]}) ASSERT_TRUE(std::isfinite(v)) << "alpha " << alpha << " pair " << k;
             if (!(e.oz[k] > 0.0 && e.iz[k] > 0.0)) {
@@ -244,14 +244,14 @@ TEST(TabulatedLanes, EveryBatchLengthAndDegenerateDirectionStayFiniteAndInBounds
       const auto lobe = std::make_shared<TabulatedMicrofacet>(
           MicrofacetTables{ndf, Smith::correlated, curve, layered ? Rgb(0.2) : Rgb(0.0), layered ? Coat{0.005, 0.04} : Coat{}, layered ? 3.0 : 1.0});
       const ShadingModel model(lobe, VisibleSlopeProposal::of(*lobe));
-      ASSERT_TRUE(model.tabulated_batch_model());
+      ASSERT_TRUE(model.lanes<TabulatedLanes>());
       // And the proposal alone (a measured table's: no f in the lanes), whose f's tables are null.
       const auto slopes = VisibleSlopeProposal::of(*lobe);  // the lanes' model points into its tables
       const TabulatedBatchModel proposal_only = TabulatedBatchModel::of(*slopes, nullptr, 0.85);
       ASSERT_FALSE(proposal_only.f);
       for (std::size_t n = 0; n <= 40; ++n)
         for (const SimdTarget target : kSimdTargets)
-          for (const TabulatedBatchModel* batch_model : {&*model.tabulated_batch_model(), &proposal_only}) {
+          for (const TabulatedBatchModel* batch_model : {&model.lanes<TabulatedLanes>()->model, &proposal_only}) {
             EvaluationBatch e;
             for (std::size_t k = 0; k < n; ++k) e.push(glm::normalize(degenerate[k % 8]), glm::normalize(degenerate[(k * 3 + 1) % 8]));
             eval_tabulated_batch(*batch_model, e, target);

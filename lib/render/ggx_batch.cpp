@@ -89,8 +89,37 @@ void EvalGgxBatch(const GgxBatchModel& model, EvaluationBatch& batch) {
 HWY_AFTER_NAMESPACE();
 
 #if HWY_ONCE
+#include "model/parametric.h"
+#include "model/proposal.h"
 #include "render/simd_dispatch.h"
 namespace facetfit {
+
+const ParametricBrdf* ggx_drawn_by_itself(const LanesInput& in) {
+  const auto* lobe = dynamic_cast<const ParametricBrdf*>(&in.brdf);
+  const auto* ggx = dynamic_cast<const GgxProposal*>(in.proposal);
+  if (lobe && ggx && in.lobe_weight > 0.0 && lobe->ndf().type == NdfType::ggx && lobe->ndf().alpha_x == ggx->alpha() &&
+      lobe->ndf().alpha_y == ggx->alpha())
+    return lobe;
+  return nullptr;
+}
+
+std::optional<GgxLanes> GgxLanes::recognise(const LanesInput& in) {
+  const ParametricBrdf* lobe = ggx_drawn_by_itself(in);
+  if (!lobe) return std::nullopt;
+  // The kernels hold one coat for f and density alike.
+  const ProposalParts& parts = static_cast<const GgxProposal*>(in.proposal)->parts();
+  if (parts.coat.alpha != lobe->coat().alpha || parts.coat.f0 != lobe->coat().f0) return std::nullopt;
+  GgxLanes lanes;
+  GgxBatchModel& m = lanes.model;
+  m.alpha = lobe->ndf().alpha_x;
+  m.smith = lobe->smith();
+  m.curve = lobe->curve() ? lobe->curve()->value.data() : nullptr;
+  m.f82_tint = lobe->f82_tint();
+  m.body = lobe->body();
+  m.coat = lobe->coat();
+  m.weights = {in.lobe_weight, parts.lobe, parts.body, parts.coat.present() ? parts.coat_weight() : 0.0};
+  return lanes;
+}
 
 void eval_ggx_batch(const GgxBatchModel& model, EvaluationBatch& batch, SimdTarget target) {
   FACETFIT_DISPATCH(target, EvalGgxBatch, model, batch);

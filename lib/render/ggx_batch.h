@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstddef>
+#include <optional>
 
 #include "core/vec.h"
 #include "model/coat.h"
@@ -32,5 +33,22 @@ struct GgxBatchModel {
 void eval_ggx_batch(const GgxBatchModel& model, EvaluationBatch& batch, SimdTarget target = SimdTarget::best);
 // Fills the batch's i and found for its padded_size() entries.
 void sample_ggx_batch(const GgxBatchModel& model, SampleBatch& batch, SimdTarget target = SimdTarget::best);
+
+class ParametricBrdf;
+
+// The GGX lobe of `in` when its proposal is the lobe's own visible normals (GgxProposal of the same alpha):
+// f and density then share the half vector, D and Lambda, in the lanes and in ShadingModel's scalar path.
+// Null otherwise.
+const ParametricBrdf* ggx_drawn_by_itself(const LanesInput& in);
+
+// The lanes back-end (render/lanes.h) of such a lobe with the proposal's coat.
+struct GgxLanes {
+  GgxBatchModel model;
+
+  static std::optional<GgxLanes> recognise(const LanesInput& in);
+  bool f_in_lanes() const { return true; }
+  void eval(EvaluationBatch& batch, const ShadingModel&) const { eval_ggx_batch(model, batch); }
+  void sample(SampleBatch& batch) const { sample_ggx_batch(model, batch); }
+};
 
 }  // namespace facetfit

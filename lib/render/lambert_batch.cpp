@@ -48,8 +48,15 @@ void SampleLambertBatch(SampleBatch& batch) {
 HWY_AFTER_NAMESPACE();
 
 #if HWY_ONCE
+#include "model/analytic.h"
 #include "render/simd_dispatch.h"
 namespace facetfit {
+
+std::optional<LambertLanes> LambertLanes::recognise(const LanesInput& in) {
+  const auto* lambert = dynamic_cast<const LambertBrdf*>(&in.brdf);
+  if (!lambert || lambert->exponent() != 1.0 || in.lobe_weight != 0.0) return std::nullopt;
+  return LambertLanes{lambert->albedo()};
+}
 
 void eval_lambert_batch(const Rgb& albedo, EvaluationBatch& batch, SimdTarget target) { FACETFIT_DISPATCH(target, EvalLambertBatch, albedo, batch); }
 

@@ -4,6 +4,8 @@
 // slower than a GGX one in lanes (docs/benchmarks.md, BM_RenderSphere).
 #pragma once
 
+#include <optional>
+
 #include "core/vec.h"
 #include "render/shading_batch.h"
 #include "render/simd_targets.h"
@@ -16,5 +18,16 @@ void eval_lambert_batch(const Rgb& albedo, EvaluationBatch& batch, SimdTarget ta
 // Fills the batch's i (cosine-weighted, by the concentric map of the disc) and found for its
 // padded_size() entries.
 void sample_lambert_batch(SampleBatch& batch, SimdTarget target = SimdTarget::best);
+
+// The lanes back-end (render/lanes.h) of a Lambertian surface (Lambert's law, not Minnaert's) sampled by
+// the cosine alone.
+struct LambertLanes {
+  Rgb albedo;
+
+  static std::optional<LambertLanes> recognise(const LanesInput& in);
+  bool f_in_lanes() const { return true; }
+  void eval(EvaluationBatch& batch, const ShadingModel&) const { eval_lambert_batch(albedo, batch); }
+  void sample(SampleBatch& batch) const { sample_lambert_batch(batch); }
+};
 
 }  // namespace facetfit

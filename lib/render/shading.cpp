@@ -1,46 +1,36 @@
 #include "render/shading.h"
 
 #include <cmath>
+#include <type_traits>
+#include <variant>
 
-#include "io/merl.h"
-#include "model/analytic.h"
 #include "model/ndf.h"
 #include "model/parametric.h"
-#include "model/tabulated.h"
-#include "model/visible_slopes.h"
 
 namespace facetfit {
 
+namespace {
+
+// fn(the back-end in `lanes`), or false where no back-end runs the model.
+template <class Fn>
+bool with_lanes(const LanesBackend& lanes, Fn fn) {
+  return std::visit([&](const auto& backend) {
+    if constexpr (std::is_same_v<std::decay_t<decltype(backend)>, std::monostate>) return false;
+    else return fn(backend);
+  }, lanes);
+}
+
+}  // namespace
+
 ShadingModel::ShadingModel(std::shared_ptr<const Brdf> brdf, std::shared_ptr<const Proposal> proposal)
     : brdf_(std::move(brdf)), proposal_(std::move(proposal)), lobe_weight_(proposal_ && proposal_->can_sample() ? 0.85 : 0.0) {
-  const auto* lobe = dynamic_cast<const ParametricBrdf*>(brdf_.get());
-  const auto* ggx = dynamic_cast<const GgxProposal*>(proposal_.get());
-  if (lobe && ggx && lobe_weight_ > 0.0 && lobe->ndf().type == NdfType::ggx && lobe->ndf().alpha_x == ggx->alpha() &&
-      lobe->ndf().alpha_y == ggx->alpha())
-    ggx_brdf_ = lobe, ggx_proposal_ = ggx;
-  // The batch kernel holds one coat for f and density alike.
-  if (ggx_brdf_ && ggx_proposal_->parts().coat.alpha == lobe->coat().alpha && ggx_proposal_->parts().coat.f0 == lobe->coat().f0) {
-    GgxBatchModel& m = batch_model_.emplace();
-    m.alpha = ggx->alpha();
-    m.smith = lobe->smith();
-    m.curve = lobe->curve() ? lobe->curve()->value.data() : nullptr;
-    m.f82_tint = lobe->f82_tint();
-    m.body = lobe->body();
-    m.coat = lobe->coat();
-    const ProposalParts& parts = ggx->parts();
-    m.weights = {lobe_weight_, parts.lobe, parts.body, parts.coat.present() ? parts.coat_weight() : 0.0};
-  }
-  // A tabulated lobe's visible slopes (model/visible_slopes.h): a LUT's own, or those of a measured
-  // table's fitted LUT (or of a Beckmann lobe's tabulated NDF), with f in the lanes where the BRDF is the
-  // LUT itself (a MERL-layout table's f in its own lanes).
-  const auto* slopes = dynamic_cast<const VisibleSlopeProposal*>(proposal_.get());
-  if (!batch_model_ && slopes && lobe_weight_ > 0.0) {
-    tabulated_batch_model_ = TabulatedBatchModel::of(*slopes, dynamic_cast<const TabulatedMicrofacet*>(brdf_.get()), lobe_weight_);
-    if (const auto* table = dynamic_cast<const MerlTable*>(brdf_.get())) merl_batch_model_ = MerlBatchModel::of(*table);
-  }
-  // The Lambert lanes hold Lambert's law alone, not Minnaert's.
-  if (const auto* lambert = dynamic_cast<const LambertBrdf*>(brdf_.get()); lambert && lambert->exponent() == 1.0 && lobe_weight_ == 0.0)
-    lambert_albedo_ = lambert->albedo();
+  const LanesInput in{*brdf_, proposal_.get(), lobe_weight_};
+  if ((ggx_brdf_ = ggx_drawn_by_itself(in))) ggx_proposal_ = static_cast<const GgxProposal*>(proposal_.get());
+  lanes_ = recognise_lanes(in);
+}
+
+bool ShadingModel::f_in_lanes() const {
+  return with_lanes(lanes_, [](const auto& backend) { return backend.f_in_lanes(); });
 }
 
 Rgb ShadingModel::f(const Vec3& o, const Vec3& i) const {
@@ -68,18 +58,10 @@ ShadingModel::Evaluation ShadingModel::eval(const Vec3& o, const Vec3& i) const 
 }
 
 void ShadingModel::eval(EvaluationBatch& batch, bool simd) const {
-  if (simd && batch_model_) return eval_ggx_batch(*batch_model_, batch);
-  if (simd && lambert_albedo_) return eval_lambert_batch(*lambert_albedo_, batch);
-  if (simd && tabulated_batch_model_) {
-    eval_tabulated_batch(*tabulated_batch_model_, batch, SimdTarget::best, tabulated_batch_model_->f);
-    if (tabulated_batch_model_->f) return;
-    if (merl_batch_model_) return eval_merl_batch(*merl_batch_model_, batch);
-    for (std::size_t k = 0; k < batch.size(); ++k) {
-      const Rgb v = f(batch.o(k), batch.i(k));
-      batch.r[k] = v.r, batch.g[k] = v.g, batch.b[k] = v.b;
-    }
-    return;
-  }
+  if (simd && with_lanes(lanes_, [&](const auto& backend) {
+    backend.eval(batch, *this);
+    return true;
+  })) return;
   for (std::size_t k = 0; k < batch.size(); ++k) {
     const Evaluation e = eval(batch.o(k), batch.i(k), batch.with_pdf[k] != 0.0);
     batch.r[k] = e.f.r, batch.g[k] = e.f.g, batch.b[k] = e.f.b, batch.pdf[k] = e.pdf;
@@ -87,9 +69,10 @@ void ShadingModel::eval(EvaluationBatch& batch, bool simd) const {
 }
 
 void ShadingModel::sample_directions(SampleBatch& batch, bool simd) const {
-  if (simd && batch_model_) return sample_ggx_batch(*batch_model_, batch);
-  if (simd && lambert_albedo_) return sample_lambert_batch(batch);
-  if (simd && tabulated_batch_model_) return sample_tabulated_batch(*tabulated_batch_model_, batch);
+  if (simd && with_lanes(lanes_, [&](const auto& backend) {
+    backend.sample(batch);
+    return true;
+  })) return;
   for (std::size_t k = 0; k < batch.size(); ++k) {
     const auto i = sample_direction(batch.o(k), batch.u1[k], batch.u2[k], batch.u3[k]);
     batch.found[k] = i ? 1.0 : 0.0;

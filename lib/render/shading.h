@@ -15,11 +15,8 @@
 #include "core/brdf.h"
 #include "model/ndf.h"
 #include "model/proposal.h"
-#include "render/ggx_batch.h"
-#include "render/lambert_batch.h"
-#include "render/merl_batch.h"
+#include "render/lanes.h"
 #include "render/shading_batch.h"
-#include "render/tabulated_batch.h"
 
 namespace facetfit {
 
@@ -43,19 +40,18 @@ class ShadingModel {
   // The same, or f alone (density zero) unless `with_pdf`: a measured or tabulated proposal's density costs
   // a lookup of its own, which a light's direction does not need.
   Evaluation eval(const Vec3& o, const Vec3& i, bool with_pdf) const { return with_pdf ? eval(o, i) : Evaluation{f(o, i), 0.0}; }
-  // eval() of every pair of the batch: in SIMD lanes for a GGX lobe (render/ggx_batch.h) or a tabulated
-  // lobe's visible slopes (render/tabulated_batch.h: the density, and f where the BRDF is the lobe itself;
-  // a MERL-layout table's f in render/merl_batch.h) unless `simd` is false, one pair at a time otherwise (the reference
-  // the lanes are tested against).
+  // eval() of every pair of the batch: in SIMD lanes where a back-end of render/lanes.h runs this model
+  // (wholly, or the proposal's density with f one pair at a time), unless `simd` is false; one pair at a
+  // time otherwise (the reference the lanes are tested against).
   void eval(EvaluationBatch& batch, bool simd = true) const;
-  // The lanes' model, where this one runs in them (tests call render/ggx_batch.h with it).
-  const std::optional<GgxBatchModel>& batch_model() const { return batch_model_; }
-  const std::optional<TabulatedBatchModel>& tabulated_batch_model() const { return tabulated_batch_model_; }
+  // The lanes back-end that runs this model, if it is a T (tests call its kernels with its model).
+  template <class T>
+  const T* lanes() const { return std::get_if<T>(&lanes_); }
   // Whether eval(EvaluationBatch&) and sample_directions() run in lanes (wholly or in part): a batch then
   // costs less than the pairs one by one.
-  bool has_lanes() const { return batch_model_ || tabulated_batch_model_ || lambert_albedo_; }
+  bool has_lanes() const { return !std::holds_alternative<std::monostate>(lanes_); }
   // Whether f itself runs in them too, not one pair at a time inside eval(EvaluationBatch&).
-  bool f_in_lanes() const { return batch_model_ || lambert_albedo_ || (tabulated_batch_model_ && (tabulated_batch_model_->f || merl_batch_model_)); }
+  bool f_in_lanes() const;
 
   using Sample = BrdfSample;
   std::optional<Sample> sample(const Vec3& o, double u1, double u2, double u3) const;
@@ -77,12 +73,7 @@ class ShadingModel {
   // and Lambda(o) once for f and pdf. Null otherwise.
   const ParametricBrdf* ggx_brdf_ = nullptr;
   const GgxProposal* ggx_proposal_ = nullptr;
-  std::optional<GgxBatchModel> batch_model_;  // the same lobe for eval(EvaluationBatch&)
-  // A tabulated lobe's visible slopes in lanes: their draws and density, and f too where the BRDF is the
-  // lobe itself.
-  std::optional<TabulatedBatchModel> tabulated_batch_model_;
-  std::optional<MerlBatchModel> merl_batch_model_;  // f of a MERL-layout table under a tabulated proposal
-  std::optional<Rgb> lambert_albedo_;  // a Lambertian surface sampled by the cosine alone (render/lambert_batch.h)
+  LanesBackend lanes_;  // none (std::monostate) where no back-end runs this model
 };
 
 }  // namespace facetfit

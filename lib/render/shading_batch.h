@@ -49,6 +49,18 @@ class Columns {
   std::size_t size_ = 0, capacity_ = 0;
 };
 
+class Brdf;
+class Proposal;
+class ShadingModel;
+
+// What a lanes back-end (render/lanes.h) recognises a model by: its BRDF, its proposal (null: the cosine
+// alone) and the probability of drawing from the proposal rather than the cosine.
+struct LanesInput {
+  const Brdf& brdf;
+  const Proposal* proposal;
+  double lobe_weight;
+};
+
 // How a shading model draws its directions, as the SIMD kernels read it (ShadingModel::sample_direction):
 // lobe_weight of the draws from the proposal, whose parts (ProposalParts, model/proposal.h) are the lobe,
 // the body's cosine and a coat's visible normals (part_coat 0 without a coat), the rest cosine sampling.

@@ -276,9 +276,29 @@ void EvalTabulatedBatch(const TabulatedBatchModel& model, EvaluationBatch& batch
 HWY_AFTER_NAMESPACE();
 
 #if HWY_ONCE
+#include "io/merl.h"
+#include "render/shading.h"
 #include "render/simd_dispatch.h"
 
 namespace facetfit {
+
+std::optional<TabulatedLanes> TabulatedLanes::recognise(const LanesInput& in) {
+  const auto* slopes = dynamic_cast<const VisibleSlopeProposal*>(in.proposal);
+  if (!slopes || !(in.lobe_weight > 0.0)) return std::nullopt;
+  TabulatedLanes lanes{TabulatedBatchModel::of(*slopes, dynamic_cast<const TabulatedMicrofacet*>(&in.brdf), in.lobe_weight), {}};
+  if (const auto* table = dynamic_cast<const MerlTable*>(&in.brdf)) lanes.merl = MerlBatchModel::of(*table);
+  return lanes;
+}
+
+void TabulatedLanes::eval(EvaluationBatch& batch, const ShadingModel& shading) const {
+  eval_tabulated_batch(model, batch, SimdTarget::best, model.f);
+  if (model.f) return;
+  if (merl) return eval_merl_batch(*merl, batch);
+  for (std::size_t k = 0; k < batch.size(); ++k) {
+    const Rgb v = shading.f(batch.o(k), batch.i(k));
+    batch.r[k] = v.r, batch.g[k] = v.g, batch.b[k] = v.b;
+  }
+}
 
 TabulatedBatchModel TabulatedBatchModel::of(const VisibleSlopeProposal& proposal, const TabulatedMicrofacet* lobe, double lobe_weight) {
   TabulatedBatchModel m;

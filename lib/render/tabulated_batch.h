@@ -15,6 +15,7 @@
 #include "core/vec.h"
 #include "model/coat.h"
 #include "model/smith.h"
+#include "render/merl_batch.h"
 #include "render/shading_batch.h"
 #include "render/simd_targets.h"
 
@@ -70,5 +71,18 @@ struct TabulatedBatchModel {
 void eval_tabulated_batch(const TabulatedBatchModel& model, EvaluationBatch& batch, SimdTarget target = SimdTarget::best, bool with_f = true);
 // Fills the batch's i and found for its padded_size() entries (ShadingModel::sample_direction).
 void sample_tabulated_batch(const TabulatedBatchModel& model, SampleBatch& batch, SimdTarget target = SimdTarget::best);
+
+// The lanes back-end (render/lanes.h) of a tabulated lobe's visible slopes (model/visible_slopes.h): a LUT's
+// own, or those of a measured table's fitted LUT (or of a Beckmann lobe's tabulated NDF). f in the lanes
+// where the BRDF is the LUT itself, or a MERL-layout table (render/merl_batch.h); else one pair at a time.
+struct TabulatedLanes {
+  TabulatedBatchModel model;
+  std::optional<MerlBatchModel> merl;
+
+  static std::optional<TabulatedLanes> recognise(const LanesInput& in);
+  bool f_in_lanes() const { return model.f || merl; }
+  void eval(EvaluationBatch& batch, const ShadingModel& shading) const;
+  void sample(SampleBatch& batch) const { sample_tabulated_batch(model, batch); }
+};
 
 }  // namespace facetfit
