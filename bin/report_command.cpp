@@ -22,7 +22,7 @@ namespace fs = std::filesystem;
 struct ReportArgs {
   std::vector<std::string> inputs;
   std::string out_dir, luts_dir;
-  int size = 128, spp = 32;
+  int size = ReportOptions{}.size, spp = ReportOptions{}.spp;
   std::string shard = "1/1";
   bool fail_on_regression = false;
   bool force = false;
