@@ -142,8 +142,8 @@ void utia_fit_section(std::ostringstream& md, const std::string& scratch) {
                         Case{0.45, 0.2, 34.38, Smith::masking}}) {
     const MicrofacetBrdf brdf(Ndf{NdfType::ggx, c.alpha_x, c.alpha_y}, c.smith, Fresnel::schlick(Rgb(0.9, 0.6, 0.3)));
     UtiaBrdf::tabulate(RotatedBrdf(brdf, c.degrees * kPi / 180.0)).write(scratch);
-    const MerlTable table = load_table(scratch);
-    MerlTable without = table;
+    const HalfDiffTable table = load_table(scratch);
+    HalfDiffTable without = table;
     without.set_source_backscatter({});
     const Fitter fitter = fitter_for(c.smith, 90);
     const FitResult fit = fitter.fit(table), from_table = fitter.fit(without);
@@ -205,7 +205,7 @@ void resolution_section(std::ostringstream& md) {
     const Fresnel gold = Fresnel::conductor({0.143, 0.374, 1.442}, {3.983, 2.385, 1.603});
     const GroundTruthError smooth = measure_ground_truth({NdfType::ggx, 0.02, Smith::correlated, gold}, fitter);
     const GroundTruthError rough = measure_ground_truth({NdfType::ggx, 0.7, Smith::correlated, gold}, fitter);
-    const MerlTable table = MerlTable::tabulate(MicrofacetBrdf(Ndf::isotropic(NdfType::ggx, 0.7), Smith::correlated, gold));
+    const HalfDiffTable table = HalfDiffTable::tabulate(MicrofacetBrdf(Ndf::isotropic(NdfType::ggx, 0.7), Smith::correlated, gold));
     std::vector<double> ms;
     for (int r = 0; r < 9; ++r) {
       const auto start = std::chrono::steady_clock::now();
@@ -221,16 +221,16 @@ void resolution_section(std::ostringstream& md) {
 }
 
 // f(k, k) of the green channel per theta_h bin, as backscatter_of does for luminance.
-Backscatter green_backscatter(const MerlTable& table) {
+Backscatter green_backscatter(const HalfDiffTable& table) {
   Backscatter back;
-  for (int i = 0; i < MerlTable::kThetaH; ++i) {
-    const float* row = table.channel(1) + MerlTable::index(i, 0, 0);
+  for (int i = 0; i < HalfDiffTable::kThetaH; ++i) {
+    const float* row = table.channel(1) + HalfDiffTable::index(i, 0, 0);
     double sum = 0.0;
     int n = 0;
-    for (int k = 0; k < MerlTable::kPhiD; ++k)
-      if (!MerlTable::missing(row[k])) sum += row[k], ++n;
+    for (int k = 0; k < HalfDiffTable::kPhiD; ++k)
+      if (!HalfDiffTable::missing(row[k])) sum += row[k], ++n;
     if (n == 0) continue;
-    back.theta.push_back(MerlTable::theta_h(i));
+    back.theta.push_back(HalfDiffTable::theta_h(i));
     back.value.push_back(sum / n);
   }
   return back;
@@ -276,7 +276,7 @@ void rgl_section(std::ostringstream& md, const std::string& folder) {
   std::ostringstream why;
   for (const fs::path& file : files) {
     const RglBsdf bsdf = RglBsdf::read(file.string());
-    const MerlTable table = MerlTable::tabulate(bsdf);
+    const HalfDiffTable table = HalfDiffTable::tabulate(bsdf);
     const auto file_ndf = [&](double theta) { return bsdf.measured_ndf(theta); };
     md << "| " << file.stem().string();
     std::string errors;

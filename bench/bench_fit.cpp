@@ -34,8 +34,8 @@ namespace facetfit {
 namespace {
 
 // One realistic material, tabulated once: GGX alpha 0.2, height-correlated, gold.
-const MerlTable& gold() {
-  static const MerlTable table = MerlTable::tabulate(MicrofacetBrdf(
+const HalfDiffTable& gold() {
+  static const HalfDiffTable table = HalfDiffTable::tabulate(MicrofacetBrdf(
       Ndf::isotropic(NdfType::ggx, 0.2), Smith::correlated, Fresnel::conductor({0.143, 0.374, 1.442}, {3.983, 2.385, 1.603})));
   return table;
 }
@@ -49,9 +49,9 @@ std::unique_ptr<tbb::global_control> limit_threads(const benchmark::State& state
 void BM_ReadMerl(benchmark::State& state) {
   const std::string path = (std::filesystem::temp_directory_path() / "facetfit-bench-gold.binary").string();
   gold().write(path);
-  for (auto _ : state) benchmark::DoNotOptimize(MerlTable::read(path));
+  for (auto _ : state) benchmark::DoNotOptimize(HalfDiffTable::read(path));
   std::filesystem::remove(path);
-  state.SetBytesProcessed(int64_t(state.iterations()) * int64_t(MerlTable::kFileBytes));
+  state.SetBytesProcessed(int64_t(state.iterations()) * int64_t(HalfDiffTable::kFileBytes));
 }
 BENCHMARK(BM_ReadMerl)->Unit(benchmark::kMillisecond);
 
@@ -69,8 +69,8 @@ BENCHMARK(BM_Fit)->ArgNames({"threads", "resolution"})
 
 // A real measurement: one RGL material, from FACETFIT_RGL_DIR or ../shared/data/rgl (run from the
 // repository's root, as make bench does).
-const MerlTable* rgl_material(const char* name) {
-  static std::map<std::string, std::optional<MerlTable>> cache;
+const HalfDiffTable* rgl_material(const char* name) {
+  static std::map<std::string, std::optional<HalfDiffTable>> cache;
   auto [it, added] = cache.try_emplace(name);
   if (added) {
     const char* env = std::getenv("FACETFIT_RGL_DIR");
@@ -95,16 +95,16 @@ BENCHMARK(BM_LoadRgl)->ArgName("threads")->Arg(1)->Unit(benchmark::kMillisecond)
 // table (the anchor): extraction, parametric fits, refinement, every distance.
 // The RGL material the benchmark's second argument names (0: acrylic_felt_green_rgb, 1:
 // ilm_l3_37_metallic_rgb), or null after skipping the benchmark without the data.
-const MerlTable* rgl_material_of(benchmark::State& state, const char** name) {
+const HalfDiffTable* rgl_material_of(benchmark::State& state, const char** name) {
   *name = state.range(1) == 0 ? "acrylic_felt_green_rgb" : "ilm_l3_37_metallic_rgb";
-  const MerlTable* table = rgl_material(*name);
+  const HalfDiffTable* table = rgl_material(*name);
   if (!table) state.SkipWithError("no RGL data: set FACETFIT_RGL_DIR");
   return table;
 }
 
 void BM_FitRgl(benchmark::State& state) {
   const char* name = nullptr;
-  const MerlTable* table = rgl_material_of(state, &name);
+  const HalfDiffTable* table = rgl_material_of(state, &name);
   if (!table) return;
   const auto threads = limit_threads(state);
   FitOptions options;
@@ -122,7 +122,7 @@ BENCHMARK(BM_FitRgl)->ArgNames({"threads", "material", "refine"})
 // closures add to a fit (the bar: at most 50% of the rest).
 void BM_ClosureFit(benchmark::State& state) {
   const char* name = nullptr;
-  const MerlTable* table = rgl_material_of(state, &name);
+  const HalfDiffTable* table = rgl_material_of(state, &name);
   if (!table) return;
   const auto threads = limit_threads(state);
   const FitResult fit = Fitter(FitOptions{}).fit(*table);
@@ -171,7 +171,7 @@ void BM_FresnelPass(benchmark::State& state) {
   const Fitter fitter(FitOptions::paper());
   const FitResult fit = fitter.fit(gold());
   for (auto _ : state) benchmark::DoNotOptimize(fit_fresnel(gold(), fit.ndf(), Smith::correlated));
-  state.SetBytesProcessed(int64_t(state.iterations()) * int64_t(3 * MerlTable::kBins * sizeof(float)));
+  state.SetBytesProcessed(int64_t(state.iterations()) * int64_t(3 * HalfDiffTable::kBins * sizeof(float)));
 }
 BENCHMARK(BM_FresnelPass)->ArgName("threads")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 
@@ -191,7 +191,7 @@ BENCHMARK(BM_RefineAlpha)->Unit(benchmark::kMillisecond);
 
 void BM_TabulateAnalytic(benchmark::State& state) {
   const MicrofacetBrdf brdf(Ndf::isotropic(NdfType::ggx, 0.2), Smith::correlated, Fresnel::schlick(Rgb(0.9)));
-  for (auto _ : state) benchmark::DoNotOptimize(MerlTable::tabulate(brdf));
+  for (auto _ : state) benchmark::DoNotOptimize(HalfDiffTable::tabulate(brdf));
 }
 BENCHMARK(BM_TabulateAnalytic)->Unit(benchmark::kMillisecond);
 
@@ -210,7 +210,7 @@ void BM_LoadUtia(benchmark::State& state) {
 }
 BENCHMARK(BM_LoadUtia)->Unit(benchmark::kMillisecond);
 void BM_FitUtia(benchmark::State& state) {
-  const MerlTable table = load_table(utia_file());
+  const HalfDiffTable table = load_table(utia_file());
   FitOptions options;
   options.refine = state.range(0) ? FitOptions::Refine::full : FitOptions::Refine::none;
   const Fitter fitter(options);
@@ -222,7 +222,7 @@ BENCHMARK(BM_FitUtia)->ArgName("refine")->Arg(0)->Arg(1)->Unit(benchmark::kMilli
 // BM_FitUtia/refine:1 the anisotropic input adds (twice: GGX and Beckmann).
 void BM_FitAnisotropicLobe(benchmark::State& state) {
   const auto limit = limit_threads(state);
-  const MerlTable table = load_table(utia_file());
+  const HalfDiffTable table = load_table(utia_file());
   const MeasuredBins solve = anisotropic_bins(table, 24), all = anisotropic_bins(table, 1);
   AnisotropicParametricFit start;
   start.alpha = {0.5, 0.3, 0.2};
@@ -369,7 +369,7 @@ BENCHMARK(BM_Bake)->ArgName("threads")->Arg(1)->Arg(0)->Unit(benchmark::kMillise
 void BM_Sha256File(benchmark::State& state) {
   gold_file();
   for (auto _ : state) benchmark::DoNotOptimize(sha256_file(gold_file()));
-  state.SetBytesProcessed(int64_t(state.iterations()) * int64_t(MerlTable::kFileBytes));
+  state.SetBytesProcessed(int64_t(state.iterations()) * int64_t(HalfDiffTable::kFileBytes));
 }
 BENCHMARK(BM_Sha256File)->Unit(benchmark::kMillisecond);
 

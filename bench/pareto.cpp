@@ -49,7 +49,7 @@ int main(int argc, char** argv) {
     const RenderedImage reference = render(scene_of(measured, 1024, 99));
     std::vector<bool> mask(std::size_t(reference.width) * reference.height);
     for (std::size_t p = 0; p < mask.size(); ++p) mask[p] = reference.rgba[4 * p + 3] >= 1.0f;
-    const MerlTable table = load_table(material);
+    const HalfDiffTable table = load_table(material);
     const DisplayTransform display;
     const std::string tmp = (fs::temp_directory_path() / "facetfit-pareto.exr").string();
     std::vector<Point> points;

@@ -4,7 +4,7 @@
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   return facetfit::fuzz::run(data, size, ".binary", [](const std::string& path) {
-    for (const auto at : {facetfit::MerlTable::BinPoint::start, facetfit::MerlTable::BinPoint::center})
-      (void)facetfit::MerlTable::read(path, at);
+    for (const auto at : {facetfit::HalfDiffTable::BinPoint::start, facetfit::HalfDiffTable::BinPoint::center})
+      (void)facetfit::HalfDiffTable::read(path, at);
   });
 }

@@ -55,10 +55,10 @@ TEST(MerlBins, GroundTruthWrittenEitherWayComesBack) {
   const Fitter fitter(FitOptions::paper());
   for (const double alpha : {0.1, 0.4, 0.7}) {
     const MicrofacetBrdf truth(Ndf::isotropic(NdfType::ggx, alpha), Smith::correlated, Fresnel::schlick(Rgb(0.04)));
-    for (const auto written : {MerlTable::BinPoint::start, MerlTable::BinPoint::center}) {
+    for (const auto written : {HalfDiffTable::BinPoint::start, HalfDiffTable::BinPoint::center}) {
       const std::string file = dir.file(std::string(to_string(written)) + ".binary");
-      MerlTable::tabulate(truth, written).write(file);
-      for (const auto read : {MerlTable::BinPoint::start, MerlTable::BinPoint::center}) {
+      HalfDiffTable::tabulate(truth, written).write(file);
+      for (const auto read : {HalfDiffTable::BinPoint::start, HalfDiffTable::BinPoint::center}) {
         const FitResult r = fitter.fit(load_table(file, read));
         ASSERT_TRUE(r.ok()) << r.problem;
         const double error = std::abs(r.alpha_ggx / alpha - 1.0);

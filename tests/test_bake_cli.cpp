@@ -35,8 +35,8 @@ nlohmann::json read_json(const std::string& path) {
 TEST(Bake, WarningsDoNotOverwriteTheProgressBar) {
   if (test::run_command("command -v script >/dev/null").status != 0) GTEST_SKIP() << "no script(1) to give the command a terminal";
   TempDir dir;
-  MerlTable::tabulate(LambertBrdf(Rgb(1.3, 0.3, 0.1))).write(dir.file("bright.binary"));  // albedo above 1: warnings
-  MerlTable::tabulate(LambertBrdf(Rgb(0.5))).write(dir.file("plain.binary"));
+  HalfDiffTable::tabulate(LambertBrdf(Rgb(1.3, 0.3, 0.1))).write(dir.file("bright.binary"));  // albedo above 1: warnings
+  HalfDiffTable::tabulate(LambertBrdf(Rgb(0.5))).write(dir.file("plain.binary"));
   const RunResult r = test::run_command("script -qec \"" + std::string(FACETFIT_CLI) + " bake " + dir.file("bright.binary") + " " +
                                         dir.file("plain.binary") + " --refine none -o " + dir.file("out") + "\" /dev/null");
   ASSERT_EQ(r.status, 0) << r.out << r.err;

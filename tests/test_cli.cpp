@@ -41,12 +41,12 @@ TEST_P(CliBadFile, OneClearLine) {
   if (name == "dims.binary") test::write_bytes(path, test::merl_header(90, 90, 90) + std::string(4096, '\0'));
   if (name == "huge.binary") test::write_bytes(path, test::merl_header(1000, 1000, 1000));
   if (name == "nan.binary") {
-    std::string bytes = test::merl_header(90, 90, 180) + std::string(3 * MerlTable::kBins * 8, '\0');
+    std::string bytes = test::merl_header(90, 90, 180) + std::string(3 * HalfDiffTable::kBins * 8, '\0');
     std::memset(bytes.data() + 12 + 8 * 1000, 0xff, 8);  // all ones: a NaN
     test::write_bytes(path, bytes);
   }
   if (name == "big.binary") {  // a single 1e308, finite as a double, not as the table's float (issue 47)
-    std::string bytes = test::merl_header(90, 90, 180) + std::string(3 * MerlTable::kBins * 8, '\0');
+    std::string bytes = test::merl_header(90, 90, 180) + std::string(3 * HalfDiffTable::kBins * 8, '\0');
     const double big = 1e308;
     std::memcpy(bytes.data() + 12 + 8 * 1000, &big, 8);
     test::write_bytes(path, bytes);
@@ -97,7 +97,7 @@ TEST(Cli, WithoutThePluginCoreCommandsRunAndOthersFailInOneLine) {
 TEST(Cli, InfoPrintsMetadataAsText) {
   TempDir dir;
   const Fitter fitter{FitOptions::paper()};
-  write_lut(dir.file("evil.exr"), make_lut(fitter.fit(MerlTable::tabulate(LambertBrdf(Rgb(0.5)))), fitter.quadrature(),
+  write_lut(dir.file("evil.exr"), make_lut(fitter.fit(HalfDiffTable::tabulate(LambertBrdf(Rgb(0.5)))), fitter.quadrature(),
                                            "evil\x1b[2J\nforged line", "x", 0.02, false));
   const RunResult r = facetfit("info " + dir.file("evil.exr"));
   ASSERT_EQ(r.status, 0) << r.err;
@@ -314,9 +314,9 @@ TEST(Cli, ConvertIntoReadOnlyFolderFailsCleanly) {
 TEST(Cli, MeaninglessFitIsReportedWithNulls) {
   TempDir dir;
   // A table with every measurement zero.
-  MerlTable table;
+  HalfDiffTable table;
   for (int c = 0; c < 3; ++c)
-    for (std::size_t n = 0; n < MerlTable::kBins; ++n) table.channel(c)[n] = 0.0f;
+    for (std::size_t n = 0; n < HalfDiffTable::kBins; ++n) table.channel(c)[n] = 0.0f;
   table.write(dir.file("zero.binary"));
   const RunResult r = facetfit("fit " + dir.file("zero.binary") + " --json");
   EXPECT_EQ(r.status, 1);

@@ -198,7 +198,7 @@ TEST(ClosureFit, MomentTableAgreesWithTheDirectSum) {
 }
 
 TEST(ClosureFit, DerivativesMatchDifferences) {
-  const MeasuredBins bins = measured_bins(MerlTable::tabulate(ClosureBrdf(two_lobes())), 18, 90);
+  const MeasuredBins bins = measured_bins(HalfDiffTable::tabulate(ClosureBrdf(two_lobes())), 18, 90);
   Closures at = two_lobes();
   at.coat = Coat{0.04, 0.05};
   at.lobes[0].alpha_x = at.lobes[0].alpha_y = 0.1;  // away from the optimum: nonzero residuals
@@ -216,7 +216,7 @@ TEST(ClosureFit, DerivativesMatchDifferences) {
 TEST(ClosureFit, RecoversATwoLobeMixtureWrittenInMerl) {
   TempDir dir;
   const Closures truth = two_lobes();
-  MerlTable::tabulate(ClosureBrdf(truth)).write(dir.file("mix.binary"));
+  HalfDiffTable::tabulate(ClosureBrdf(truth)).write(dir.file("mix.binary"));
   const FitResult fit = Fitter(FitOptions{}).fit(load_table(dir.file("mix.binary")));
   ASSERT_TRUE(fit.ok()) << fit.problem;
   const Closures& c = fit.closures.closures;
@@ -242,7 +242,7 @@ TEST(ClosureFit, RecoversATwoLobeMixtureWrittenInMerl) {
 TEST(ClosureFit, OneLobeStaysOneLobe) {
   // A material that is one GGX lobe gets no second: no lobe that does not pay for itself.
   const FitResult fit = Fitter(FitOptions{}).fit(
-      MerlTable::tabulate(MicrofacetBrdf(Ndf::isotropic(NdfType::ggx, 0.2), Smith::correlated, Fresnel::schlick(Rgb(0.9, 0.6, 0.3)))));
+      HalfDiffTable::tabulate(MicrofacetBrdf(Ndf::isotropic(NdfType::ggx, 0.2), Smith::correlated, Fresnel::schlick(Rgb(0.9, 0.6, 0.3)))));
   ASSERT_TRUE(fit.ok()) << fit.problem;
   ASSERT_EQ(fit.closures.closures.lobes.size(), 1u);
   EXPECT_NEAR(fit.closures.closures.lobes[0].alpha_x, 0.2, 0.006);
@@ -260,7 +260,7 @@ TEST(ClosureFit, SchlickOnlyClosuresHaveNoF82Term) {
   lobe.f0 = Rgb(0.9, 0.6, 0.3);
   lobe.f82 = Rgb(0.5, 0.5, 0.5);
   truth.lobes = {lobe};
-  const MerlTable table = MerlTable::tabulate(ClosureBrdf(truth));
+  const HalfDiffTable table = HalfDiffTable::tabulate(ClosureBrdf(truth));
   FitOptions options;
   options.closure_fresnel = ClosureLobe::Fresnel::schlick;
   const FitResult schlick = Fitter(options).fit(table), f82 = Fitter(FitOptions{}).fit(table);

@@ -11,11 +11,11 @@
 namespace facetfit {
 namespace {
 
-MerlTable table_of(NdfType type, double alpha, Smith smith, const Fresnel& fresnel = Fresnel::schlick(Rgb(0.9, 0.6, 0.3))) {
-  return MerlTable::tabulate(MicrofacetBrdf(Ndf::isotropic(type, alpha), smith, fresnel));
+HalfDiffTable table_of(NdfType type, double alpha, Smith smith, const Fresnel& fresnel = Fresnel::schlick(Rgb(0.9, 0.6, 0.3))) {
+  return HalfDiffTable::tabulate(MicrofacetBrdf(Ndf::isotropic(type, alpha), smith, fresnel));
 }
 
-FitResult fit_with(const MerlTable& table, Smith smith, int max_iterations = 1000) {
+FitResult fit_with(const HalfDiffTable& table, Smith smith, int max_iterations = 1000) {
   FitOptions options = FitOptions::paper();
   options.smith = smith;
   options.max_iterations = max_iterations;
@@ -48,7 +48,7 @@ TEST(Extract, NormalizedAndSigmaConsistent) {
 
 TEST(Extract, SigmaMatchesTheAnalyticProjectedArea) {
   const Ndf ndf = Ndf::isotropic(NdfType::ggx, 0.5);
-  const FitResult r = fit_with(MerlTable::tabulate(MicrofacetBrdf(ndf, Smith::correlated, Fresnel::one())), Smith::correlated);
+  const FitResult r = fit_with(HalfDiffTable::tabulate(MicrofacetBrdf(ndf, Smith::correlated, Fresnel::one())), Smith::correlated);
   for (int j = 0; j < r.ndf().grid.size(); ++j) {
     const double theta = r.ndf().grid.theta(j);
     EXPECT_NEAR(r.ndf().sigma[std::size_t(j)], ndf.sigma(spherical_direction(theta, 0.0)), 2e-4) << "theta " << theta;
@@ -58,7 +58,7 @@ TEST(Extract, SigmaMatchesTheAnalyticProjectedArea) {
 TEST(Extract, MismatchedSmithBiasesRoughness) {
   // The reference implementation extracts with the masking assumption whatever made the data. On
   // height-correlated data that underestimates alpha of rough materials; the matching model does not.
-  const MerlTable table = table_of(NdfType::ggx, 0.7, Smith::correlated);
+  const HalfDiffTable table = table_of(NdfType::ggx, 0.7, Smith::correlated);
   const FitResult mismatched = fit_with(table, Smith::masking);
   const FitResult matched = fit_with(table, Smith::correlated);
   EXPECT_LT(mismatched.alpha_ggx, 0.67);
@@ -67,7 +67,7 @@ TEST(Extract, MismatchedSmithBiasesRoughness) {
 
 TEST(Extract, FourIterationsAreNotEnoughForRoughMaterials) {
   // dj_brdf stops after four iterations. Rough materials need more to converge.
-  const MerlTable table = table_of(NdfType::ggx, 1.0, Smith::correlated);
+  const HalfDiffTable table = table_of(NdfType::ggx, 1.0, Smith::correlated);
   const FitResult four = fit_with(table, Smith::correlated, 4);
   const FitResult converged = fit_with(table, Smith::correlated);
   EXPECT_FALSE(four.extraction.converged);
@@ -76,7 +76,7 @@ TEST(Extract, FourIterationsAreNotEnoughForRoughMaterials) {
 }
 
 TEST(Extract, ResolutionsAgree) {
-  const MerlTable table = table_of(NdfType::ggx, 0.3, Smith::correlated);
+  const HalfDiffTable table = table_of(NdfType::ggx, 0.3, Smith::correlated);
   for (int resolution : {32, 64, 90, 128, 256}) {
     FitOptions options = FitOptions::paper();
     options.resolution = resolution;

@@ -30,7 +30,7 @@ Baked fit_of(const Brdf& brdf, Smith smith = Smith::correlated) {
   FitOptions options = FitOptions::paper();
   options.smith = smith;
   Baked b{Fitter(options), {}};
-  b.fit = b.fitter.fit(MerlTable::tabulate(brdf));
+  b.fit = b.fitter.fit(HalfDiffTable::tabulate(brdf));
   return b;
 }
 
@@ -169,11 +169,11 @@ TEST(Lut, ADarkChannelOfNegativeNoiseBakesAndReadsBack) {
   // Blue is noise around a slightly negative mean (RGL's dark channels): the paper's Fresnel ratio
   // would be negative there; the curve is clamped at zero and the LUT reads back (a negative f0 is
   // refused on reading).
-  MerlTable table = MerlTable::tabulate(MicrofacetBrdf(Ndf::isotropic(NdfType::ggx, 0.2), Smith::correlated, Fresnel::one()));
+  HalfDiffTable table = HalfDiffTable::tabulate(MicrofacetBrdf(Ndf::isotropic(NdfType::ggx, 0.2), Smith::correlated, Fresnel::one()));
   std::mt19937 rng(7);
   std::normal_distribution<float> noise(-0.002f, 0.01f);
   float* blue = table.channel(2);
-  for (std::size_t n = 0; n < MerlTable::kBins; ++n) blue[n] = noise(rng);
+  for (std::size_t n = 0; n < HalfDiffTable::kBins; ++n) blue[n] = noise(rng);
   for (const FitOptions& options : {FitOptions::paper(), FitOptions{}}) {
     const FitResult fit = Fitter(options).fit(table);
     ASSERT_TRUE(fit.ok()) << fit.problem;

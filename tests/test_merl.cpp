@@ -18,22 +18,22 @@ namespace {
 using test::error_of;
 using test::TempDir;
 
-MerlTable gold_table() {
-  return MerlTable::tabulate(MicrofacetBrdf(Ndf::isotropic(NdfType::ggx, 0.3), Smith::correlated,
+HalfDiffTable gold_table() {
+  return HalfDiffTable::tabulate(MicrofacetBrdf(Ndf::isotropic(NdfType::ggx, 0.3), Smith::correlated,
                                             Fresnel::conductor({0.143, 0.374, 1.442}, {3.983, 2.385, 1.603})));
 }
 
 TEST(Merl, WriteReadRoundTripIsExactToFloat) {
   TempDir dir;
-  const MerlTable table = gold_table();
+  const HalfDiffTable table = gold_table();
   table.write(dir.file("gold.binary"));
-  EXPECT_EQ(std::filesystem::file_size(dir.file("gold.binary")), MerlTable::kFileBytes);
-  const MerlTable back = MerlTable::read(dir.file("gold.binary"));
+  EXPECT_EQ(std::filesystem::file_size(dir.file("gold.binary")), HalfDiffTable::kFileBytes);
+  const HalfDiffTable back = HalfDiffTable::read(dir.file("gold.binary"));
   for (int c = 0; c < 3; ++c)
-    for (std::size_t n = 0; n < MerlTable::kBins; n += 97) {
+    for (std::size_t n = 0; n < HalfDiffTable::kBins; n += 97) {
       const float a = table.channel(c)[n], b = back.channel(c)[n];
-      if (MerlTable::missing(a)) {
-        EXPECT_TRUE(MerlTable::missing(b));
+      if (HalfDiffTable::missing(a)) {
+        EXPECT_TRUE(HalfDiffTable::missing(b));
       } else {
         EXPECT_NEAR(a, b, 1e-6f * std::max(1.0f, a));
       }
@@ -44,26 +44,26 @@ TEST(Merl, WriteReadRoundTripIsExactToFloat) {
 
 TEST(Merl, ChannelScalesAndLayoutFollowTheReferenceReader) {
   TempDir dir;
-  MerlTable table;
+  HalfDiffTable table;
   table.set(10, 20, 30, Rgb(1.0, 2.0, 3.0));
   table.write(dir.file("t.binary"));
   const std::string bytes = test::read_bytes(dir.file("t.binary"));
-  const std::size_t n = MerlTable::index(10, 20, 30);
+  const std::size_t n = HalfDiffTable::index(10, 20, 30);
   EXPECT_EQ(n, std::size_t(30 + 180 * 20 + 180 * 90 * 10));
   double stored[3];
   for (int c = 0; c < 3; ++c)
-    std::memcpy(&stored[c], bytes.data() + 12 + (std::size_t(c) * MerlTable::kBins + n) * 8, 8);
+    std::memcpy(&stored[c], bytes.data() + 12 + (std::size_t(c) * HalfDiffTable::kBins + n) * 8, 8);
   EXPECT_NEAR(stored[0], 1.0 * 1500.0, 1e-9);
   EXPECT_NEAR(stored[1], 2.0 * 1500.0 / 1.15, 1e-9);
   EXPECT_NEAR(stored[2], 3.0 * 1500.0 / 1.66, 1e-9);
 }
 
 TEST(Merl, NearestLookupTruncatesLikeTheReferenceReader) {
-  MerlTable table;
-  for (int i = 0; i < MerlTable::kThetaH; ++i)
-    for (int j = 0; j < MerlTable::kThetaD; ++j)
-      for (int k = 0; k < MerlTable::kPhiD; ++k) table.set(i, j, k, Rgb(i, j, k));
-  table.set_lookup(MerlTable::Lookup::nearest);
+  HalfDiffTable table;
+  for (int i = 0; i < HalfDiffTable::kThetaH; ++i)
+    for (int j = 0; j < HalfDiffTable::kThetaD; ++j)
+      for (int k = 0; k < HalfDiffTable::kPhiD; ++k) table.set(i, j, k, Rgb(i, j, k));
+  table.set_lookup(HalfDiffTable::Lookup::nearest);
   // Just inside bin (12, 34, 56) of each axis.
   const double th = std::pow((12 + 0.9) / 90.0, 2) * 0.5 * kPi, td = (34 + 0.9) / 90.0 * 0.5 * kPi,
                pd = (56 + 0.9) / 180.0 * kPi;
@@ -75,10 +75,10 @@ TEST(Merl, NearestLookupTruncatesLikeTheReferenceReader) {
 }
 
 TEST(Merl, LinearLookupInterpolatesAndSkipsMissingBins) {
-  MerlTable table;
-  for (int i = 0; i < MerlTable::kThetaH; ++i)
-    for (int j = 0; j < MerlTable::kThetaD; ++j)
-      for (int k = 0; k < MerlTable::kPhiD; ++k) table.set(i, j, k, Rgb(i + 2.0 * j + 0.5 * k));
+  HalfDiffTable table;
+  for (int i = 0; i < HalfDiffTable::kThetaH; ++i)
+    for (int j = 0; j < HalfDiffTable::kThetaD; ++j)
+      for (int k = 0; k < HalfDiffTable::kPhiD; ++k) table.set(i, j, k, Rgb(i + 2.0 * j + 0.5 * k));
   // Halfway along theta_d between bins 40 and 41: the mean of the two.
   const double th = std::pow(30.0 / 90.0, 2) * 0.5 * kPi, pd = 50.0 / 180.0 * kPi;
   auto [o, i] = from_half_diff(th, 40.5 / 90.0 * 0.5 * kPi, pd);
@@ -97,22 +97,22 @@ TEST(Merl, LinearLookupInterpolatesAndSkipsMissingBins) {
 // MERL files mark missing bins with negative numbers; in memory a missing bin is NaN.
 TEST(Merl, NegativeFileEntriesAreMissing) {
   TempDir dir;
-  MerlTable table = gold_table();
+  HalfDiffTable table = gold_table();
   table.write(dir.file("a.binary"));
   std::string bytes = test::read_bytes(dir.file("a.binary"));
   const double minus_one = -1.0;
-  std::memcpy(bytes.data() + 12 + MerlTable::index(5, 6, 7) * 8, &minus_one, 8);
+  std::memcpy(bytes.data() + 12 + HalfDiffTable::index(5, 6, 7) * 8, &minus_one, 8);
   test::write_bytes(dir.file("b.binary"), bytes);
-  const MerlTable back = MerlTable::read(dir.file("b.binary"));
-  EXPECT_TRUE(MerlTable::missing(back.value(0, 5, 6, 7)));
-  EXPECT_FALSE(MerlTable::missing(back.value(1, 5, 6, 7)));
+  const HalfDiffTable back = HalfDiffTable::read(dir.file("b.binary"));
+  EXPECT_TRUE(HalfDiffTable::missing(back.value(0, 5, 6, 7)));
+  EXPECT_FALSE(HalfDiffTable::missing(back.value(1, 5, 6, 7)));
 }
 
 // A negative value tabulated in memory (RGL noise) is a measurement: kept, read back by eval.
 TEST(Merl, NegativeMeasurementsStay) {
-  MerlTable table = gold_table();
+  HalfDiffTable table = gold_table();
   table.set(5, 6, 7, Rgb(-0.01, 0.2, -0.02));
-  EXPECT_FALSE(MerlTable::missing(table.value(0, 5, 6, 7)));
+  EXPECT_FALSE(HalfDiffTable::missing(table.value(0, 5, 6, 7)));
   EXPECT_FLOAT_EQ(table.value(0, 5, 6, 7), -0.01f);
   EXPECT_FLOAT_EQ(table.value(2, 5, 6, 7), -0.02f);
 }
@@ -123,18 +123,18 @@ class MerlBadFile : public testing::Test {
   std::string read_error(const std::string& bytes) {
     const std::string path = dir.file("bad.binary");
     test::write_bytes(path, bytes);
-    return error_of([&] { MerlTable::read(path); });
+    return error_of([&] { HalfDiffTable::read(path); });
   }
   TempDir dir;
 };
 
 TEST_F(MerlBadFile, Missing) {
-  const std::string msg = error_of([&] { MerlTable::read(dir.file("nope.binary")); });
+  const std::string msg = error_of([&] { HalfDiffTable::read(dir.file("nope.binary")); });
   EXPECT_NE(msg.find("nope.binary: cannot open"), std::string::npos) << msg;
 }
 
 TEST_F(MerlBadFile, Folder) {
-  const std::string msg = error_of([&] { MerlTable::read(dir.path().string()); });
+  const std::string msg = error_of([&] { HalfDiffTable::read(dir.path().string()); });
   EXPECT_NE(msg.find("is a folder"), std::string::npos) << msg;
 }
 
@@ -158,25 +158,25 @@ TEST_F(MerlBadFile, Truncated) {
 }
 
 TEST_F(MerlBadFile, TrailingData) {
-  const std::string msg = read_error(test::merl_header(90, 90, 180) + std::string(3 * MerlTable::kBins * 8 + 8, '\0'));
+  const std::string msg = read_error(test::merl_header(90, 90, 180) + std::string(3 * HalfDiffTable::kBins * 8 + 8, '\0'));
   EXPECT_NE(msg.find("(trailing data)"), std::string::npos) << msg;
 }
 
 TEST_F(MerlBadFile, NanPayloadNamesTheOffset) {
-  std::string bytes = test::merl_header(90, 90, 180) + std::string(3 * MerlTable::kBins * 8, '\0');
+  std::string bytes = test::merl_header(90, 90, 180) + std::string(3 * HalfDiffTable::kBins * 8, '\0');
   const double nan = std::numeric_limits<double>::quiet_NaN();
-  const std::size_t bin = MerlTable::index(3, 4, 5);
-  std::memcpy(bytes.data() + 12 + (MerlTable::kBins + bin) * 8, &nan, 8);
+  const std::size_t bin = HalfDiffTable::index(3, 4, 5);
+  std::memcpy(bytes.data() + 12 + (HalfDiffTable::kBins + bin) * 8, &nan, 8);
   const std::string msg = read_error(bytes);
-  EXPECT_NE(msg.find("NaN at byte offset " + std::to_string(12 + (MerlTable::kBins + bin) * 8)), std::string::npos) << msg;
+  EXPECT_NE(msg.find("NaN at byte offset " + std::to_string(12 + (HalfDiffTable::kBins + bin) * 8)), std::string::npos) << msg;
   EXPECT_NE(msg.find("green channel, bin theta_h 3, theta_d 4, phi_d 5"), std::string::npos) << msg;
   EXPECT_EQ(msg.find('\n'), std::string::npos);
 }
 
 TEST_F(MerlBadFile, InfPayloadInTheLastChannel) {
-  std::string bytes = test::merl_header(90, 90, 180) + std::string(3 * MerlTable::kBins * 8, '\0');
+  std::string bytes = test::merl_header(90, 90, 180) + std::string(3 * HalfDiffTable::kBins * 8, '\0');
   const double inf = -std::numeric_limits<double>::infinity();
-  const std::size_t last = 3 * MerlTable::kBins - 1;
+  const std::size_t last = 3 * HalfDiffTable::kBins - 1;
   std::memcpy(bytes.data() + 12 + last * 8, &inf, 8);
   const std::string msg = read_error(bytes);
   EXPECT_NE(msg.find("Inf at byte offset " + std::to_string(12 + last * 8) + " (blue channel, bin theta_h 89, theta_d 89, phi_d 179)"),
@@ -186,7 +186,7 @@ TEST_F(MerlBadFile, InfPayloadInTheLastChannel) {
 
 TEST_F(MerlBadFile, WriteIntoMissingFolderNamesTheTarget) {
   const std::string target = dir.file("no/such/folder/x.binary");
-  const std::string msg = error_of([&] { MerlTable().write(target); });
+  const std::string msg = error_of([&] { HalfDiffTable().write(target); });
   EXPECT_NE(msg.find(target), std::string::npos) << msg;
 }
 

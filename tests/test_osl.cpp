@@ -298,7 +298,7 @@ class OslModel : public ::testing::TestWithParam<std::string> {
     ASSERT_EQ(masking.status, 0) << masking.err;
     // A body darker toward grazing angles (Minnaert's exponent 1.4, model/body.h): format 4's attribute, in a
     // format 5 LUT.
-    MerlTable::tabulate(SumBrdf({std::make_shared<LambertBrdf>(Rgb(0.5, 0.3, 0.1), 1.4),
+    HalfDiffTable::tabulate(SumBrdf({std::make_shared<LambertBrdf>(Rgb(0.5, 0.3, 0.1), 1.4),
                                  std::make_shared<MicrofacetBrdf>(Ndf::isotropic(NdfType::ggx, 0.2), Smith::correlated,
                                                                   Fresnel::schlick(Rgb(0.04)))}))
         .write(file("minnaert-ggx-0.20.binary"));

@@ -28,7 +28,7 @@ TEST(Plausibility, DirectionalAlbedoOfLambertIsItsAlbedo) {
 
 TEST(Plausibility, APlausibleMaterialHasNoWarning) {
   const SumBrdf truth({std::make_shared<LambertBrdf>(Rgb(0.5, 0.3, 0.1)), ggx(0.2, Fresnel::schlick(Rgb(0.04)))});
-  const FitResult r = Fitter(FitOptions{}).fit(MerlTable::tabulate(truth));
+  const FitResult r = Fitter(FitOptions{}).fit(HalfDiffTable::tabulate(truth));
   ASSERT_TRUE(r.ok()) << r.problem;
   EXPECT_TRUE(r.warnings.empty()) << r.warnings.front();
 }
@@ -36,18 +36,18 @@ TEST(Plausibility, APlausibleMaterialHasNoWarning) {
 TEST(Plausibility, AlbedoAboveOneAndFresnelAboveOneAreReported) {
   // A body of albedo 1.3 in red: more light out than in, at every angle.
   const SumBrdf truth({std::make_shared<LambertBrdf>(Rgb(1.3, 0.3, 0.1)), ggx(0.2, Fresnel::schlick(Rgb(0.04)))});
-  const FitResult r = Fitter(FitOptions{}).fit(MerlTable::tabulate(truth));
+  const FitResult r = Fitter(FitOptions{}).fit(HalfDiffTable::tabulate(truth));
   ASSERT_TRUE(r.ok()) << r.problem;
   EXPECT_TRUE(mentions(r.warnings, "directional albedo of the measurement above 1")) << ::testing::PrintToString(r.warnings);
   EXPECT_TRUE(mentions(r.warnings, "directional albedo of the tabulated fit above 1")) << ::testing::PrintToString(r.warnings);
   // A lobe whose Fresnel is 1.5 (a mis-scaled measurement): the paper's fit reads it as F > 1.
-  const FitResult bright = Fitter(FitOptions::paper()).fit(MerlTable::tabulate(*ggx(0.3, Fresnel::schlick(Rgb(1.5)))));
+  const FitResult bright = Fitter(FitOptions::paper()).fit(HalfDiffTable::tabulate(*ggx(0.3, Fresnel::schlick(Rgb(1.5)))));
   ASSERT_TRUE(bright.ok()) << bright.problem;
   EXPECT_TRUE(mentions(bright.warnings, "Fresnel factor above 1")) << ::testing::PrintToString(bright.warnings);
 }
 
 TEST(Plausibility, NegativeMeasurementsAreCountedPerChannel) {
-  MerlTable table = MerlTable::tabulate(*ggx(0.3, Fresnel::schlick(Rgb(0.9))));
+  HalfDiffTable table = HalfDiffTable::tabulate(*ggx(0.3, Fresnel::schlick(Rgb(0.9))));
   for (int i = 40; i < 60; ++i) table.set(i, 10, 5, Rgb(0.5, 0.5, -0.01));
   const FitResult r = Fitter(FitOptions::paper()).fit(table);
   ASSERT_TRUE(r.ok()) << r.problem;

@@ -28,7 +28,7 @@ std::shared_ptr<const Brdf> ggx(double alpha, const Fresnel& fresnel) {
 FitResult fit_full(const Brdf& brdf) {
   FitOptions options;
   options.refine = FitOptions::Refine::full;
-  return Fitter(options).fit(MerlTable::tabulate(brdf));
+  return Fitter(options).fit(HalfDiffTable::tabulate(brdf));
 }
 
 void expect_rgb_near(const Rgb& a, const Rgb& b, double tolerance, const char* what) {
@@ -39,10 +39,10 @@ TEST(Refine, LambertPlusGgxThroughTheMerlWriter) {
   const Rgb albedo(0.5, 0.3, 0.1);
   const SumBrdf truth({std::make_shared<LambertBrdf>(albedo), ggx(0.2, Fresnel::schlick(Rgb(0.04)))});
   const fs::path file = fs::path(::testing::TempDir()) / "lambert_ggx.binary";
-  MerlTable::tabulate(truth).write(file.string());
+  HalfDiffTable::tabulate(truth).write(file.string());
   FitOptions options;
   options.refine = FitOptions::Refine::full;
-  const FitResult r = Fitter(options).fit(MerlTable::read(file.string()));
+  const FitResult r = Fitter(options).fit(HalfDiffTable::read(file.string()));
   ASSERT_TRUE(r.ok()) << r.problem;
   // The paper's fit has no body: it is far from this material; the refinement is not.
   EXPECT_GT(r.error_extraction, 0.01);
@@ -64,11 +64,11 @@ TEST(Refine, MinnaertBodyPlusGgxThroughTheMerlWriter) {
   const Rgb albedo(0.5, 0.3, 0.1);
   const SumBrdf truth({std::make_shared<LambertBrdf>(albedo, 1.3), ggx(0.2, Fresnel::schlick(Rgb(0.04)))});
   const fs::path file = fs::path(::testing::TempDir()) / "minnaert_ggx.binary";
-  MerlTable::tabulate(truth).write(file.string());
+  HalfDiffTable::tabulate(truth).write(file.string());
   FitOptions options;
   options.refine = FitOptions::Refine::full;
   const Fitter fitter(options);
-  const FitResult r = fitter.fit(MerlTable::read(file.string()));
+  const FitResult r = fitter.fit(HalfDiffTable::read(file.string()));
   ASSERT_TRUE(r.ok()) << r.problem;
   EXPECT_NEAR(r.lobe.body_exponent, 1.3, 0.01);
   std::printf("[ minnaert ] exponent %.4f, body %.4f %.4f %.4f, alpha_ggx %.4f\n", r.lobe.body_exponent, r.body().r, r.body().g, r.body().b, r.alpha_ggx);
@@ -117,7 +117,7 @@ TEST(Refine, ParametricJacobianMatchesCentralDifferences) {
   // sharp lobes, on the bins of a coloured Lambert + GGX measurement.
   const SumBrdf truth({std::make_shared<LambertBrdf>(Rgb(0.4, 0.2, 0.1)),
                        std::make_shared<MicrofacetBrdf>(Ndf::isotropic(NdfType::ggx, 0.2), Smith::correlated, Fresnel::schlick(Rgb(0.05)))});
-  const MeasuredBins bins = measured_bins(MerlTable::tabulate(truth), 15, 45);
+  const MeasuredBins bins = measured_bins(HalfDiffTable::tabulate(truth), 15, 45);
   for (const NdfType type : {NdfType::ggx, NdfType::beckmann})
     for (const auto form : {ParametricFit::FresnelForm::f82, ParametricFit::FresnelForm::schlick})
       for (const Smith smith : {Smith::masking, Smith::correlated, Smith::separable})
@@ -139,7 +139,7 @@ TEST(Refine, RefinementJacobianMatchesCentralDifferences) {
                        std::make_shared<MicrofacetBrdf>(Ndf::isotropic(NdfType::ggx, 0.2), Smith::correlated, Fresnel::schlick(Rgb(0.05)))});
   const fs::path file = fs::path(::testing::TempDir()) / "jacobian.bin";
   UtiaBrdf::tabulate(truth).write(file.string());
-  const MeasuredBins merl = measured_bins(MerlTable::tabulate(truth), 15, 45), utia = measured_bins(load_table(file.string()), 1, 1);
+  const MeasuredBins merl = measured_bins(HalfDiffTable::tabulate(truth), 15, 45), utia = measured_bins(load_table(file.string()), 1, 1);
   const Quadrature quad(90);
   for (const double alpha : {0.05, 0.6})
     for (const bool coat : {false, true}) {
@@ -164,7 +164,7 @@ TEST(Refine, LutCarriesBodyCoatAndParametricFits) {
   FitOptions options;
   options.refine = FitOptions::Refine::full;
   const Fitter fitter(options);
-  const FitResult r = fitter.fit(MerlTable::tabulate(truth));
+  const FitResult r = fitter.fit(HalfDiffTable::tabulate(truth));
   const fs::path file = fs::path(::testing::TempDir()) / "coated.exr";
   write_lut(file.string(), make_lut(r, fitter.quadrature(), "coated", "0", 0.02, true));
   const Lut lut = read_lut(file.string());
@@ -301,7 +301,7 @@ TEST(Metric, MeasurementErrorAppliesTheLossToGrazingPairsOnly) {
 // The bins of a source with two one-sided estimates: each bin twice, once per estimate measured, with the
 // estimate's own cosine and lightness (no division by a grazing cosine) and half the bin's weight.
 TEST(MeasuredBinsOneSided, EachBinOncePerMeasuredEstimate) {
-  MerlTable table = MerlTable::tabulate(LambertBrdf(Rgb(0.5)));
+  HalfDiffTable table = HalfDiffTable::tabulate(LambertBrdf(Rgb(0.5)));
   const MeasuredBins reciprocal = measured_bins(table, 9, 60);
   const auto source = std::make_shared<SkewedSource>();
   table.set_source_one_sided(source);
@@ -335,7 +335,7 @@ TEST(MeasuredBinsSamples, AUtiaFileGivesItsNodes) {
   const SumBrdf truth({std::make_shared<LambertBrdf>(albedo), ggx(0.3, Fresnel::schlick(Rgb(0.04)))});
   const fs::path file = fs::path(::testing::TempDir()) / "lambert_ggx_utia.bin";
   UtiaBrdf::tabulate(truth).write(file.string());
-  MerlTable table = load_table(file.string());
+  HalfDiffTable table = load_table(file.string());
   ASSERT_TRUE(table.source_samples());
   const MeasuredBins bins = measured_bins(table, 9, 60);
   ASSERT_EQ(bins.size(), std::size_t(UtiaBrdf::kTheta * UtiaBrdf::kTheta * UtiaBrdf::kPhi));
@@ -375,7 +375,7 @@ TEST(RefineRgl, NeverWorseThanTheExtraction) {
   for (const auto& entry : fs::directory_iterator(rgl_dir())) {
     if (entry.path().extension() != ".bsdf") continue;
     ++files;
-    const MerlTable table = load_table(entry.path().string());
+    const HalfDiffTable table = load_table(entry.path().string());
     const MeasuredBins bins = error_bins(table);
     const auto distance = [&](const FitResult& r) {
       return measurement_error(bins, TabulatedMicrofacet(r.lobe.tables(r.smith), {}));
@@ -431,7 +431,7 @@ TEST(RefineAnisotropic, ThroughAUtiaFile) {
   UtiaBrdf::tabulate(RotatedBrdf(material, 0.6)).write(file.string());
   FitOptions options;
   options.refine = FitOptions::Refine::full;
-  const MerlTable table = load_table(file.string());
+  const HalfDiffTable table = load_table(file.string());
   const FitResult r = Fitter(options).fit(table);
   ASSERT_TRUE(r.ok() && r.anisotropic) << r.problem;
   const AnisotropicFit& a = *r.anisotropic;
@@ -442,7 +442,7 @@ TEST(RefineAnisotropic, ThroughAUtiaFile) {
               a.ggx.alpha.angle * 180.0 / kPi, a.ggx.body.r, a.ggx.body.g, a.ggx.body.b, a.ggx.f0.r, a.ggx.f0.g, a.ggx.f0.b,
               a.ggx.error, r.ggx.error);
   // The moment estimates see the body in the back-scattering too (the 2D extraction has no body); the fit
-  // on the whole file separates them. Fitted at the file's node pairs (MerlTable::source_anisotropic_samples)
+  // on the whole file separates them. Fitted at the file's node pairs (HalfDiffTable::source_anisotropic_samples)
   // it returns the material, to issue 10's ground-truth bars.
   AnisotropicParametricFit moments = a.ggx;
   moments.alpha = a.alpha_ggx;

@@ -982,17 +982,17 @@ TEST(Shading, TabulatedProposalInSimdLanesEqualsOnePairAtATime) {
   EXPECT_GT(found, 300);
 }
 
-TEST(Shading, MerlTableInSimdLanesEqualsOnePairAtATime) {
-  // A MERL-layout table's linear lookup (render/merl_batch.h) against MerlTable::eval: a glossy table with
+TEST(Shading, HalfDiffTableInSimdLanesEqualsOnePairAtATime) {
+  // A MERL-layout table's linear lookup (render/merl_batch.h) against HalfDiffTable::eval: a glossy table with
   // bins made missing (every neighbour of some pairs, one channel of others) and negative values, pairs
   // near the normal, near the mirror direction, grazing and below the horizon; both targets.
-  MerlTable table = load_table("builtin:red-plastic");
+  HalfDiffTable table = load_table("builtin:red-plastic");
   std::mt19937_64 rng(3);
   std::uniform_real_distribution<double> u(0.0, 1.0);
   for (int q = 0; q < 200000; ++q) {
     const int i = int(u(rng) * 90), j = int(u(rng) * 90), k = int(u(rng) * 180);
     if (q % 2) table.set_missing(i, j, k);
-    else table.channel(q % 3)[MerlTable::index(i, j, k)] = q % 4 ? -0.01f : std::numeric_limits<float>::quiet_NaN();
+    else table.channel(q % 3)[HalfDiffTable::index(i, j, k)] = q % 4 ? -0.01f : std::numeric_limits<float>::quiet_NaN();
   }
   const auto model = MerlBatchModel::of(table);
   ASSERT_TRUE(model);

@@ -32,7 +32,7 @@ ReportOptions small(const std::string& out) {
 TEST(Report, AMaterialNameCannotWriteHtml) {
   TempDir dir;
   const std::string name = "x' onerror='alert(1)";
-  MerlTable::tabulate(LambertBrdf(Rgb(0.5))).write(dir.file(name + ".binary"));
+  HalfDiffTable::tabulate(LambertBrdf(Rgb(0.5))).write(dir.file(name + ".binary"));
   ReportOptions o = small(dir.file("out"));
   o.inputs = {dir.file(name + ".binary")};
   run_report(o);
@@ -47,8 +47,8 @@ TEST(Report, TwoInputsOfOneNameAreNotTwoRows) {
   TempDir dir;
   std::filesystem::create_directories(dir.path() / "d1");
   std::filesystem::create_directories(dir.path() / "d2");
-  MerlTable::tabulate(LambertBrdf(Rgb(0.5))).write(dir.file("d1/mat.binary"));
-  MerlTable::tabulate(LambertBrdf(Rgb(0.2))).write(dir.file("d2/mat.binary"));
+  HalfDiffTable::tabulate(LambertBrdf(Rgb(0.5))).write(dir.file("d1/mat.binary"));
+  HalfDiffTable::tabulate(LambertBrdf(Rgb(0.2))).write(dir.file("d2/mat.binary"));
   ReportOptions o = small(dir.file("out"));
   o.inputs = {dir.file("d1/mat.binary"), dir.file("d2/mat.binary")};
   const json r = run_report(o);

@@ -44,14 +44,14 @@ void expect_all_finite(const FitResult& r) {
   }
 }
 
-FitResult fit(const MerlTable& table, Smith smith = Smith::correlated) {
+FitResult fit(const HalfDiffTable& table, Smith smith = Smith::correlated) {
   FitOptions options = FitOptions::paper();
   options.smith = smith;
   return Fitter(options).fit(table);
 }
 
-MerlTable table_of(NdfType type, double alpha, const Fresnel& fresnel) {
-  return MerlTable::tabulate(MicrofacetBrdf(Ndf::isotropic(type, alpha), Smith::correlated, fresnel));
+HalfDiffTable table_of(NdfType type, double alpha, const Fresnel& fresnel) {
+  return HalfDiffTable::tabulate(MicrofacetBrdf(Ndf::isotropic(type, alpha), Smith::correlated, fresnel));
 }
 
 class ExtremeRoughness : public testing::TestWithParam<std::tuple<NdfType, double>> {};
@@ -81,12 +81,12 @@ TEST(Stress, FresnelFromDarkToWhite) {
 }
 
 TEST(Stress, ThirtyPercentMissing) {
-  MerlTable table = table_of(NdfType::ggx, 0.3, Fresnel::conductor({0.2, 0.9, 1.1}, {3.9, 2.4, 2.1}));
+  HalfDiffTable table = table_of(NdfType::ggx, 0.3, Fresnel::conductor({0.2, 0.9, 1.1}, {3.9, 2.4, 2.1}));
   std::mt19937 rng(1);
   std::bernoulli_distribution drop(0.3);
-  for (int i = 0; i < MerlTable::kThetaH; ++i)
-    for (int j = 0; j < MerlTable::kThetaD; ++j)
-      for (int k = 0; k < MerlTable::kPhiD; ++k)
+  for (int i = 0; i < HalfDiffTable::kThetaH; ++i)
+    for (int j = 0; j < HalfDiffTable::kThetaD; ++j)
+      for (int k = 0; k < HalfDiffTable::kPhiD; ++k)
         if (drop(rng)) table.set_missing(i, j, k);
   const FitResult r = fit(table);
   ASSERT_TRUE(r.ok()) << r.problem;
@@ -98,9 +98,9 @@ TEST(Stress, ThirtyPercentMissing) {
 }
 
 TEST(Stress, WholeBackScatteringRowsMissing) {
-  MerlTable table = table_of(NdfType::beckmann, 0.2, Fresnel::schlick(Rgb(0.8)));
+  HalfDiffTable table = table_of(NdfType::beckmann, 0.2, Fresnel::schlick(Rgb(0.8)));
   for (int i = 10; i < 30; i += 3)
-    for (int k = 0; k < MerlTable::kPhiD; ++k) table.set_missing(i, 0, k);
+    for (int k = 0; k < HalfDiffTable::kPhiD; ++k) table.set_missing(i, 0, k);
   const FitResult r = fit(table);
   ASSERT_TRUE(r.ok());
   expect_all_finite(r);
@@ -108,12 +108,12 @@ TEST(Stress, WholeBackScatteringRowsMissing) {
 }
 
 TEST(Stress, MultiplicativeNoise) {
-  MerlTable table = table_of(NdfType::ggx, 0.25, Fresnel::schlick(Rgb(0.9, 0.7, 0.4)));
+  HalfDiffTable table = table_of(NdfType::ggx, 0.25, Fresnel::schlick(Rgb(0.9, 0.7, 0.4)));
   std::mt19937 rng(2);
   std::lognormal_distribution<float> noise(0.0f, 0.1f);  // about 10% per measurement
   for (int c = 0; c < 3; ++c)
-    for (std::size_t n = 0; n < MerlTable::kBins; ++n)
-      if (!MerlTable::missing(table.channel(c)[n])) table.channel(c)[n] *= noise(rng);
+    for (std::size_t n = 0; n < HalfDiffTable::kBins; ++n)
+      if (!HalfDiffTable::missing(table.channel(c)[n])) table.channel(c)[n] *= noise(rng);
   const FitResult r = fit(table);
   ASSERT_TRUE(r.ok());
   expect_all_finite(r);
@@ -151,10 +151,10 @@ TEST(Stress, NoisyUtiaFilesAtExtremeRoughness) {
 }
 
 TEST(Stress, AllZeroInputIsMeaningless) {
-  MerlTable table = table_of(NdfType::ggx, 0.3, Fresnel::one());
+  HalfDiffTable table = table_of(NdfType::ggx, 0.3, Fresnel::one());
   for (int c = 0; c < 3; ++c)
-    for (std::size_t n = 0; n < MerlTable::kBins; ++n)
-      if (!MerlTable::missing(table.channel(c)[n])) table.channel(c)[n] = 0.0f;
+    for (std::size_t n = 0; n < HalfDiffTable::kBins; ++n)
+      if (!HalfDiffTable::missing(table.channel(c)[n])) table.channel(c)[n] = 0.0f;
   for (Smith smith : {Smith::masking, Smith::correlated, Smith::separable}) {
     const FitResult r = fit(table, smith);
     EXPECT_FALSE(r.ok());
@@ -164,7 +164,7 @@ TEST(Stress, AllZeroInputIsMeaningless) {
 }
 
 TEST(Stress, AllMissingInputIsMeaningless) {
-  const FitResult r = fit(MerlTable());
+  const FitResult r = fit(HalfDiffTable());
   EXPECT_FALSE(r.ok());
   expect_all_finite(r);
 }
@@ -172,7 +172,7 @@ TEST(Stress, AllMissingInputIsMeaningless) {
 TEST(Stress, PureLambertianStaysFinite) {
   // Not a microfacet material: the numbers mean little, but they are numbers.
   for (Smith smith : {Smith::masking, Smith::correlated, Smith::separable}) {
-    const FitResult r = fit(MerlTable::tabulate(LambertBrdf(Rgb(0.8))), smith);
+    const FitResult r = fit(HalfDiffTable::tabulate(LambertBrdf(Rgb(0.8))), smith);
     expect_all_finite(r);
     EXPECT_TRUE(r.ok()) << r.problem;
   }
@@ -181,7 +181,7 @@ TEST(Stress, PureLambertianStaysFinite) {
 TEST(Stress, SeparableAndMaskingAtExtremes) {
   for (Smith smith : {Smith::masking, Smith::separable})
     for (double alpha : {0.005, 1.5}) {
-      const FitResult r = fit(MerlTable::tabulate(MicrofacetBrdf(Ndf::isotropic(NdfType::ggx, alpha), smith, Fresnel::one())), smith);
+      const FitResult r = fit(HalfDiffTable::tabulate(MicrofacetBrdf(Ndf::isotropic(NdfType::ggx, alpha), smith, Fresnel::one())), smith);
       ASSERT_TRUE(r.ok());
       expect_all_finite(r);
       EXPECT_NEAR(r.alpha_ggx, alpha, alpha * 0.015);
@@ -311,7 +311,7 @@ TEST(MerlLanes, EveryBatchLengthAndDegenerateDirectionStayFiniteAndInBounds) {
   // whose bins are all measured and one whose bins are all missing.
   const Vec3 degenerate[] = {{0, 0, 1}, {1, 0, 0}, {0, -1, 0}, {0.6, 0, 0.8}, {-0.6, 0, -0.8}, {0, 0, -1}, {1e-300, 0, 1}, {0.9999999, 0, 1e-12}};
   for (const bool empty : {false, true}) {
-    const MerlTable table = empty ? MerlTable() : load_table("builtin:red-plastic");
+    const HalfDiffTable table = empty ? HalfDiffTable() : load_table("builtin:red-plastic");
     const auto model = MerlBatchModel::of(table);
     ASSERT_TRUE(model);
     for (std::size_t n = 0; n <= 40; ++n)

@@ -21,7 +21,7 @@ namespace {
 MicrofacetTables fitted_tables(NdfType type, double alpha, const Fresnel& fresnel, Smith smith = Smith::correlated) {
   FitOptions options = FitOptions::paper();
   options.smith = smith;
-  const FitResult fit = Fitter(options).fit(MerlTable::tabulate(MicrofacetBrdf(Ndf::isotropic(type, alpha), smith, fresnel)));
+  const FitResult fit = Fitter(options).fit(HalfDiffTable::tabulate(MicrofacetBrdf(Ndf::isotropic(type, alpha), smith, fresnel)));
   EXPECT_TRUE(fit.ok()) << fit.problem;
   return {fit.ndf(), smith, fit.fresnel(), {}, {}};
 }

@@ -18,7 +18,7 @@
 
 namespace facetfit {
 
-Backscatter backscatter_of(const MerlTable& table) {
+Backscatter backscatter_of(const HalfDiffTable& table) {
   Backscatter back;
   if (const BackscatterLattice& lattice = table.source_backscatter(); !lattice.empty()) {  // measured off the bins
     for (std::size_t p = 0; p < lattice.theta.size(); ++p) {
@@ -27,15 +27,15 @@ Backscatter backscatter_of(const MerlTable& table) {
     }
     return back;
   }
-  for (int i = 0; i < MerlTable::kThetaH; ++i) {
+  for (int i = 0; i < HalfDiffTable::kThetaH; ++i) {
     Rgb mean(0.0);
     bool complete = true;
     for (int c = 0; c < 3 && complete; ++c) {
-      const float* row = table.channel(c) + MerlTable::index(i, 0, 0);
+      const float* row = table.channel(c) + HalfDiffTable::index(i, 0, 0);
       double sum = 0.0;
       int n = 0;
-      for (int k = 0; k < MerlTable::kPhiD; ++k) {
-        if (MerlTable::missing(row[k])) continue;
+      for (int k = 0; k < HalfDiffTable::kPhiD; ++k) {
+        if (HalfDiffTable::missing(row[k])) continue;
         sum += row[k];
         ++n;
       }
@@ -43,7 +43,7 @@ Backscatter backscatter_of(const MerlTable& table) {
       mean[c] = n > 0 ? sum / n : 0.0;
     }
     if (!complete) continue;
-    back.theta.push_back(MerlTable::theta_h(i));
+    back.theta.push_back(HalfDiffTable::theta_h(i));
     back.value.push_back(std::max(0.0, luminance(mean)));  // below zero: noise on a zero measurement
   }
   return back;
@@ -82,7 +82,7 @@ std::optional<ClosureLobe::Fresnel> parse_closure_fresnel(const std::string& nam
   return std::nullopt;
 }
 
-void Fitter::refine_on_measurement(const MerlTable& table, FitResult& result) const {
+void Fitter::refine_on_measurement(const HalfDiffTable& table, FitResult& result) const {
   const MeasuredBins fit_bins = solve_bins(table), parametric = parametric_bins(table), bins = error_bins(table);
   const Smith smith = options_.smith;
   const auto error_of = [&](const LobeFit& lobe) {
@@ -144,14 +144,14 @@ void Fitter::refine_on_measurement(const MerlTable& table, FitResult& result) co
 
 // The paper's method fits nothing more: its representations are only measured, so that the one
 // recommended is chosen by distance from the measurement, as for a refined fit (fit/recommend.h).
-void Fitter::measure_paper_fits(const MerlTable& table, FitResult& result) const {
+void Fitter::measure_paper_fits(const HalfDiffTable& table, FitResult& result) const {
   const MeasuredBins bins = error_bins(table);
   if (bins.size() == 0) return;
   result.error_extraction = result.error = measurement_error(bins, TabulatedMicrofacet(result.lobe.tables(options_.smith), {}));
   for (ParametricFit* p : {&result.ggx, &result.beckmann, &result.lsq}) p->error = parametric_error(bins, options_.smith, *p);
 }
 
-void Fitter::fit_anisotropic_lobes(const MerlTable& table, const FresnelCurve& paper_fresnel, const FitResult& result,
+void Fitter::fit_anisotropic_lobes(const HalfDiffTable& table, const FresnelCurve& paper_fresnel, const FitResult& result,
                                    AnisotropicFit& a) const {
   const auto moments = [&](NdfType type, const AnisotropicAlpha& alpha) {
     AnisotropicParametricFit p;
@@ -177,7 +177,7 @@ void Fitter::fit_anisotropic_lobes(const MerlTable& table, const FresnelCurve& p
   a.refined = true;
 }
 
-FitResult Fitter::fit(const MerlTable& table) const {
+FitResult Fitter::fit(const HalfDiffTable& table) const {
   FitResult result;
   result.smith = options_.smith;
   result.extraction = extract_ndf(backscatter_of(table), quadrature_,

@@ -42,7 +42,7 @@ struct FitOptions {
   enum class Refine { none, full };
   Refine refine = Refine::full;
   // Which point of its bins a MERL file's values stand for, when the input is read (io/merl.h).
-  MerlTable::BinPoint merl_bins = MerlTable::BinPoint::start;
+  HalfDiffTable::BinPoint merl_bins = HalfDiffTable::BinPoint::start;
   // The closure representation's first lobe: F82-tint, or generalized Schlick like the rest (fit/closure_fit.h).
   ClosureLobe::Fresnel closure_fresnel = ClosureLobe::Fresnel::f82_tint;
 
@@ -96,7 +96,7 @@ struct FitResult {
   bool refined = false;             // Refine::full: body, lobe and parametric fits fitted on the measurement
   std::string problem;  // empty for a meaningful fit; otherwise why it is not one
   std::vector<std::string> warnings;  // implausible values in the measurement or the fit (fit/plausibility.h)
-  // With a source that holds back-scattering along azimuths (MerlTable::source_backscatter); the rest of
+  // With a source that holds back-scattering along azimuths (HalfDiffTable::source_backscatter); the rest of
   // the result is the isotropic fit of the table (for UTIA, the azimuthal mean).
   std::optional<AnisotropicFit> anisotropic;
 
@@ -108,7 +108,7 @@ struct FitResult {
 
 // f(k, k) per theta_h bin: the mean over phi_d of the theta_d = 0 bins (one configuration, stored 180
 // times), as luminance. Bins with no valid measurement are left out.
-Backscatter backscatter_of(const MerlTable& table);
+Backscatter backscatter_of(const HalfDiffTable& table);
 
 // Holds the quadrature of its resolution, so fitting many materials pays for it once. fit() is const
 // and thread-safe.
@@ -117,15 +117,15 @@ class Fitter {
   explicit Fitter(const FitOptions& options);
   const FitOptions& options() const { return options_; }
   const Quadrature& quadrature() const { return quadrature_; }
-  FitResult fit(const MerlTable& table) const;
+  FitResult fit(const HalfDiffTable& table) const;
 
  private:
   // --refine full: the parametric fits and the body + tabulated lobe on the whole measurement.
-  void refine_on_measurement(const MerlTable& table, FitResult& result) const;
+  void refine_on_measurement(const HalfDiffTable& table, FitResult& result) const;
   // --refine none: the distances of the paper's representations from the measurement.
-  void measure_paper_fits(const MerlTable& table, FitResult& result) const;
+  void measure_paper_fits(const HalfDiffTable& table, FitResult& result) const;
   // The anisotropic GGX and Beckmann lobes of `a` (AnisotropicFit::ggx, beckmann) from its moment alphas.
-  void fit_anisotropic_lobes(const MerlTable& table, const FresnelCurve& paper_fresnel, const FitResult& result, AnisotropicFit& a) const;
+  void fit_anisotropic_lobes(const HalfDiffTable& table, const FresnelCurve& paper_fresnel, const FitResult& result, AnisotropicFit& a) const;
 
   FitOptions options_;
   Quadrature quadrature_;

@@ -8,11 +8,11 @@
 
 namespace facetfit {
 
-static_assert(FresnelCurve::kSize == MerlTable::kThetaD, "one Fresnel entry per MERL theta_d bin");
+static_assert(FresnelCurve::kSize == HalfDiffTable::kThetaD, "one Fresnel entry per MERL theta_d bin");
 
 namespace {
 
-constexpr int kH = MerlTable::kThetaH, kD = MerlTable::kThetaD, kP = MerlTable::kPhiD;
+constexpr int kH = HalfDiffTable::kThetaH, kD = HalfDiffTable::kThetaD, kP = HalfDiffTable::kPhiD;
 
 struct Sums {
   std::array<std::array<double, 3>, kD> measured{};
@@ -31,21 +31,21 @@ struct Sums {
 
 }  // namespace
 
-std::optional<FresnelCurve> fit_fresnel(const MerlTable& table, const TabulatedNdf& ndf, Smith smith) {
+std::optional<FresnelCurve> fit_fresnel(const HalfDiffTable& table, const TabulatedNdf& ndf, Smith smith) {
   // Everything that depends on one axis only is computed once.
   std::array<double, kH> d_h{}, cos_h{}, sin_h{};
   for (int i = 0; i < kH; ++i) {
-    d_h[i] = ndf.D(MerlTable::theta_h(i));
-    cos_h[i] = std::cos(MerlTable::theta_h(i));
-    sin_h[i] = std::sin(MerlTable::theta_h(i));
+    d_h[i] = ndf.D(HalfDiffTable::theta_h(i));
+    cos_h[i] = std::cos(HalfDiffTable::theta_h(i));
+    sin_h[i] = std::sin(HalfDiffTable::theta_h(i));
   }
   std::array<double, kD> cos_d{}, sin_d{};
   for (int j = 0; j < kD; ++j) {
-    cos_d[j] = std::cos(MerlTable::theta_d(j));
-    sin_d[j] = std::sin(MerlTable::theta_d(j));
+    cos_d[j] = std::cos(HalfDiffTable::theta_d(j));
+    sin_d[j] = std::sin(HalfDiffTable::theta_d(j));
   }
   std::array<double, kP / 2 + 1> cos_p{};
-  for (int k = 0; k <= kP / 2; ++k) cos_p[k] = std::cos(MerlTable::phi_d(k));
+  for (int k = 0; k <= kP / 2; ++k) cos_p[k] = std::cos(HalfDiffTable::phi_d(k));
   const G1Table g1(ndf);
   const float* channel[3] = {table.channel(0), table.channel(1), table.channel(2)};
 
@@ -73,7 +73,7 @@ std::optional<FresnelCurve> fit_fresnel(const MerlTable& table, const TabulatedN
                 above_row[kP - k] = above_row[k];
               }
             }
-            const std::size_t row = MerlTable::index(i, j, 0);
+            const std::size_t row = HalfDiffTable::index(i, j, 0);
             for (int c = 0; c < 3; ++c) {
               const float* values = channel[c] + row;
               // Branch-free so that it vectorizes: the weight is 1 for a valid bin, 0 otherwise. Row sums
@@ -81,7 +81,7 @@ std::optional<FresnelCurve> fit_fresnel(const MerlTable& table, const TabulatedN
               float measured = 0.0f, model = 0.0f, count = 0.0f;
 #pragma omp simd reduction(+ : measured, model, count)
               for (int k = 0; k < kP; ++k) {
-                const bool valid = !MerlTable::missing(values[k]);  // a missing bin is NaN: select, not multiply
+                const bool valid = !HalfDiffTable::missing(values[k]);  // a missing bin is NaN: select, not multiply
                 const float w = valid ? above_row[k] : 0.0f;
                 measured += w * (valid ? values[k] : 0.0f);
                 model += w * model_row[k];

@@ -20,6 +20,6 @@ namespace facetfit {
 // dominated by the bins where the F = 1 model is nearly zero, i.e. by noise and by what is not
 // microfacet reflection. nullopt when no bin holds a usable measurement in some channel (a fit
 // without meaning, not an error: Fitter::fit reports it in FitResult::problem).
-std::optional<FresnelCurve> fit_fresnel(const MerlTable& table, const TabulatedNdf& ndf, Smith smith);
+std::optional<FresnelCurve> fit_fresnel(const HalfDiffTable& table, const TabulatedNdf& ndf, Smith smith);
 
 }  // namespace facetfit

@@ -83,30 +83,30 @@ MeasuredBins sample_bins(const std::vector<MeasuredSample>& samples, std::uint64
 
 }  // namespace
 
-MeasuredBins measured_bins(const MerlTable& table, int stride_d, int stride_phi) {
+MeasuredBins measured_bins(const HalfDiffTable& table, int stride_d, int stride_phi) {
   if (table.source_samples()) return sample_bins(*table.source_samples());
   MeasuredBins bins;
   const OneSidedMeasurement* one_sided = table.source_one_sided().get();
   double total = 0.0;
-  for (int i = 0; i < MerlTable::kThetaH; ++i) {
+  for (int i = 0; i < HalfDiffTable::kThetaH; ++i) {
     // The cell's measure, 4 cos(theta_d) sin(theta_d) sin(theta_h) dtheta_h dtheta_d dphi_d (the Jacobian of
     // the half/difference parameterization), at the cell's centre; theta_h = u^2 pi/2, so dtheta_h = u pi du.
-    const double u = (i + 0.5) / MerlTable::kThetaH;
+    const double u = (i + 0.5) / HalfDiffTable::kThetaH;
     const double theta_h_mid = u * u * 0.5 * kPi;
     const double h_measure = std::sin(theta_h_mid) * u * kPi;
-    for (int j = 0; j < MerlTable::kThetaD; j += stride_d) {
-      const double theta_d_mid = (j + 0.5) / MerlTable::kThetaD * 0.5 * kPi;
+    for (int j = 0; j < HalfDiffTable::kThetaD; j += stride_d) {
+      const double theta_d_mid = (j + 0.5) / HalfDiffTable::kThetaD * 0.5 * kPi;
       const double measure = 4.0 * std::cos(theta_d_mid) * std::sin(theta_d_mid) * h_measure;
-      MeasuredBins::Row row{MerlTable::theta_h(i), MerlTable::theta_d(j), bins.size(), bins.size()};
-      for (int k = 0; k < MerlTable::kPhiD; k += stride_phi) {
-        const auto [wo, wi] = from_half_diff(MerlTable::theta_h(i), MerlTable::theta_d(j), MerlTable::phi_d(k));
-        const double cos_h = std::cos(MerlTable::theta_h(i)), cos_d = std::cos(MerlTable::theta_d(j));
+      MeasuredBins::Row row{HalfDiffTable::theta_h(i), HalfDiffTable::theta_d(j), bins.size(), bins.size()};
+      for (int k = 0; k < HalfDiffTable::kPhiD; k += stride_phi) {
+        const auto [wo, wi] = from_half_diff(HalfDiffTable::theta_h(i), HalfDiffTable::theta_d(j), HalfDiffTable::phi_d(k));
+        const double cos_h = std::cos(HalfDiffTable::theta_h(i)), cos_d = std::cos(HalfDiffTable::theta_d(j));
         if (one_sided) {
           total += add_one_sided(bins, *one_sided, wo, wi, cos_h, cos_d, measure);
           continue;
         }
         Rgb v;
-        for (int c = 0; c < 3; ++c) v[c] = table.value(c, i, j, k);  // missing: NaN (MerlTable::missing)
+        for (int c = 0; c < 3; ++c) v[c] = table.value(c, i, j, k);  // missing: NaN (HalfDiffTable::missing)
         total += add_bin(bins, wo, wi, cos_h, cos_d, measure, v);
       }
       row.end = bins.size();
@@ -117,7 +117,7 @@ MeasuredBins measured_bins(const MerlTable& table, int stride_d, int stride_phi)
   return bins;
 }
 
-MeasuredBins anisotropic_bins(const MerlTable& table, int stride) {
+MeasuredBins anisotropic_bins(const HalfDiffTable& table, int stride) {
   if (table.source_anisotropic_samples()) return sample_bins(*table.source_anisotropic_samples(), std::uint64_t(std::max(stride, 1)));
   return measured_bins(table.source_half_diff(), stride);
 }

@@ -53,7 +53,7 @@ struct MeasuredBins {
 // estimates. A table whose source measured at nodes of its own (source_samples(): a UTIA file) gives
 // those nodes instead, every one, one row each: the table resamples between them, and a fit of the
 // resampled table fits the interpolation (docs/extraction.md). Empty when there is no valid bin.
-MeasuredBins measured_bins(const MerlTable& table, int stride_d, int stride_phi);
+MeasuredBins measured_bins(const HalfDiffTable& table, int stride_d, int stride_phi);
 
 // The nodes of an anisotropic source's lattice (io/half_diff_lattice.h), every `stride`-th of each
 // (theta_h, theta_d) row's phi_h x phi_d nodes (the start staggered from row to row); a row is one
@@ -61,10 +61,10 @@ MeasuredBins measured_bins(const MerlTable& table, int stride_d, int stride_phi)
 MeasuredBins measured_bins(const HalfDiffLattice& lattice, int stride);
 
 // What an anisotropic fit of the table's source reads: the pairs it was measured at
-// (MerlTable::source_anisotropic_samples: a UTIA file's, one in `stride` spread over them by a hash of
+// (HalfDiffTable::source_anisotropic_samples: a UTIA file's, one in `stride` spread over them by a hash of
 // the index) or else its lattice (source_half_diff, every `stride`-th as above). Empty when the source
 // has neither.
-MeasuredBins anisotropic_bins(const MerlTable& table, int stride);
+MeasuredBins anisotropic_bins(const HalfDiffTable& table, int stride);
 
 // The bin sets of the fits: the tabulated lobe's refinement solves on the sparse one (6.4k bins: the
 // fitted distances move by < 1% between 93k bins and this), the parametric fits (8 to 12 unknowns) on
@@ -74,12 +74,12 @@ MeasuredBins anisotropic_bins(const MerlTable& table, int stride);
 // distances move by < 2% and no choice between fits changes, at 15% less of the fit's time). A source
 // measured at nodes of its own (a UTIA file) has no other measurement: the three sets are its 1,728
 // nodes, so its distances are measured on what was fitted.
-inline MeasuredBins solve_bins(const MerlTable& table) { return measured_bins(table, 6, 30); }
-inline MeasuredBins parametric_bins(const MerlTable& table) { return measured_bins(table, 9, 60); }
+inline MeasuredBins solve_bins(const HalfDiffTable& table) { return measured_bins(table, 6, 30); }
+inline MeasuredBins parametric_bins(const HalfDiffTable& table) { return measured_bins(table, 9, 60); }
 // The closure fit (fit/closure_fit.h: 13 to 29 unknowns) solves on sparser bins still (0.8k): with them its
 // renders of the six RGL materials stand as near Mitsuba's as with the parametric set, at half the time.
-inline MeasuredBins closure_bins(const MerlTable& table) { return measured_bins(table, 18, 90); }
-inline MeasuredBins error_bins(const MerlTable& table) { return measured_bins(table, 3, table.source_one_sided() ? 24 : 12); }
+inline MeasuredBins closure_bins(const HalfDiffTable& table) { return measured_bins(table, 18, 90); }
+inline MeasuredBins error_bins(const HalfDiffTable& table) { return measured_bins(table, 3, table.source_one_sided() ? 24 : 12); }
 
 // The metric's transform of x = f c: CIE L*'s lightness function of pi x (cube root, linear near
 // black, so its slope at zero is bounded). Negative values (RGL noise around zero) take the same

@@ -40,7 +40,7 @@ Rgb directional_albedo(const Brdf& brdf, const Vec3& o, int n) {
   return sum * (kPi / double(n * n));
 }
 
-std::vector<std::string> plausibility_warnings(const MerlTable& table, const FitResult& fit) {
+std::vector<std::string> plausibility_warnings(const HalfDiffTable& table, const FitResult& fit) {
   std::vector<std::string> out;
   // Negative measurements, per channel.
   for (int c = 0; c < 3; ++c) {
@@ -48,28 +48,28 @@ std::vector<std::string> plausibility_warnings(const MerlTable& table, const Fit
     std::size_t negative = 0, valid = 0;
     const float* v = table.channel(c);
 #pragma omp simd reduction(+ : negative, valid)
-    for (std::size_t n = 0; n < MerlTable::kBins; ++n) {
+    for (std::size_t n = 0; n < HalfDiffTable::kBins; ++n) {
       valid += std::size_t(v[n] == v[n]);
       negative += std::size_t(v[n] < 0.0f);
     }
     if (negative > 0)
       out.push_back(format("%.1f%% of the measured values are negative in the ", 100.0 * double(negative) / double(valid)) +
-                    MerlTable::channel_name(c) + " channel (noise around zero, kept as measurements)");
+                    HalfDiffTable::channel_name(c) + " channel (noise around zero, kept as measurements)");
   }
   // The Fresnel curve of the tabulated representation.
   for (int j = 0; j < FresnelCurve::kSize; ++j) {
     const auto [c, v] = above(fit.fresnel().value[std::size_t(j)], 1.0);
     if (c < 0) continue;
     out.push_back(format("Fresnel factor above 1: %.3f at theta_d %.0f degrees", v, FresnelCurve::theta_d(j) * 180.0 / kPi) +
-                  " (" + MerlTable::channel_name(c) + "; first such angle)");
+                  " (" + HalfDiffTable::channel_name(c) + "; first such angle)");
     break;
   }
   if (fit.refined)
     for (const auto& [name, p] : {std::pair<const char*, const ParametricFit*>{"ggx", &fit.ggx}, {"beckmann", &fit.beckmann}, {"lsq", &fit.lsq}}) {
       const auto [c0, f0] = above(p->f0, 1.0);
       const auto [c82, f82] = above(p->f82, 1.0);
-      if (c0 >= 0) out.push_back(std::string(name) + format(" fit: f0 above 1 (%.3f, ", f0) + MerlTable::channel_name(c0) + ")");
-      if (c82 >= 0) out.push_back(std::string(name) + format(" fit: f82 above 1 (%.3f, ", f82) + MerlTable::channel_name(c82) + ")");
+      if (c0 >= 0) out.push_back(std::string(name) + format(" fit: f0 above 1 (%.3f, ", f0) + HalfDiffTable::channel_name(c0) + ")");
+      if (c82 >= 0) out.push_back(std::string(name) + format(" fit: f82 above 1 (%.3f, ", f82) + HalfDiffTable::channel_name(c82) + ")");
     }
   // Directional albedo of the measurement and of the tabulated representation.
   const TabulatedMicrofacet model(fit.lobe.tables(fit.smith), {});
@@ -78,7 +78,7 @@ std::vector<std::string> plausibility_warnings(const MerlTable& table, const Fit
       const auto [c, v] = above(directional_albedo(*brdf, spherical_direction(degrees * kPi / 180.0, 0.0)), 1.0);
       if (c < 0) continue;
       out.push_back(std::string("directional albedo of the ") + what + format(" above 1: %.3f at theta %.0f degrees", v, degrees) +
-                    " (" + MerlTable::channel_name(c) + ")");
+                    " (" + HalfDiffTable::channel_name(c) + ")");
       break;
     }
   }

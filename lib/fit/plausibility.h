@@ -19,6 +19,6 @@ Rgb directional_albedo(const Brdf& brdf, const Vec3& o, int n = 16);
 
 // One line per finding, each naming the quantity, its value and where: empty when all is plausible.
 // `fit` may be the paper's alone (then its parametric fits are not checked: they are moment estimates).
-std::vector<std::string> plausibility_warnings(const MerlTable& table, const FitResult& fit);
+std::vector<std::string> plausibility_warnings(const HalfDiffTable& table, const FitResult& fit);
 
 }  // namespace facetfit

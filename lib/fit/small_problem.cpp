@@ -71,10 +71,10 @@ namespace {
 using Vector = Eigen::VectorXd;
 using Matrix = Eigen::MatrixXd;
 
-// The helpers below take SmallProblem's Block and Residuals (private to it) as deduced template parameters.
+using Block = SmallProblem::Block;
+using Residuals = SmallProblem::Residuals;
 
 // The unknowns of the variable blocks, clamped into their bounds, and those bounds.
-template <class Block>
 void gather_unknowns(const std::vector<Block>& blocks, Vector& x, Vector& lower, Vector& upper) {
   for (const Block& b : blocks)
     for (int j = 0; j < b.size && b.offset >= 0; ++j) {
@@ -84,7 +84,6 @@ void gather_unknowns(const std::vector<Block>& blocks, Vector& x, Vector& lower,
 }
 
 // The unknowns `v` written back into the variable blocks' values.
-template <class Block>
 void scatter(const std::vector<Block>& blocks, const Vector& v) {
   for (const Block& b : blocks)
     for (int j = 0; j < b.size && b.offset >= 0; ++j) b.values[j] = v[b.offset + j];
@@ -103,7 +102,6 @@ struct Workspace {
 
 // The arguments of a residual block of `m` residuals over `used` blocks: their values, and with
 // `with_jacobians` a slice of one buffer for each variable block's Jacobian (nullptr for a constant one).
-template <class Block>
 void point_at_blocks(const std::vector<Block>& blocks, const std::vector<int>& used, int m, bool with_jacobians, Workspace& w) {
   w.residual.resize(std::size_t(m));
   w.parameters.clear();
@@ -122,7 +120,6 @@ void point_at_blocks(const std::vector<Block>& blocks, const std::vector<int>& u
 
 // This block's rows of J over the unknowns it touches (a few of the n: the scatter keeps the
 // accumulation sparse), and their columns among the n.
-template <class Block>
 void gather_rows(const std::vector<Block>& blocks, const std::vector<int>& used, int m, Workspace& w) {
   w.columns.clear();
   for (std::size_t k = 0; k < used.size(); ++k)
@@ -158,7 +155,6 @@ void add_to_normal_equations(Workspace& w, int m, Matrix& jtj, Vector& jtr) {
 
 // 1/2 sum r^2 at the blocks' values, and J^T J, J^T r (over the n unknowns) when asked; NaN when a cost
 // function fails or yields a non-finite value.
-template <class Block, class Residuals>
 double evaluate_residuals(const std::vector<Block>& blocks, const std::vector<Residuals>& residuals, int n, Matrix* jtj, Vector* jtr,
                           Workspace& w) {
   if (jtj) jtj->setZero(n, n), jtr->setZero(n);

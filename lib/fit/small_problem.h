@@ -53,7 +53,7 @@ class SmallProblem {
   // Moves the blocks' values (clamped into their bounds first) toward a minimum of 1/2 sum r^2.
   Summary Solve(int max_iterations, double function_tolerance = 1e-6);
 
- private:
+  // What the problem holds, as Solve's steps (small_problem.cpp) read it.
   struct Block {
     double* values;
     int size;
@@ -65,6 +65,8 @@ class SmallProblem {
     std::unique_ptr<ceres::CostFunction> cost;
     std::vector<int> blocks;  // indices into blocks_
   };
+
+ private:
   // The index of the block at `values`, added (of `size`) at its first use.
   std::size_t block_of(double* values, int size = -1);
 

@@ -3,13 +3,11 @@
 #include <glob.h>
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <utility>
 #include <filesystem>
 
 #include "core/error.h"
-#include "core/frame.h"
 #include "io/rgl.h"
 #include "io/utia.h"
 #include "model/builtin.h"
@@ -23,12 +21,12 @@ namespace {
 // The input formats, each by its extension with its reader: the one list every command consults.
 struct InputFormat {
   const char* extension;
-  std::shared_ptr<const Brdf> (*read)(const std::string& path, MerlTable::BinPoint merl_bins);
+  std::shared_ptr<const Brdf> (*read)(const std::string& path, HalfDiffTable::BinPoint merl_bins);
 };
 constexpr InputFormat kInputFormats[] = {
-    {".binary", [](const std::string& p, MerlTable::BinPoint b) -> std::shared_ptr<const Brdf> { return std::make_shared<MerlTable>(MerlTable::read(p, b)); }},
-    {".bsdf", [](const std::string& p, MerlTable::BinPoint) -> std::shared_ptr<const Brdf> { return std::make_shared<RglBsdf>(RglBsdf::read(p)); }},
-    {".bin", [](const std::string& p, MerlTable::BinPoint) -> std::shared_ptr<const Brdf> { return std::make_shared<UtiaBrdf>(UtiaBrdf::read(p)); }},
+    {".binary", [](const std::string& p, HalfDiffTable::BinPoint b) -> std::shared_ptr<const Brdf> { return std::make_shared<HalfDiffTable>(HalfDiffTable::read(p, b)); }},
+    {".bsdf", [](const std::string& p, HalfDiffTable::BinPoint) -> std::shared_ptr<const Brdf> { return std::make_shared<RglBsdf>(RglBsdf::read(p)); }},
+    {".bin", [](const std::string& p, HalfDiffTable::BinPoint) -> std::shared_ptr<const Brdf> { return std::make_shared<UtiaBrdf>(UtiaBrdf::read(p)); }},
 };
 
 const InputFormat* input_format(const fs::path& p) {
@@ -50,15 +48,15 @@ std::string resolve_source(const std::string& base_dir, const std::string& sourc
   return (fs::path(base_dir) / source).lexically_normal().string();
 }
 
-std::optional<MerlTable::BinPoint> parse_bin_point(const std::string& name) {
-  if (name == "start") return MerlTable::BinPoint::start;
-  if (name == "center") return MerlTable::BinPoint::center;
+std::optional<HalfDiffTable::BinPoint> parse_bin_point(const std::string& name) {
+  if (name == "start") return HalfDiffTable::BinPoint::start;
+  if (name == "center") return HalfDiffTable::BinPoint::center;
   return std::nullopt;
 }
 
-const char* to_string(MerlTable::BinPoint at) { return at == MerlTable::BinPoint::start ? "start" : "center"; }
+const char* to_string(HalfDiffTable::BinPoint at) { return at == HalfDiffTable::BinPoint::start ? "start" : "center"; }
 
-std::shared_ptr<const Brdf> load_brdf(const std::string& source, MerlTable::BinPoint merl_bins) {
+std::shared_ptr<const Brdf> load_brdf(const std::string& source, HalfDiffTable::BinPoint merl_bins) {
   if (is_builtin(source)) {
     const std::string name = source.substr(std::string(kBuiltinPrefix).size());
     const auto material = find_builtin(name);
@@ -75,64 +73,15 @@ std::shared_ptr<const Brdf> load_brdf(const std::string& source, MerlTable::BinP
   fail(source, "unsupported format '" + path.extension().string() + "' (supported: " + supported + "builtin:NAME)");
 }
 
-namespace {
-
-// The mean of a BRDF over turns of both directions about the normal: what an isotropic table holds of an
-// anisotropic measurement that has no lattice of its own to average on (RGL files; UTIA files average at
-// their nodes instead). 32 turns: on an analytic anisotropic GGX a 16-turn mean was 3.1% off the exact
-// one, 32 turns 1e-4.
-class AzimuthalMean final : public Brdf {
- public:
-  static constexpr int kTurns = 32;
-  explicit AzimuthalMean(const Brdf& source) : source_(source) {
-    for (int k = 0; k < kTurns; ++k) turns_[std::size_t(k)] = TurnedFrame(2.0 * kPi * k / kTurns);
-  }
-  std::optional<Rgb> eval(const Vec3& o, const Vec3& i) const override {
-    Rgb sum(0.0);
-    for (const TurnedFrame& turn : turns_) {
-      const auto f = source_.eval(turn.from_frame(o), turn.from_frame(i));
-      if (!f) return std::nullopt;
-      sum += *f;
-    }
-    return sum / double(kTurns);
-  }
-
- private:
-  const Brdf& source_;
-  std::array<TurnedFrame, kTurns> turns_;  // computed once: eval runs per bin
-};
-
-}  // namespace
-
-MerlTable table_of(const Brdf& source) {
-  if (const auto* table = dynamic_cast<const MerlTable*>(&source)) return *table;
-  // UTIA: anisotropic, tabulated as its azimuthal mean (the isotropic fits see that; fit/extract_2d.h
-  // fits the file itself).
-  if (const auto* utia = dynamic_cast<const UtiaBrdf*>(&source)) {
-    const UtiaBrdf mean = utia->azimuthal_mean();
-    MerlTable table = MerlTable::tabulate(mean);
-    table.set_source_samples(std::make_shared<const std::vector<MeasuredSample>>(mean.samples_at_first_azimuth()));
-    table.set_source_backscatter(utia->backscatter());
-    table.set_source_anisotropic_samples(std::make_shared<const std::vector<MeasuredSample>>(utia->samples()));
-    return table;
-  }
-  // Anisotropic RGL: the same, the lattice read through the file's evaluation (90 polar angles, 64 azimuths).
-  if (const auto* rgl = dynamic_cast<const RglBsdf*>(&source); rgl && rgl->anisotropic()) {
-    MerlTable table = MerlTable::tabulate(AzimuthalMean(*rgl));
-    table.set_source_backscatter(rgl->backscatter(90, 64));
-    table.set_source_half_diff(HalfDiffLattice::of(*rgl));
-    return table;
-  }
-  MerlTable table = MerlTable::tabulate(source);
-  // RGL: the table holds the reciprocal blend of the two one-sided estimates; the fits' distances read
-  // each where it was measured (fit/measurement.h). Copies of the file share its tables.
-  if (const auto* rgl = dynamic_cast<const RglBsdf*>(&source)) table.set_source_one_sided(std::make_shared<RglBsdf>(*rgl));
-  return table;
+HalfDiffTable table_of(const Brdf& source) {
+  if (const auto* table = dynamic_cast<const HalfDiffTable*>(&source)) return *table;
+  if (const auto* reader = dynamic_cast<const SelfTabulating*>(&source)) return reader->table();
+  return HalfDiffTable::tabulate(source);
 }
 
-MerlTable load_table(const std::string& source, MerlTable::BinPoint merl_bins) {
+HalfDiffTable load_table(const std::string& source, HalfDiffTable::BinPoint merl_bins) {
   // A MERL file is read as it is (not through load_brdf, whose shared copy would double the 17 MB).
-  if (!is_builtin(source) && fs::path(source).extension() == ".binary") return MerlTable::read(source, merl_bins);
+  if (!is_builtin(source) && fs::path(source).extension() == ".binary") return HalfDiffTable::read(source, merl_bins);
   return table_of(*load_brdf(source, merl_bins));
 }
 

@@ -23,20 +23,20 @@ bool is_measurement(const std::string& source);
 
 // Loads one source. Throws Error("<source>: <problem>"). `merl_bins`: which point of its bins a MERL
 // file's values stand for (io/merl.h).
-MerlTable load_table(const std::string& source, MerlTable::BinPoint merl_bins = MerlTable::BinPoint::start);
+HalfDiffTable load_table(const std::string& source, HalfDiffTable::BinPoint merl_bins = HalfDiffTable::BinPoint::start);
 
 // One source as it is, at its own resolution: the MERL table, the RGL file (symmetric slices), the UTIA
 // file or the analytic built-in. Throws Error("<source>: <problem>").
-std::shared_ptr<const Brdf> load_brdf(const std::string& source, MerlTable::BinPoint merl_bins = MerlTable::BinPoint::start);
+std::shared_ptr<const Brdf> load_brdf(const std::string& source, HalfDiffTable::BinPoint merl_bins = HalfDiffTable::BinPoint::start);
 
 // The MERL-layout table the fits see of a loaded source: a MERL table as it is, a UTIA file as its
-// azimuthal mean with its own back-scattering (MerlTable::source_backscatter), anything else tabulated.
+// azimuthal mean with its own back-scattering (HalfDiffTable::source_backscatter), anything else tabulated.
 // load_table(source) is table_of(*load_brdf(source)), without the copy for MERL files.
-MerlTable table_of(const Brdf& source);
+HalfDiffTable table_of(const Brdf& source);
 
 // "start" or "center"; nullopt otherwise.
-std::optional<MerlTable::BinPoint> parse_bin_point(const std::string& name);
-const char* to_string(MerlTable::BinPoint at);
+std::optional<HalfDiffTable::BinPoint> parse_bin_point(const std::string& name);
+const char* to_string(HalfDiffTable::BinPoint at);
 
 // Folders become the supported files inside them, globs their matches; `builtin:` alone becomes every
 // built-in material.

@@ -45,32 +45,32 @@ struct BinCoords {
 
 // Whether a stored double, scaled, is a value the table's float holds: not NaN or infinite (x - x is NaN for
 // both), not past a float's range. Branch-free, for the reader's vectorized loop.
-bool representable(double x, double scale) { return x - x == 0.0 && x * scale <= MerlTable::kMaxValue; }
+bool representable(double x, double scale) { return x - x == 0.0 && x * scale <= HalfDiffTable::kMaxValue; }
 
 BinCoords bin_coords(const Vec3& o, const Vec3& i) {
   const HalfDiff hd = to_half_diff(o, i);
   double phi_d = hd.phi_d;
   if (phi_d < 0.0) phi_d += kPi;  // reciprocity: period pi
   if (phi_d >= kPi) phi_d -= kPi;
-  return {std::sqrt(std::max(0.0, hd.theta_h) / (0.5 * kPi)) * MerlTable::kThetaH,
-          hd.theta_d / (0.5 * kPi) * MerlTable::kThetaD, phi_d / kPi * MerlTable::kPhiD};
+  return {std::sqrt(std::max(0.0, hd.theta_h) / (0.5 * kPi)) * HalfDiffTable::kThetaH,
+          hd.theta_d / (0.5 * kPi) * HalfDiffTable::kThetaD, phi_d / kPi * HalfDiffTable::kPhiD};
 }
 
 
 }  // namespace
 
-MerlTable::MerlTable() : data_(3 * kBins) { std::fill(data_.begin(), data_.end(), kMissing); }
+HalfDiffTable::HalfDiffTable() : data_(3 * kBins) { std::fill(data_.begin(), data_.end(), kMissing); }
 
-MerlTable::MerlTable(Uninitialized) : data_(3 * kBins) {}
+HalfDiffTable::HalfDiffTable(Uninitialized) : data_(3 * kBins) {}
 
-double MerlTable::theta_h(double i) {
+double HalfDiffTable::theta_h(double i) {
   const double u = i / kThetaH;
   return u * u * 0.5 * kPi;
 }
-double MerlTable::theta_d(double j) { return j / kThetaD * 0.5 * kPi; }
-double MerlTable::phi_d(double k) { return k / kPhiD * kPi; }
+double HalfDiffTable::theta_d(double j) { return j / kThetaD * 0.5 * kPi; }
+double HalfDiffTable::phi_d(double k) { return k / kPhiD * kPi; }
 
-MerlTable MerlTable::centres_to_edges() const {
+HalfDiffTable HalfDiffTable::centres_to_edges() const {
   // What is averaged is f cos(theta_i) cos(theta_o), smooth and bounded, not f, which grows as
   // 1 / cos^2 toward grazing back-scattering: a plain mean of f there is off by 7% in the last theta_h
   // bin, and the power iteration carries that into alpha (+1.7% at alpha 0.4). In half/diff
@@ -90,7 +90,7 @@ MerlTable MerlTable::centres_to_edges() const {
     const double a = th[i].cos[at] * td[j].cos[at], b = th[i].sin[at] * td[j].sin[at], c = tp[k].cos[at];
     return a * a - b * b * c * c;
   };
-  MerlTable out;
+  HalfDiffTable out;
   tbb::parallel_for(0, kThetaH, [&](int i) {
     // The lower edge of bin i lies halfway between the centres of bins i - 1 and i.
     const int h[2] = {std::max(i - 1, 0), i};
@@ -120,17 +120,17 @@ MerlTable MerlTable::centres_to_edges() const {
   return out;
 }
 
-void MerlTable::set(int i, int j, int k, const Rgb& v) {
+void HalfDiffTable::set(int i, int j, int k, const Rgb& v) {
   const std::size_t n = index(i, j, k);
   for (int c = 0; c < 3; ++c) channel(c)[n] = float(v[c]);
 }
 
-void MerlTable::set_missing(int i, int j, int k) {
+void HalfDiffTable::set_missing(int i, int j, int k) {
   const std::size_t n = index(i, j, k);
   for (int c = 0; c < 3; ++c) channel(c)[n] = kMissing;
 }
 
-MerlTable MerlTable::read(const std::string& path, BinPoint at) {
+HalfDiffTable HalfDiffTable::read(const std::string& path, BinPoint at) {
   std::error_code ec;
   const auto status = fs::status(path, ec);
   if (!fs::exists(status)) fail(path, "cannot open: no such file");
@@ -157,7 +157,7 @@ MerlTable MerlTable::read(const std::string& path, BinPoint at) {
 
   // Chunks of 1 MiB read with pread and converted in parallel into the table: the copy out of the page
   // cache and the conversion both run on every core, and no 35 MB buffer of doubles is ever allocated.
-  MerlTable table{Uninitialized{}};
+  HalfDiffTable table{Uninitialized{}};
   constexpr std::size_t kChunk = std::size_t(1) << 17;  // doubles
   const std::size_t total = 3 * kBins, chunks = (total + kChunk - 1) / kChunk;
   tbb::enumerable_thread_specific<std::vector<double>> buffers([] { return std::vector<double>(kChunk); });
@@ -208,8 +208,8 @@ MerlTable MerlTable::read(const std::string& path, BinPoint at) {
   return at == BinPoint::center ? table.centres_to_edges() : table;
 }
 
-MerlTable MerlTable::tabulate(const Brdf& brdf, BinPoint at) {
-  MerlTable table;
+HalfDiffTable HalfDiffTable::tabulate(const Brdf& brdf, BinPoint at) {
+  HalfDiffTable table;
   const double offset = at == BinPoint::center ? 0.5 : 0.0;
   tbb::parallel_for(0, kThetaH, [&](int i) {
     for (int j = 0; j < kThetaD; ++j) {
@@ -225,7 +225,7 @@ MerlTable MerlTable::tabulate(const Brdf& brdf, BinPoint at) {
   return table;
 }
 
-void MerlTable::write(const std::string& path) const {
+void HalfDiffTable::write(const std::string& path) const {
   AtomicFile out(path);
   File file(std::fopen(out.temp_path().c_str(), "wb"));
   if (!file) fail(path, std::string("cannot write: ") + std::strerror(errno));
@@ -246,7 +246,7 @@ void MerlTable::write(const std::string& path) const {
   out.commit();
 }
 
-std::optional<Rgb> MerlTable::eval(const Vec3& o, const Vec3& i) const {
+std::optional<Rgb> HalfDiffTable::eval(const Vec3& o, const Vec3& i) const {
   // No cosine divides here: a pair whose product of cosines underflows is still looked up (as the lanes do).
   if (!above_horizon(o) || !above_horizon(i)) return Rgb(0.0);
   const BinCoords x = bin_coords(o, i);
@@ -254,7 +254,7 @@ std::optional<Rgb> MerlTable::eval(const Vec3& o, const Vec3& i) const {
   return lookup_ == Lookup::nearest ? eval_nearest(x.h, x.d, x.p) : eval_linear(x.h, x.d, x.p);
 }
 
-std::optional<Rgb> MerlTable::eval_nearest(double x_h, double x_d, double x_p) const {
+std::optional<Rgb> HalfDiffTable::eval_nearest(double x_h, double x_d, double x_p) const {
   const int i = std::min(int(x_h), kThetaH - 1);
   const int j = std::min(int(x_d), kThetaD - 1);
   const int k = std::min(int(x_p), kPhiD - 1);
@@ -267,7 +267,7 @@ std::optional<Rgb> MerlTable::eval_nearest(double x_h, double x_d, double x_p) c
   return v;
 }
 
-std::optional<Rgb> MerlTable::eval_linear(double x_h, double x_d, double x_p) const {
+std::optional<Rgb> HalfDiffTable::eval_linear(double x_h, double x_d, double x_p) const {
   // Weights of the two neighbours along one axis; theta axes clamp at their last bin.
   struct Axis {
     int i0, i1;

@@ -1,4 +1,7 @@
-// MERL isotropic BRDF tables (Matusik et al. 2003): 90 x 90 x 180 bins over (theta_h, theta_d, phi_d).
+// The measurement every fit reads: an isotropic BRDF tabulated over Rusinkiewicz's half and difference
+// angles in the layout of MERL's tables (Matusik et al. 2003), 90 x 90 x 180 bins over (theta_h, theta_d,
+// phi_d), whatever the source: a MERL file is read into it as it is, other formats tabulate themselves into
+// it (io/input.h table_of) with what their fits read of them besides the bins (the source_* members).
 //
 // Bin positions (docs/conventions.md): theta_h bin i sits at theta_h = (i / 90)^2 pi/2, theta_d bin j
 // at j/90 pi/2, phi_d bin k at k/180 pi, the inverse of the index maps of MERL's reference reader
@@ -21,7 +24,7 @@
 
 namespace facetfit {
 
-class MerlTable final : public Brdf {
+class HalfDiffTable final : public Brdf {
  public:
   static constexpr int kThetaH = 90;
   static constexpr int kThetaD = 90;
@@ -45,16 +48,16 @@ class MerlTable final : public Brdf {
   // phi_d(k) below); a file written at centres is resampled on reading (docs/conventions.md).
   enum class BinPoint { start, center };
 
-  MerlTable();  // every bin missing
+  HalfDiffTable();  // every bin missing
 
   // Throws Error("<path>: <problem>") for anything that is not a complete, finite MERL table.
-  static MerlTable read(const std::string& path, BinPoint at = BinPoint::start);
+  static HalfDiffTable read(const std::string& path, BinPoint at = BinPoint::start);
   // Tabulates any BRDF at the bins' lower edges (`center`: at their centres, as a table for a file of
   // that convention); pairs below the horizon become missing bins.
-  static MerlTable tabulate(const Brdf& brdf, BinPoint at = BinPoint::start);
+  static HalfDiffTable tabulate(const Brdf& brdf, BinPoint at = BinPoint::start);
   // The table of values at the bins' centres moved to their lower edges: each value the mean of the
   // valid centre values around it (2 per axis; theta axes clamp at 0, phi_d wraps with period pi).
-  MerlTable centres_to_edges() const;
+  HalfDiffTable centres_to_edges() const;
   // Writes MERL layout through a temporary file; missing bins are written as -1.
   void write(const std::string& path) const;
 
@@ -127,7 +130,7 @@ class MerlTable final : public Brdf {
     }
   };
   struct Uninitialized {};
-  explicit MerlTable(Uninitialized);
+  explicit HalfDiffTable(Uninitialized);
 
   std::vector<float, UninitializedAllocator<float>> data_;  // 3 * kBins, channel-planar as in the file
   BackscatterLattice source_backscatter_;
@@ -135,6 +138,14 @@ class MerlTable final : public Brdf {
   std::shared_ptr<const OneSidedMeasurement> source_one_sided_;
   std::shared_ptr<const std::vector<MeasuredSample>> source_samples_, source_anisotropic_samples_;
   Lookup lookup_ = Lookup::linear;
+};
+
+// A source whose reader tabulates it (an RGL or a UTIA file): into the table, with what its fits read of it
+// besides the bins (the table's source_* members). table_of() (io/input.h) asks it.
+class SelfTabulating {
+ public:
+  virtual ~SelfTabulating() = default;
+  virtual HalfDiffTable table() const = 0;
 };
 
 }  // namespace facetfit

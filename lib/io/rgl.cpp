@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "core/error.h"
+#include "core/frame.h"
 #include "core/quadrature_rules.h"
 
 namespace facetfit {
@@ -693,6 +694,48 @@ std::optional<RglBsdf::Slices> parse_slices(const std::string& name) {
   if (name == "symmetric") return RglBsdf::Slices::symmetric;
   if (name == "light") return RglBsdf::Slices::light;
   return std::nullopt;
+}
+
+namespace {
+
+// The mean of a BRDF over turns of both directions about the normal: what an isotropic table holds of an
+// anisotropic measurement that has no lattice of its own to average on (RGL files; UTIA files average at
+// their nodes instead). 32 turns: on an analytic anisotropic GGX a 16-turn mean was 3.1% off the exact
+// one, 32 turns 1e-4.
+class AzimuthalMean final : public Brdf {
+ public:
+  static constexpr int kTurns = 32;
+  explicit AzimuthalMean(const Brdf& source) : source_(source) {
+    for (int k = 0; k < kTurns; ++k) turns_[std::size_t(k)] = TurnedFrame(2.0 * kPi * k / kTurns);
+  }
+  std::optional<Rgb> eval(const Vec3& o, const Vec3& i) const override {
+    Rgb sum(0.0);
+    for (const TurnedFrame& turn : turns_) {
+      const auto f = source_.eval(turn.from_frame(o), turn.from_frame(i));
+      if (!f) return std::nullopt;
+      sum += *f;
+    }
+    return sum / double(kTurns);
+  }
+
+ private:
+  const Brdf& source_;
+  std::array<TurnedFrame, kTurns> turns_;  // computed once: eval runs per bin
+};
+
+}  // namespace
+
+HalfDiffTable RglBsdf::table() const {
+  if (anisotropic()) {
+    HalfDiffTable table = HalfDiffTable::tabulate(AzimuthalMean(*this));
+    table.set_source_backscatter(backscatter(90, 64));
+    table.set_source_half_diff(HalfDiffLattice::of(*this));
+    return table;
+  }
+  // Copies of the file share its tables.
+  HalfDiffTable table = HalfDiffTable::tabulate(*this);
+  table.set_source_one_sided(std::make_shared<RglBsdf>(*this));
+  return table;
 }
 
 }  // namespace facetfit

@@ -34,10 +34,11 @@
 
 #include "core/brdf.h"
 #include "io/backscatter_lattice.h"
+#include "io/merl.h"
 
 namespace facetfit {
 
-class RglBsdf final : public Brdf, public OneSidedMeasurement {
+class RglBsdf final : public Brdf, public OneSidedMeasurement, public SelfTabulating {
  public:
   // Throws Error("<path>: <problem>") for anything that is not a complete, consistent, finite RGB
   // tensor file. Every size in the header is checked before it is trusted.
@@ -94,6 +95,11 @@ class RglBsdf final : public Brdf, public OneSidedMeasurement {
   // Back-scattering f(k, k) on `thetas` polar angles, at the middle of equal steps up to 89.5 degrees,
   // times `azimuths` azimuths: what an anisotropic fit reads (fit/extract_2d.h).
   BackscatterLattice backscatter(int thetas, int azimuths) const;
+  // The table the fits read: the reciprocal blend of the two one-sided estimates, with the file itself as
+  // the table's source_one_sided (the fits' distances read each estimate where it was measured,
+  // fit/measurement.h); for an anisotropic file its azimuthal mean, with its back-scattering at 90 x 64
+  // nodes and its lattice over the half vector's azimuth.
+  HalfDiffTable table() const override;
 
   // How well the file's tables agree with each other under this reader's parameterization (the
   // theta -> u = sqrt(theta / (pi/2)) and phi -> (phi - phi_i + pi) / 2pi maps, node-centred grids,

@@ -191,4 +191,13 @@ std::optional<Rgb> UtiaBrdf::eval(const Vec3& o, const Vec3& i) const {
   return sum;
 }
 
+HalfDiffTable UtiaBrdf::table() const {
+  const UtiaBrdf mean = azimuthal_mean();
+  HalfDiffTable table = HalfDiffTable::tabulate(mean);
+  table.set_source_samples(std::make_shared<const std::vector<MeasuredSample>>(mean.samples_at_first_azimuth()));
+  table.set_source_backscatter(backscatter());
+  table.set_source_anisotropic_samples(std::make_shared<const std::vector<MeasuredSample>>(samples()));
+  return table;
+}
+
 }  // namespace facetfit

@@ -21,10 +21,11 @@
 
 #include "core/brdf.h"
 #include "io/backscatter_lattice.h"
+#include "io/merl.h"
 
 namespace facetfit {
 
-class UtiaBrdf final : public Brdf {
+class UtiaBrdf final : public Brdf, public SelfTabulating {
  public:
   static constexpr int kTheta = 6, kPhi = 48;
   static constexpr double kThetaStep = 15.0, kPhiStep = 7.5;  // degrees
@@ -48,6 +49,10 @@ class UtiaBrdf final : public Brdf {
   std::vector<MeasuredSample> samples_at_first_azimuth() const;
   // Every node pair (82,944), weighted the same way: what the file measured, for anisotropic fits.
   std::vector<MeasuredSample> samples() const;
+  // The table the fits read: the azimuthal mean (the isotropic fits see that; fit/extract_2d.h fits the
+  // file itself), with the nodes it was measured at (the mean's, for the isotropic fits' distances; every
+  // node, for the anisotropic ones) and its back-scattering at its own nodes.
+  HalfDiffTable table() const override;
   // Writes the file through a temporary; throws Error naming the file.
   void write(const std::string& path) const;
 

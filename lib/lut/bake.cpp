@@ -77,7 +77,7 @@ BakeOutcome bake_material(const std::string& source, const std::string& name, co
     // make, the hash of its 0.7 MB milliseconds), the table only on a miss. Without one, the SHA-256 of a
     // 35 MB MERL table costs as much CPU as reading and fitting it: hash on one core while the other reads.
     std::string sha;
-    std::optional<MerlTable> table;
+    std::optional<HalfDiffTable> table;
     if (!options.force && fs::exists(json_path)) {
       sha = source_sha256(source);
     } else {

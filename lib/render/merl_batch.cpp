@@ -34,7 +34,7 @@ V atan2(D d, V y, V x) {
 }
 
 // The two neighbours along a theta axis of `res` bins at bin coordinate x >= 0, and the second's weight:
-// the last bin clamps (MerlTable::eval_linear).
+// the last bin clamps (HalfDiffTable::eval_linear).
 struct Axis {
   V i0, i1, t;
 };
@@ -79,18 +79,18 @@ void EvalMerlBatch(const MerlBatchModel& model, EvaluationBatch& batch) {
     phi_d = hn::IfThenElse(phi_d < zero, phi_d + pi, phi_d);  // reciprocity: period pi
     phi_d = hn::IfThenElse(phi_d >= pi, phi_d - pi, phi_d);
     // Bin coordinates (bin i of each axis at coordinate i), and the neighbours around them.
-    const Axis ah = clamped(d, hn::Sqrt(hn::Max(zero, theta_h) / half_pi) * hn::Set(d, MerlTable::kThetaH), MerlTable::kThetaH);
-    const Axis ad = clamped(d, theta_d / half_pi * hn::Set(d, MerlTable::kThetaD), MerlTable::kThetaD);
-    const V x_p = phi_d / pi * hn::Set(d, MerlTable::kPhiD);
-    const V p0 = hn::Min(hn::Floor(x_p), hn::Set(d, MerlTable::kPhiD - 1.0));
-    const Axis ap{p0, hn::IfThenElseZero(p0 < hn::Set(d, MerlTable::kPhiD - 1.0), p0 + one), x_p - p0};
+    const Axis ah = clamped(d, hn::Sqrt(hn::Max(zero, theta_h) / half_pi) * hn::Set(d, HalfDiffTable::kThetaH), HalfDiffTable::kThetaH);
+    const Axis ad = clamped(d, theta_d / half_pi * hn::Set(d, HalfDiffTable::kThetaD), HalfDiffTable::kThetaD);
+    const V x_p = phi_d / pi * hn::Set(d, HalfDiffTable::kPhiD);
+    const V p0 = hn::Min(hn::Floor(x_p), hn::Set(d, HalfDiffTable::kPhiD - 1.0));
+    const Axis ap{p0, hn::IfThenElseZero(p0 < hn::Set(d, HalfDiffTable::kPhiD - 1.0), p0 + one), x_p - p0};
     // Missing neighbours (NaN) drop out and the remaining weights are renormalized, per channel.
     V sum[3] = {zero, zero, zero}, weight[3] = {zero, zero, zero};
     for (int corner = 0; corner < 8; ++corner) {
       const V w = ((corner & 1) ? ah.t : one - ah.t) * ((corner & 2) ? ad.t : one - ad.t) * ((corner & 4) ? ap.t : one - ap.t);
       const auto counts = w > zero;
       const V i = (corner & 1) ? ah.i1 : ah.i0, j = (corner & 2) ? ad.i1 : ad.i0, p = (corner & 4) ? ap.i1 : ap.i0;
-      const V bin = p + hn::Set(d, MerlTable::kPhiD) * (j + hn::Set(d, MerlTable::kThetaD) * i);  // MerlTable::index
+      const V bin = p + hn::Set(d, HalfDiffTable::kPhiD) * (j + hn::Set(d, HalfDiffTable::kThetaD) * i);  // HalfDiffTable::index
       const auto index = hn::DemoteTo(di, bin);
       for (int ch = 0; ch < 3; ++ch) {
         const V v = hn::PromoteTo(d, hn::GatherIndex(df, model.channel[ch], index));
@@ -115,8 +115,8 @@ HWY_AFTER_NAMESPACE();
 #include "render/simd_dispatch.h"
 namespace facetfit {
 
-std::optional<MerlBatchModel> MerlBatchModel::of(const MerlTable& table) {
-  if (table.lookup() != MerlTable::Lookup::linear) return std::nullopt;
+std::optional<MerlBatchModel> MerlBatchModel::of(const HalfDiffTable& table) {
+  if (table.lookup() != HalfDiffTable::Lookup::linear) return std::nullopt;
   MerlBatchModel m;
   for (int c = 0; c < 3; ++c) m.channel[c] = table.channel(c);
   return m;

@@ -521,8 +521,8 @@ std::shared_ptr<const ShadingModel> load_material(const SceneDesc& scene, const 
     const std::shared_ptr<const Brdf> measurement = load_brdf(source);
     const auto* rgl = dynamic_cast<const RglBsdf*>(measurement.get());
     const bool utia = dynamic_cast<const UtiaBrdf*>(measurement.get()) != nullptr;
-    std::shared_ptr<const MerlTable> table = std::dynamic_pointer_cast<const MerlTable>(measurement);
-    if (!table && (!(rgl || utia) || m.proposal.empty())) table = std::make_shared<MerlTable>(table_of(*measurement));
+    std::shared_ptr<const HalfDiffTable> table = std::dynamic_pointer_cast<const HalfDiffTable>(measurement);
+    if (!table && (!(rgl || utia) || m.proposal.empty())) table = std::make_shared<HalfDiffTable>(table_of(*measurement));
     std::shared_ptr<const Proposal> proposal;
     if (!m.proposal.empty()) {
       proposal = std::make_shared<VisibleSlopeProposal>(scene_lut(scene, m.proposal).tables);

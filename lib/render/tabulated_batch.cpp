@@ -286,7 +286,7 @@ std::optional<TabulatedLanes> TabulatedLanes::recognise(const LanesInput& in) {
   const auto* slopes = dynamic_cast<const VisibleSlopeProposal*>(in.proposal);
   if (!slopes || !(in.lobe_weight > 0.0)) return std::nullopt;
   TabulatedLanes lanes{TabulatedBatchModel::of(*slopes, dynamic_cast<const TabulatedMicrofacet*>(&in.brdf), in.lobe_weight), {}};
-  if (const auto* table = dynamic_cast<const MerlTable*>(&in.brdf)) lanes.merl = MerlBatchModel::of(*table);
+  if (const auto* table = dynamic_cast<const HalfDiffTable*>(&in.brdf)) lanes.merl = MerlBatchModel::of(*table);
   return lanes;
 }
 

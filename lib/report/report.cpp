@@ -396,7 +396,7 @@ json run_report(const ReportOptions& o) {
           write_heatmap_png((images / (r + "_delta_e.png")).string(), img.width, img.height, diff.delta_e, mask);
         }
         // The figures the paper validates fits with: lobes in the plane of incidence, NDF, Fresnel.
-        const MerlTable table = load_table(source, o.bake.fit.merl_bins);
+        const HalfDiffTable table = load_table(source, o.bake.fit.merl_bins);
         for (const auto& [file, svg] : material_figures(table, read_lut(lut)))
           write_file_atomic((images / file).string(), svg);
         write_file_atomic((images / kCompleteStamp).string(), key + "\n");

@@ -48,7 +48,7 @@ std::string to_json_text(const py::object& o) { return py::module_::import("json
 // A measured material as the fit reads it: the MERL-layout table of any input.
 struct Measurement {
   std::string source;
-  std::shared_ptr<const MerlTable> table;
+  std::shared_ptr<const HalfDiffTable> table;
 };
 
 struct Model {
@@ -99,7 +99,7 @@ Measurement load(const std::string& source, const std::string& merl_bins) {
   const auto b = parse_bin_point(merl_bins);
   if (!b) throw py::value_error("merl_bins: must be start or center, not '" + merl_bins + "'");
   py::gil_scoped_release release;
-  return Measurement{source, std::make_shared<MerlTable>(load_table(source, *b))};
+  return Measurement{source, std::make_shared<HalfDiffTable>(load_table(source, *b))};
 }
 
 Fit fit(const Measurement& m, const FitOptions& options) {

@@ -22,10 +22,10 @@ std::vector<GroundTruthCase> standard_ground_truth_cases() {
 
 GroundTruthError measure_ground_truth(const GroundTruthCase& c, const Fitter& fitter, const std::string& merl_path) {
   const Ndf ndf = Ndf::isotropic(c.type, c.alpha);
-  MerlTable table = MerlTable::tabulate(MicrofacetBrdf(ndf, c.smith, c.fresnel));
+  HalfDiffTable table = HalfDiffTable::tabulate(MicrofacetBrdf(ndf, c.smith, c.fresnel));
   if (!merl_path.empty()) {
     table.write(merl_path);
-    table = MerlTable::read(merl_path);
+    table = HalfDiffTable::read(merl_path);
   }
   const FitResult fit = fitter.fit(table);
   GroundTruthError e;
