@@ -188,7 +188,7 @@ void run_bake(const BakeArgs& args, Context& ctx) {
   }
   BakeOptions options;
   options.colorspace = args.color.working_space;
-  if (!run_step(status, [&] { options.from_rec709 = args.color.from_rec709(); })) return;
+  if (!run_step(status, [&] { options.from_rec709 = args.color.from_rec709(args.color.config()); })) return;
   if (!run_step(status, [&] { prepare_output_folder(args.out_dir); })) return;
 
   options.fit = *fit;

@@ -46,17 +46,17 @@ void add_view_options(CLI::App* cmd, ColorSettings& s) {
   add_ocio_config_option(cmd, s);
 }
 
-ColorMatrix ColorSettings::from_rec709() const {
-  const ColorConfig config(ocio_config);  // a config named by $OCIO is read, and refused when broken, even if unused
-  return config.from_rec709(working_space);
-}
+// A config named by $OCIO is read, and refused when broken, even where the command ends up not needing it.
+ColorConfig ColorSettings::config() const { return ColorConfig(ocio_config); }
 
-DisplayTransform ColorSettings::pictures(const std::string& space, const ColorMatrix& space_from_rec709) const {
+ColorMatrix ColorSettings::from_rec709(const ColorConfig& config) const { return config.from_rec709(working_space); }
+
+DisplayTransform ColorSettings::pictures(const ColorConfig& config, const std::string& space, const ColorMatrix& space_from_rec709) const {
   if (display.empty()) {
     if (!view.empty()) fail("--view " + view, "needs --display");
     return DisplayTransform(glm::inverse(space_from_rec709));
   }
-  return DisplayTransform(ColorConfig(ocio_config), space, display, view);
+  return DisplayTransform(config, space, display, view);
 }
 
 namespace {

@@ -8,6 +8,7 @@
 #include <optional>
 #include <string>
 
+#include "color/colorspace.h"
 #include "color/display.h"
 #include "core/color_space.h"
 #include "fit/fit.h"
@@ -50,11 +51,13 @@ struct ColorSettings {
   std::string working_space = kRec709Space;
   std::string ocio_config;
   std::string display, view;
-  // The space's matrix from lin_rec709; throws Error (one line) for a bad config or an unknown space.
-  ColorMatrix from_rec709() const;
+  // The config of --ocio-config or $OCIO, read once per command; throws Error (one line) when it is broken.
+  ColorConfig config() const;
+  // The working space's matrix from lin_rec709; throws Error (one line) for an unknown space.
+  ColorMatrix from_rec709(const ColorConfig& config) const;
   // The pictures of pixels in `space` (matrix `from_rec709`): the config's display and view, or without
   // --display the sRGB display of their Rec.709 colour. Throws Error (one line).
-  DisplayTransform pictures(const std::string& space, const ColorMatrix& from_rec709) const;
+  DisplayTransform pictures(const ColorConfig& config, const std::string& space, const ColorMatrix& from_rec709) const;
 };
 void add_working_space_options(CLI::App* cmd, ColorSettings& settings);
 void add_view_options(CLI::App* cmd, ColorSettings& settings);

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <optional>
 
 #include "commands.h"
 #include "color/image_diff.h"
@@ -85,9 +86,12 @@ void run_render(const RenderArgs& args, Context& ctx) {
     const std::vector<std::pair<std::string, std::string>> outputs = {
         {"-o", args.output}, {"--png", args.png}, {"--save-sky", args.save_sky}};
     check_outputs(outputs);
-    const ColorMatrix from_rec709 = args.color.from_rec709();
+    const ColorConfig config = args.color.config();
+    const ColorMatrix from_rec709 = args.color.from_rec709(config);
     // Before the render, which can take minutes: the --png's display and view must exist.
-    const DisplayTransform pictures = args.color.pictures(args.color.working_space, from_rec709);
+    std::optional<DisplayTransform> pictures;
+    if (!args.png.empty() || !args.color.display.empty() || !args.color.view.empty())
+      pictures.emplace(args.color.pictures(config, args.color.working_space, from_rec709));
     SceneDesc scene;
     // A measurement rendered as one of the LUT's representations is baked first, into a temporary folder.
     std::unique_ptr<fs::path, void (*)(fs::path*)> baked_dir(nullptr, [](fs::path* p) {
@@ -146,7 +150,7 @@ void run_render(const RenderArgs& args, Context& ctx) {
     write_exr(args.output, image,
               {{"scene", args.scene.empty() ? "default" : args.scene}, {"spp", std::to_string(image.spp)},
                {"seconds", std::to_string(image.seconds)}});
-    if (!args.png.empty()) write_display_png(args.png, image.rgba.data(), image.width, image.height, 4, pictures);
+    if (!args.png.empty()) write_display_png(args.png, image.rgba.data(), image.width, image.height, 4, *pictures);
     if (!ctx.quiet()) std::printf("%s (%dx%d, %d spp, %.3f s)\n", args.output.c_str(), image.width, image.height, image.spp, image.seconds);
   } catch (const Error& e) {
     report_error(e.what());

@@ -134,7 +134,7 @@ void run_report_command(const ReportArgs& args, Context& ctx) {
   o.bake.tolerance = args.tolerance;
   if (!args.color.display.empty() || !args.color.view.empty()) {
     try {
-      o.pictures = std::make_shared<const DisplayTransform>(args.color.pictures(kRec709Space, ColorMatrix(1.0)));
+      o.pictures = std::make_shared<const DisplayTransform>(args.color.pictures(args.color.config(), kRec709Space, ColorMatrix(1.0)));
     } catch (const Error& e) {
       report_error(e.what());
       status = 1;

@@ -43,8 +43,7 @@ std::string bake_cache_key(const std::string& sha256, const BakeOptions& o) {
   k["sampling"] = o.with_sampling;
   if (o.colorspace != kRec709Space) {
     k["colorspace"] = o.colorspace;
-    for (int column = 0; column < 3; ++column)
-      for (int row = 0; row < 3; ++row) k["colorspace_matrix"].push_back(o.from_rec709[column][row]);
+    k["colorspace_matrix"] = matrix_text(o.from_rec709);
   }
   const std::string text = json_text(k);
   return sha256_hex(text.data(), text.size());

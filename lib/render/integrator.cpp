@@ -64,7 +64,10 @@ Integrator::Integrator(const SceneDesc& desc, const RenderSettings& settings)
   check_memory("render", "a " + std::to_string(width_) + " x " + std::to_string(height_) + " image", image_bytes(desc.camera),
                budget);
   std::uint64_t memory_left = budget - image_bytes(desc.camera);
-  for (LightDesc light : desc.lights) lights_.push_back((light.value = desc.from_rec709 * light.value, light));
+  for (LightDesc light : desc.lights) {
+    light.value = desc.from_rec709 * light.value;
+    lights_.push_back(light);
+  }
   const std::map<std::string, int> material_index = LoadMaterials(memory_left);
   LoadEnvironment(memory_left);
   referenced_by(desc_, "a mesh object", [&] { return &tracer_.emplace(desc_); });
