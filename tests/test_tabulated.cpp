@@ -26,7 +26,7 @@ MicrofacetTables fitted_tables(NdfType type, double alpha, const Fresnel& fresne
   return {fit.ndf(), smith, fit.fresnel(), {}, {}};
 }
 
-Vec3 direction_at(double theta_deg, double phi = 0.3) { return spherical_direction(theta_deg * kPi / 180.0, phi); }
+using test::direction_at;
 
 TEST(Tabulated, EvalMatchesTheAnalyticModel) {
   const Fresnel gold = Fresnel::conductor({0.143, 0.374, 1.442}, {3.983, 2.385, 1.603});

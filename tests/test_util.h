@@ -104,4 +104,7 @@ inline RunResult run_command(const std::string& command) {
 inline RunResult facetfit(const std::string& args) { return run_command(std::string(FACETFIT_CLI) + " " + args); }
 #endif
 
+// The unit direction at elevation theta_deg (degrees) and azimuth phi (radians).
+inline Vec3 direction_at(double theta_deg, double phi = 0.3) { return spherical_direction(theta_deg * kPi / 180.0, phi); }
+
 }  // namespace facetfit::test

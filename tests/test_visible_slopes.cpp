@@ -11,11 +11,12 @@
 #include "model/ndf.h"
 #include "model/tabulated.h"
 #include "model/visible_slopes.h"
+#include "test_util.h"
 
 namespace facetfit {
 namespace {
 
-Vec3 direction_at(double theta_deg, double phi = 0.3) { return spherical_direction(theta_deg * kPi / 180.0, phi); }
+using test::direction_at;
 
 struct Lobe {
   NdfType type;

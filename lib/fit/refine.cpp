@@ -59,9 +59,9 @@ struct PassTerms {
 // The residuals of one row (bins sharing theta_h and theta_d): 3 per bin. Parameter blocks: body (3),
 // the body's exponent k (1), the row's Fresnel entries (3 each), then its D nodes (1 each), with the
 // pass's fixed terms per bin.
-class RowCost final : public ceres::CostFunction {
+class LobeRowCost final : public ceres::CostFunction {
  public:
-  RowCost(const MeasuredBins& bins, const MeasuredBins::Row& row, const PassTerms& terms, NodeWeights fresnel, NodeWeights nodes)
+  LobeRowCost(const MeasuredBins& bins, const MeasuredBins::Row& row, const PassTerms& terms, NodeWeights fresnel, NodeWeights nodes)
       : bins_(bins), row_(row), terms_(terms), fresnel_(std::move(fresnel)), nodes_(std::move(nodes)) {
     set_num_residuals(int(3 * (row.end - row.begin)));
     mutable_parameter_block_sizes()->push_back(3);
@@ -236,7 +236,7 @@ LobeFit refine_lobe(const MeasuredBins& bins, const Quadrature& quad, Smith smit
       std::vector<double*> blocks{body.data(), &exponent};
       for (int e : row_entries[r].node) blocks.push_back(fresnel[std::size_t(e)].data());
       for (int n : row_nodes[r].node) blocks.push_back(&d[std::size_t(n)]);
-      problem.AddResidualBlock(new RowCost(bins, bins.rows[r], terms, row_entries[r], row_nodes[r]), nullptr, blocks);
+      problem.AddResidualBlock(new LobeRowCost(bins, bins.rows[r], terms, row_entries[r], row_nodes[r]), nullptr, blocks);
     }
     std::vector<double*> all_nodes;
     for (double& v : d) all_nodes.push_back(&v);
@@ -297,7 +297,7 @@ double refine_jacobian_error(const MeasuredBins& bins, const Quadrature& quad, S
     std::vector<double*> blocks{body.data(), &exponent};
     for (int e : entries.node) blocks.push_back(fresnel[std::size_t(e)].data());
     for (int n : nodes.node) blocks.push_back(&d[std::size_t(n)]);
-    worst = std::max(worst, jacobian_error(RowCost(bins, row, terms, std::move(entries), std::move(nodes)), blocks));
+    worst = std::max(worst, jacobian_error(LobeRowCost(bins, row, terms, std::move(entries), std::move(nodes)), blocks));
   }
   return worst;
 }
