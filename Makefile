@@ -43,9 +43,10 @@ asan: deps
 	  -DFACETFIT_SANITIZE=ON -DFACETFIT_BUILD_TOOLS=OFF -DFACETFIT_WERROR=ON >/dev/null
 	@cmake --build $(ASAN_BUILD) -j $(JOBS) --target facetfit_unit_tests facetfit_stress_tests
 
-# libFuzzer harnesses of every reader (fuzz/), built by clang with ASan + UBSan.
+# libFuzzer harnesses of every reader (fuzz/), built by clang with ASan + UBSan. Without unity files: the one
+# build where each source of the library compiles alone, so that none leans on a neighbour's includes.
 fuzz-build: deps
-	@cmake -S . -B $(FUZZ_BUILD) $(CMAKE_GEN) -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++ \
+	@cmake -S . -B $(FUZZ_BUILD) $(CMAKE_GEN) -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++ -DFACETFIT_UNITY_BUILD=OFF \
 	  -DFACETFIT_SANITIZE=ON -DFACETFIT_FUZZ=ON -DFACETFIT_BUILD_TOOLS=OFF -DFACETFIT_OSL_TESTS=OFF -DFACETFIT_MITSUBA_TESTS=OFF >/dev/null
 	@cmake --build $(FUZZ_BUILD) -j $(JOBS) --target fuzz_all
 
