@@ -3,6 +3,8 @@ fitted, baked, evaluated, sampled, rendered and compared (docs/python.md)."""
 import json
 import math
 import os
+import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -254,6 +256,22 @@ def test_bake_takes_what_the_command_takes(tmp_path):
         facetfit.bake(str(src), str(tmp_path / "x"), name="one")
     records = facetfit.bake("builtin:", str(tmp_path / "all"), refine="none", sampling=False)
     assert len(records) == len(facetfit.builtins()) and all(r["status"] == "baked" for r in records)
+
+
+def test_the_wheel_installs_the_command(tmp_path):
+    """Issue 48: `pip install .` puts the command among the environment's scripts and its plugins in the
+    environment's lib/facetfit, where it looks for them: it bakes, reads back what Python wrote, and writes
+    a PNG through the OpenImageIO module."""
+    command = os.path.join(os.path.dirname(sys.executable), "facetfit")
+    run = lambda *args: subprocess.run([command, *args], capture_output=True, text=True, check=True).stdout
+    assert run("--version").startswith("facetfit " + facetfit.__version__ + " (")
+    f = facetfit.fit("builtin:red-plastic")
+    f.write_lut(tmp_path / "red.exr")
+    info = json.loads(run("info", "--json", str(tmp_path / "red.exr")))
+    assert info["metadata"]["recommended"]["representation"] == f.recommended()["representation"]
+    run("render", "--material", str(tmp_path / "red.exr"), "--spp", "1", "--width", "16", "--height", "12",
+        "-o", str(tmp_path / "red-render.exr"), "--png", str(tmp_path / "red-render.png"))
+    assert (tmp_path / "red-render.png").stat().st_size > 0
 
 
 def test_write_image(tmp_path):
