@@ -156,6 +156,38 @@ TEST(Lut, ClosuresAreValidatedAndOlderLutsGetOneLobe) {
   EXPECT_EQ(c.lobes[0].fresnel, ClosureLobe::Fresnel::f82_tint);
 }
 
+// A LUT in another working space must carry a usable matrix from lin_rec709: anything else is one line
+// naming the file and the attribute, never colours multiplied by garbage.
+TEST(Lut, AWorkingSpaceWithoutAUsableMatrixIsRefused) {
+  const Baked b = fit_of(MicrofacetBrdf(Ndf::isotropic(NdfType::ggx, 0.2), Smith::correlated, Fresnel::schlick(Rgb(0.9, 0.6, 0.3))));
+  TempDir dir;
+  write_lut(dir.file("g.exr"), make_lut(b.fit, b.fitter.quadrature(), "x", "", 0.02, true));
+  auto in = OIIO::ImageInput::open(dir.file("g.exr"));
+  const OIIO::ImageSpec original = in->spec();
+  std::vector<float> px(std::size_t(original.width) * std::size_t(original.height) * std::size_t(original.nchannels));
+  ASSERT_TRUE(in->read_image(0, 0, 0, original.nchannels, OIIO::TypeDesc::FLOAT, px.data()));
+  const auto with_matrix = [&](const std::string& file, const char* matrix) {
+    OIIO::ImageSpec spec = original;
+    spec.attribute("facetfit:colorspace", "ACEScg");
+    if (matrix) spec.attribute("facetfit:colorspace_matrix", matrix);
+    auto out = OIIO::ImageOutput::create(dir.file(file));
+    EXPECT_TRUE(out->open(dir.file(file), spec) && out->write_image(OIIO::TypeDesc::FLOAT, px.data()) && out->close());
+    return dir.file(file);
+  };
+  const char* kAcesCg = "0.61 0.34 0.05 0.07 0.92 0.01 0.02 0.11 0.87";
+  const Lut good = read_lut(with_matrix("good.exr", kAcesCg));
+  EXPECT_EQ(good.meta.colorspace, "ACEScg");
+  EXPECT_NEAR(good.meta.from_rec709[1][0], 0.34, 1e-12);  // column 1, row 0: the text is row by row
+  for (const char* bad : {static_cast<const char*>(nullptr), "", "0.61 0.34 0.05 0.07 0.92 0.01 0.02 0.11",
+                          "0.61 0.34 0.05 0.07 0.92 0.01 0.02 0.11 0.87 1", "0.61 0.34 0.05 0.07 nan 0.01 0.02 0.11 0.87",
+                          "1 2 3 2 4 6 0 0 1", "1e30 0 0 0 1 0 0 0 1", "1 0 0 0 1 0 0 0 inf", "one two three"}) {
+    const std::string e = error_of([&] { read_lut(with_matrix("bad.exr", bad)); });
+    EXPECT_NE(e.find("bad.exr: facetfit:colorspace_matrix is missing or not nine numbers"), std::string::npos)
+        << (bad ? bad : "(absent)") << ": " << e;
+    EXPECT_EQ(e.find('\n'), std::string::npos) << e;
+  }
+}
+
 TEST(Lut, ToleranceChoosesTheRepresentation) {
   const Baked two_lobes = fit_of(SumBrdf({std::make_shared<MicrofacetBrdf>(Ndf::isotropic(NdfType::ggx, 0.05), Smith::correlated, Fresnel::one()),
                                           std::make_shared<MicrofacetBrdf>(Ndf::isotropic(NdfType::ggx, 0.5), Smith::correlated, Fresnel::one())}));

@@ -64,7 +64,8 @@ inline void convert_pixels(float* px, std::size_t pixels, int stride, const Colo
 }
 
 // A matrix as text, nine numbers row by row (facetfit:colorspace_matrix of a LUT or a render), and back:
-// nullopt unless nine finite numbers with a nonzero determinant.
+// nullopt unless nine numbers within +-100 with a determinant above 1e-6 (a conversion between two RGB
+// spaces of real primaries has entries of a few units: ACEScg's from Rec.709 are within 0.02-0.9).
 inline std::string matrix_text(const ColorMatrix& m) {
   std::ostringstream out;
   out.precision(17);
@@ -77,7 +78,7 @@ inline std::optional<ColorMatrix> parse_matrix(const std::string& text) {
   ColorMatrix m;
   for (int row = 0; row < 3; ++row)
     for (int column = 0; column < 3; ++column)
-      if (!(in >> m[column][row]) || !std::isfinite(m[column][row])) return std::nullopt;
+      if (!(in >> m[column][row]) || !(std::abs(m[column][row]) <= 100.0)) return std::nullopt;
   std::string rest;
   if (in >> rest || !(std::abs(glm::determinant(m)) > 1e-6)) return std::nullopt;
   return m;
