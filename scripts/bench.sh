@@ -12,6 +12,8 @@ trap 'rm -f "$json" "$startup"' EXIT
 python3 "$root/bench/startup.py" "$build/bin/facetfit" "$startup" 10 "$root/../shared/data/rgl/ilm_l3_37_metallic_rgb.bsdf"
 python3 "$root/scripts/bench_to_md.py" "$json" "$root/docs/benchmarks.md" "$startup"
 "$build/bench/facetfit_pareto" "$root/docs"
+# The report's noise at its default spp and at 32, against 1024 (the floor report.h states).
+python3 "$root/bench/report_noise.py" "$build/bin/facetfit" "$root/docs/report-noise.md"
 # Cycles through Blender's bpy wheel, in a venv of the build.
 py=$("$root/scripts/setup-bpy.sh" "$build/../bpy-venv" | tail -n 1)
 "$py" "$root/scripts/cycles_compare.py" "$build/bin/facetfit" "$root/docs/cycles.md"
