@@ -34,6 +34,28 @@ Baked fit_of(const Brdf& brdf, Smith smith = Smith::correlated) {
   return b;
 }
 
+// The LUT of a fit, read back whole so that it can be written again with its attributes changed (the
+// damaged-file tests).
+class RewritableLut {
+ public:
+  RewritableLut(const std::string& path, const Baked& b) {
+    write_lut(path, make_lut(b.fit, b.fitter.quadrature(), "x", "", 0.02, true));
+    auto in = OIIO::ImageInput::open(path);
+    spec = in->spec();
+    pixels_.resize(std::size_t(spec.width) * std::size_t(spec.height) * std::size_t(spec.nchannels));
+    EXPECT_TRUE(in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, pixels_.data()));
+  }
+  // The pixels as read, under `changed` (a copy of `spec` with attributes set or erased).
+  void write(const std::string& path, const OIIO::ImageSpec& changed) const {
+    auto out = OIIO::ImageOutput::create(path);
+    EXPECT_TRUE(out->open(path, changed) && out->write_image(OIIO::TypeDesc::FLOAT, pixels_.data()) && out->close());
+  }
+  OIIO::ImageSpec spec;
+
+ private:
+  std::vector<float> pixels_;
+};
+
 TEST(Lut, RoundTripEvaluatesAsTheInMemoryModel) {
   const Baked b = fit_of(MicrofacetBrdf(Ndf::isotropic(NdfType::ggx, 0.25), Smith::separable,
                                         Fresnel::conductor({0.2, 0.9, 1.1}, {3.9, 2.4, 2.1})),
@@ -112,21 +134,16 @@ TEST(Lut, MetadataRoundTrip) {
 TEST(Lut, ClosuresAreValidatedAndOlderLutsGetOneLobe) {
   const Baked b = fit_of(MicrofacetBrdf(Ndf::isotropic(NdfType::ggx, 0.2), Smith::correlated, Fresnel::schlick(Rgb(0.9, 0.6, 0.3))));
   TempDir dir;
-  write_lut(dir.file("g.exr"), make_lut(b.fit, b.fitter.quadrature(), "x", "", 0.02, true));
-  auto in = OIIO::ImageInput::open(dir.file("g.exr"));
-  const OIIO::ImageSpec original = in->spec();
-  std::vector<float> px(std::size_t(original.width) * std::size_t(original.height) * std::size_t(original.nchannels));
-  ASSERT_TRUE(in->read_image(0, 0, 0, original.nchannels, OIIO::TypeDesc::FLOAT, px.data()));
+  const RewritableLut original(dir.file("g.exr"), b);
   const auto damaged = [&](const char* name, float value, const std::string& expected) {
-    OIIO::ImageSpec spec = original;
+    OIIO::ImageSpec spec = original.spec;
     if (std::isinf(value))
       spec.erase_attribute(name);
     else if (std::string(name).find("code") != std::string::npos || std::string(name).find("lobes") != std::string::npos)
       spec.attribute(name, int(value));
     else
       spec.attribute(name, value);
-    auto out = OIIO::ImageOutput::create(dir.file("bad.exr"));
-    ASSERT_TRUE(out->open(dir.file("bad.exr"), spec) && out->write_image(OIIO::TypeDesc::FLOAT, px.data()) && out->close());
+    original.write(dir.file("bad.exr"), spec);
     const std::string e = error_of([&] { read_lut(dir.file("bad.exr")); });
     EXPECT_NE(e.find("bad.exr: facetfit:" + expected), std::string::npos) << name << " " << value << ": " << e;
   };
@@ -159,19 +176,14 @@ TEST(Lut, ClosuresAreValidatedAndOlderLutsGetOneLobe) {
 // A LUT in another working space must carry a usable matrix from lin_rec709: anything else is one line
 // naming the file and the attribute, never colours multiplied by garbage.
 TEST(Lut, AWorkingSpaceWithoutAUsableMatrixIsRefused) {
-  const Baked b = fit_of(MicrofacetBrdf(Ndf::isotropic(NdfType::ggx, 0.2), Smith::correlated, Fresnel::schlick(Rgb(0.9, 0.6, 0.3))));
   TempDir dir;
-  write_lut(dir.file("g.exr"), make_lut(b.fit, b.fitter.quadrature(), "x", "", 0.02, true));
-  auto in = OIIO::ImageInput::open(dir.file("g.exr"));
-  const OIIO::ImageSpec original = in->spec();
-  std::vector<float> px(std::size_t(original.width) * std::size_t(original.height) * std::size_t(original.nchannels));
-  ASSERT_TRUE(in->read_image(0, 0, 0, original.nchannels, OIIO::TypeDesc::FLOAT, px.data()));
+  const RewritableLut original(dir.file("g.exr"), fit_of(MicrofacetBrdf(Ndf::isotropic(NdfType::ggx, 0.2), Smith::correlated,
+                                                                         Fresnel::schlick(Rgb(0.9, 0.6, 0.3)))));
   const auto with_matrix = [&](const std::string& file, const char* matrix) {
-    OIIO::ImageSpec spec = original;
+    OIIO::ImageSpec spec = original.spec;
     spec.attribute("facetfit:colorspace", "ACEScg");
     if (matrix) spec.attribute("facetfit:colorspace_matrix", matrix);
-    auto out = OIIO::ImageOutput::create(dir.file(file));
-    EXPECT_TRUE(out->open(dir.file(file), spec) && out->write_image(OIIO::TypeDesc::FLOAT, px.data()) && out->close());
+    original.write(dir.file(file), spec);
     return dir.file(file);
   };
   const char* kAcesCg = "0.61 0.34 0.05 0.07 0.92 0.01 0.02 0.11 0.87";
