@@ -20,7 +20,7 @@ struct ReportOptions {
   int size = 128;   // image side, pixels
   // Samples per pixel. Noise adds to Delta E: on the built-in set, against 1024 spp, 32 spp added a mean of
   // 0.22 (at most 1.85), 256 adds 0.034 (at most 0.39), less than the gaps between the database means it
-  // ranks (README, "report").
+  // ranks (docs/report-noise.md, bench/report_noise.py).
   int spp = 256;
   std::uint64_t max_memory = 0;  // per render (render/renderer.h); 0: half of the machine's
   int shard = 1, shards = 1;  // this run renders materials k with k % shards == shard - 1
