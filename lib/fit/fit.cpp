@@ -147,8 +147,12 @@ void Fitter::refine_on_measurement(const HalfDiffTable& table, FitResult& result
 void Fitter::measure_paper_fits(const HalfDiffTable& table, FitResult& result) const {
   const MeasuredBins bins = error_bins(table);
   if (bins.size() == 0) return;
-  result.error_extraction = result.error = measurement_error(bins, TabulatedMicrofacet(result.lobe.tables(options_.smith), {}));
-  for (ParametricFit* p : {&result.ggx, &result.beckmann, &result.lsq}) p->error = parametric_error(bins, options_.smith, *p);
+  // Four independent sums, each in its own order: concurrent, and the same to the bit at any thread count.
+  const auto parametric = [&](ParametricFit& p) { return [&] { p.error = parametric_error(bins, options_.smith, p); }; };
+  tbb::parallel_invoke(
+      [&] { result.error = measurement_error(bins, TabulatedMicrofacet(result.lobe.tables(options_.smith), {})); },
+      parametric(result.ggx), parametric(result.beckmann), parametric(result.lsq));
+  result.error_extraction = result.error;
 }
 
 void Fitter::fit_anisotropic_lobes(const HalfDiffTable& table, const FresnelCurve& paper_fresnel, const FitResult& result,
