@@ -7,7 +7,7 @@ import tempfile
 
 NOTES = {
     "BM_ReadMerl": "read a MERL .binary (35 MB of doubles) into the in-memory table",
-    "BM_Fit": "the paper's method (`--refine none`): extraction + Fresnel pass + both alphas on a loaded table",
+    "BM_Fit": "the paper's method (`--refine none`): extraction + Fresnel pass + both alphas on a loaded table, and its representations' distances from the measurement (which choose the recommended one)",
     "BM_FitRgl": "a real RGL material (felt, metallic): the paper's method alone (anchor) and the default fit (`--refine full`: three parametric fits, two coat trials, two refinements of the tabulated lobe, every distance)",
     "BM_Extraction": "power iteration alone",
     "BM_Extraction2D": "anisotropic power iteration (GGX alpha 0.4 x 0.15, masking) on theta nodes x azimuthal bins, the kernel applied by FFTs",
