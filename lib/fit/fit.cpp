@@ -148,10 +148,10 @@ void Fitter::measure_paper_fits(const HalfDiffTable& table, FitResult& result) c
   const MeasuredBins bins = error_bins(table);
   if (bins.size() == 0) return;
   // Four independent sums, each in its own order: concurrent, and the same to the bit at any thread count.
-  const auto parametric = [&](ParametricFit& p) { return [&] { p.error = parametric_error(bins, options_.smith, p); }; };
+  const auto measure = [&](ParametricFit& p) { p.error = parametric_error(bins, options_.smith, p); };
   tbb::parallel_invoke(
       [&] { result.error = measurement_error(bins, TabulatedMicrofacet(result.lobe.tables(options_.smith), {})); },
-      parametric(result.ggx), parametric(result.beckmann), parametric(result.lsq));
+      [&] { measure(result.ggx); }, [&] { measure(result.beckmann); }, [&] { measure(result.lsq); });
   result.error_extraction = result.error;
 }
 
