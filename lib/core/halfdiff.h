@@ -35,14 +35,24 @@ inline HalfDiff to_half_diff(const Vec3& o, const Vec3& i) {
   return hd;
 }
 
-// The pair (o, i) at half/diff angles with phi_h = 0 (isotropic materials do not depend on phi_h).
+// An angle's cosine and sine, for loops that meet each angle many times.
+struct CosSin {
+  double cos = 1.0, sin = 0.0;
+  CosSin() = default;
+  explicit CosSin(double angle) : cos(std::cos(angle)), sin(std::sin(angle)) {}
+};
+
+// The pair (o, i) at half/diff angles with phi_h = 0 (isotropic materials do not depend on phi_h):
+// d = (sin theta_d cos phi_d, sin theta_d sin phi_d, cos theta_d), i = R_y(theta_h) d, o = i mirrored
+// about h = (sin theta_h, 0, cos theta_h).
+inline std::pair<Vec3, Vec3> from_half_diff(const CosSin& theta_h, const CosSin& theta_d, const CosSin& phi_d) {
+  const Vec3 d(theta_d.sin * phi_d.cos, theta_d.sin * phi_d.sin, theta_d.cos);
+  const double ct = theta_h.cos, st = theta_h.sin;
+  const Vec3 i(ct * d.x + st * d.z, d.y, -st * d.x + ct * d.z);
+  return {reflect_about(i, Vec3(st, 0.0, ct)), i};
+}
 inline std::pair<Vec3, Vec3> from_half_diff(double theta_h, double theta_d, double phi_d) {
-  const Vec3 d = spherical_direction(theta_d, phi_d);
-  const double ct = std::cos(theta_h), st = std::sin(theta_h);
-  const Vec3 i(ct * d.x + st * d.z, d.y, -st * d.x + ct * d.z);  // i = R_y(theta_h) d
-  const Vec3 h(st, 0.0, ct);
-  const Vec3 o = 2.0 * glm::dot(i, h) * h - i;  // mirror of i about h
-  return {o, i};
+  return from_half_diff(CosSin(theta_h), CosSin(theta_d), CosSin(phi_d));
 }
 
 }  // namespace facetfit

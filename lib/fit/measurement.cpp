@@ -98,9 +98,10 @@ MeasuredBins measured_bins(const HalfDiffTable& table, int stride_d, int stride_
       const double theta_d_mid = (j + 0.5) / HalfDiffTable::kThetaD * 0.5 * kPi;
       const double measure = 4.0 * std::cos(theta_d_mid) * std::sin(theta_d_mid) * h_measure;
       MeasuredBins::Row row{HalfDiffTable::theta_h(i), HalfDiffTable::theta_d(j), bins.size(), bins.size()};
+      const CosSin h(HalfDiffTable::theta_h(i)), d(HalfDiffTable::theta_d(j));
+      const double cos_h = h.cos, cos_d = d.cos;
       for (int k = 0; k < HalfDiffTable::kPhiD; k += stride_phi) {
-        const auto [wo, wi] = from_half_diff(HalfDiffTable::theta_h(i), HalfDiffTable::theta_d(j), HalfDiffTable::phi_d(k));
-        const double cos_h = std::cos(HalfDiffTable::theta_h(i)), cos_d = std::cos(HalfDiffTable::theta_d(j));
+        const auto [wo, wi] = from_half_diff(h, d, CosSin(HalfDiffTable::phi_d(k)));
         if (one_sided) {
           total += add_one_sided(bins, *one_sided, wo, wi, cos_h, cos_d, measure);
           continue;

@@ -5,6 +5,7 @@
 #include <tbb/parallel_for.h>
 #include <unistd.h>
 
+#include <array>
 #include <cerrno>
 #include <cmath>
 #include <cstdint>
@@ -211,10 +212,16 @@ HalfDiffTable HalfDiffTable::read(const std::string& path, BinPoint at) {
 HalfDiffTable HalfDiffTable::tabulate(const Brdf& brdf, BinPoint at) {
   HalfDiffTable table;
   const double offset = at == BinPoint::center ? 0.5 : 0.0;
+  std::array<CosSin, kThetaH> h;
+  std::array<CosSin, kThetaD> d;
+  std::array<CosSin, kPhiD> p;
+  for (int i = 0; i < kThetaH; ++i) h[std::size_t(i)] = CosSin(theta_h(i + offset));
+  for (int j = 0; j < kThetaD; ++j) d[std::size_t(j)] = CosSin(theta_d(j + offset));
+  for (int k = 0; k < kPhiD; ++k) p[std::size_t(k)] = CosSin(phi_d(k + offset));
   tbb::parallel_for(0, kThetaH, [&](int i) {
     for (int j = 0; j < kThetaD; ++j) {
       for (int k = 0; k < kPhiD; ++k) {
-        const auto [wo, wi] = from_half_diff(theta_h(i + offset), theta_d(j + offset), phi_d(k + offset));
+        const auto [wo, wi] = from_half_diff(h[std::size_t(i)], d[std::size_t(j)], p[std::size_t(k)]);
         if (wi.z <= 0.0 || wo.z <= 0.0) continue;  // stays missing: no measurement below the horizon
         const auto f = brdf.eval(wo, wi);
         if (!f || !std::isfinite(f->r) || !std::isfinite(f->g) || !std::isfinite(f->b)) continue;

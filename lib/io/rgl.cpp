@@ -259,14 +259,24 @@ Segment uniform_segment(double u, std::size_t n) {
   return {k, g - double(k)};
 }
 
-double bilinear(const double* v, std::size_t nx, std::size_t ny, double u0, double u1) {
+// The patch of an nx x ny grid holding (u0, u1), and the point's place in it: found once, it
+// interpolates any number of tables on the same grid.
+struct Patch {
+  std::size_t at, nx;  // the patch's first node, row-major; the row length
+  Segment x, y;
+  double operator()(const double* v) const {
+    const double* r0 = v + at;
+    const double* r1 = r0 + nx;
+    return (1.0 - y.t) * ((1.0 - x.t) * r0[0] + x.t * r0[1]) + y.t * ((1.0 - x.t) * r1[0] + x.t * r1[1]);
+  }
+};
+
+Patch patch_at(std::size_t nx, std::size_t ny, double u0, double u1) {
   const Segment x = uniform_segment(u0, nx), y = uniform_segment(u1, ny);
-  const double* r0 = v + y.k * nx + x.k;
-  const double* r1 = r0 + nx;
-  return (1.0 - y.t) * ((1.0 - x.t) * r0[0] + x.t * r0[1]) + y.t * ((1.0 - x.t) * r1[0] + x.t * r1[1]);
+  return {y.k * nx + x.k, nx, x, y};
 }
 
-double bilinear(const Grid& g, double u0, double u1) { return bilinear(g.v.data(), g.nx, g.ny, u0, u1); }
+double bilinear(const Grid& g, double u0, double u1) { return patch_at(g.nx, g.ny, u0, u1)(g.v.data()); }
 
 // The sample-space coordinate of an elevation: theta = (pi/2) u^2 concentrates resolution near the
 // normal, where specular peaks live.
@@ -659,10 +669,10 @@ Rgb RglBsdf::table_value(const Vec3& p_in, const Vec3& q_in) const {
 
   Rgb v(0.0);
   const std::size_t plane = t.rx * t.ry;
+  const Patch patch = patch_at(t.rx, t.ry, s[0], s[1]);
   for (int k = 0; k < b.n; ++k)  // negative entries kept, as Mitsuba does
     for (int c = 0; c < 3; ++c)
-      v[c] += b.weight[std::size_t(k)] *
-              bilinear(t.rgb.data() + (b.slice[std::size_t(k)] * 3 + std::size_t(c)) * plane, t.rx, t.ry, s[0], s[1]);
+      v[c] += b.weight[std::size_t(k)] * patch(t.rgb.data() + (b.slice[std::size_t(k)] * 3 + std::size_t(c)) * plane);
   if (!t.jacobian) return v;
   const double u_p1 = (phi_p + kPi) / (2.0 * kPi);
   return v * (bilinear(t.ndf, u_h0, u_h1) / (4.0 * bilinear(t.sigma, theta_to_u(theta_p), u_p1)));
