@@ -84,7 +84,7 @@ void add_fit_settings(CLI::App* cmd, FitSettings& s) {
                   "(height-correlated, as pbrt-v4 and Cycles render), separable")
       ->capture_default_str();
   cmd->add_option("--resolution", s.resolution, "Intervals of the theta = u^2 pi/2 grid (90: MERL's own bins)")
-      ->check(CLI::Range(4, 4096))
+      ->check(CLI::Range(kMinResolution, kMaxResolution))
       ->capture_default_str();
   cmd->add_option("--iteration-tolerance", s.iteration_tolerance, "Power-iteration stop: relative L1 change of the NDF")
       ->check(finite_in(0.0, 1.0))

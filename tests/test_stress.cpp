@@ -8,6 +8,7 @@
 #include <random>
 
 #include "fit/fit.h"
+#include "fit/recommend.h"
 #include "io/input.h"
 #include "io/utia.h"
 #include "lut/lut.h"
@@ -69,6 +70,41 @@ TEST_P(ExtremeRoughness, FiniteAndClose) {
 INSTANTIATE_TEST_SUITE_P(Alpha, ExtremeRoughness,
                          testing::Combine(testing::Values(NdfType::ggx, NdfType::beckmann),
                                           testing::Values(0.005, 0.01, 1.2, 1.5)));
+
+// The coarsest grid a fit accepts, on the narrowest lobes: either a fit whose moment alphas and distances
+// are positive and finite, recommending a representation with a finite distance, or a problem that says
+// to raise --resolution. Nothing coarser is accepted.
+TEST(Stress, CoarsestResolutionOnNarrowLobes) {
+  for (int resolution : {kMinResolution, 24})
+    for (double alpha : {0.005, 0.02, 0.05}) {
+      FitOptions options = FitOptions::paper();
+      options.resolution = resolution;
+      const FitResult r = Fitter(options).fit(table_of(NdfType::ggx, alpha, Fresnel::schlick(Rgb(0.9))));
+      SCOPED_TRACE("resolution " + std::to_string(resolution) + ", alpha " + std::to_string(alpha));
+      if (!r.ok()) {
+        EXPECT_NE(r.problem.find("raise --resolution"), std::string::npos) << r.problem;
+        continue;
+      }
+      expect_all_finite(r);
+      EXPECT_GT(r.alpha_ggx, 0.0);
+      EXPECT_GT(r.alpha_beckmann, 0.0);
+      for (double error : {r.error, r.ggx.error, r.beckmann.error}) EXPECT_TRUE(finite(error));
+      EXPECT_TRUE(finite(parameters_of(r, recommend(r, kDefaultTolerance)).error));
+    }
+  FitOptions coarse = FitOptions::paper();
+  coarse.resolution = kMinResolution - 1;
+  EXPECT_THROW(Fitter{coarse}, Error);
+}
+
+// A distance that is NaN (a parametric fit that failed) never wins the recommendation.
+TEST(Stress, ANaNDistanceIsNeverRecommended) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(recommend(0.2, 0.133, nan, 0.02), Representation::ggx);
+  EXPECT_EQ(recommend(0.2, nan, 0.133, 0.02), Representation::beckmann);
+  EXPECT_EQ(recommend(0.2, nan, nan, 0.02), Representation::tabulated);
+  EXPECT_EQ(recommend(nan, 0.1, 0.1, 0.02), Representation::tabulated);
+  EXPECT_EQ(recommend(0.2, 0.15, 0.14, 0.02), Representation::beckmann);  // control: both finite, nearer wins
+}
 
 TEST(Stress, FresnelFromDarkToWhite) {
   for (double f0 : {0.01, 0.04, 0.3, 1.0}) {

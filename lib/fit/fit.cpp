@@ -57,8 +57,9 @@ std::pair<Rgb, Rgb> f0_f82_of(const FresnelCurve& curve) {
 }
 
 Quadrature checked_quadrature(const FitOptions& options) {
-  if (options.resolution < 4 || options.resolution > 4096)
-    fail("resolution " + std::to_string(options.resolution), "must be between 4 and 4096");
+  if (options.resolution < kMinResolution || options.resolution > kMaxResolution)
+    fail("resolution " + std::to_string(options.resolution),
+         "must be between " + std::to_string(kMinResolution) + " and " + std::to_string(kMaxResolution));
   return Quadrature(options.resolution);
 }
 
@@ -203,6 +204,13 @@ FitResult Fitter::fit(const HalfDiffTable& table) const {
   result.refined = refine;
   result.alpha_ggx = alpha_ggx_from_moments(result.ndf(), quadrature_);
   result.alpha_beckmann = alpha_beckmann_from_moments(result.ndf(), quadrature_);
+  if (!(result.alpha_ggx > 0.0) || !(result.alpha_beckmann > 0.0)) {
+    // E|x| or E[x^2] of a distribution of slopes is positive: a grid too coarse for a narrow lobe
+    // extracts an NDF with negative nodes whose moments are not.
+    result.problem = "the extracted NDF's slope moments are not positive (alpha_ggx " + std::to_string(result.alpha_ggx) +
+                     ") at resolution " + std::to_string(options_.resolution) + ": raise --resolution";
+    return result;
+  }
   // The parametric representations of the paper's method: the moment alphas with the extraction's
   // Fresnel at 0 and 82 degrees (Schlick's for lsq), no body.
   const std::pair<Rgb, Rgb> reflectance = f0_f82_of(result.fresnel());

@@ -21,8 +21,11 @@ std::optional<Representation> parse_representation(const std::string& name) {
 
 Representation recommend(double error_tabulated, double error_ggx, double error_beckmann, double tolerance) {
   const double bar = std::max(error_tabulated * (1.0 + tolerance), error_tabulated + 0.005);
-  if (std::min(error_ggx, error_beckmann) > bar) return Representation::tabulated;
-  return error_ggx <= error_beckmann ? Representation::ggx : Representation::beckmann;
+  // A distance that is not a number (a fit that failed, or a NaN bar) never passes.
+  const bool ggx = error_ggx <= bar, beckmann = error_beckmann <= bar;
+  if (ggx && beckmann) return error_ggx <= error_beckmann ? Representation::ggx : Representation::beckmann;
+  if (ggx) return Representation::ggx;
+  return beckmann ? Representation::beckmann : Representation::tabulated;
 }
 
 Representation recommend(const FitResult& fit, double tolerance) {

@@ -82,7 +82,8 @@ FitOptions fit_options(const std::string& refine, int resolution, const std::str
   if (!b) throw py::value_error("merl_bins: must be start or center, not '" + merl_bins + "'");
   const auto c = parse_closure_fresnel(closure_fresnel);
   if (!c) throw py::value_error("closure_fresnel: must be f82 or schlick, not '" + closure_fresnel + "'");
-  if (resolution < 8 || resolution > 1024) throw py::value_error("resolution: must be in [8, 1024]");
+  if (resolution < kMinResolution || resolution > kMaxResolution)  // the CLI's range
+    throw py::value_error("resolution: must be in [" + std::to_string(kMinResolution) + ", " + std::to_string(kMaxResolution) + "]");
   o.refine = *r;
   o.resolution = resolution;
   o.smith = *s;
