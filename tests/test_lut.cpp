@@ -87,6 +87,21 @@ TEST(Lut, RoundTripEvaluatesAsTheInMemoryModel) {
   }
 }
 
+// write_lut reads what it wrote as read_lut does before the file takes its name: a LUT its own reader
+// refuses (here a GGX fit of alpha 0, as a failed fit would leave) is an error, and nothing is left.
+TEST(Lut, AWriteItsReaderRefusesFailsAndLeavesNothing) {
+  const Baked b = fit_of(MicrofacetBrdf(Ndf::isotropic(NdfType::ggx, 0.2), Smith::correlated, Fresnel::schlick(Rgb(0.9))));
+  Lut lut = make_lut(b.fit, b.fitter.quadrature(), "x", "", 0.02, true);
+  TempDir dir;
+  write_lut(dir.file("good.exr"), lut);  // control: the same LUT with its fit intact
+  EXPECT_NO_THROW(read_lut(dir.file("good.exr")));
+  lut.meta.ggx.alpha = 0.0;
+  const std::string error = error_of([&] { write_lut(dir.file("bad.exr"), lut); });
+  EXPECT_EQ(error, dir.file("bad.exr") + ": cannot write: its reader refuses what was written: facetfit LUT without a valid facetfit:ggx_* fit");
+  EXPECT_FALSE(std::filesystem::exists(dir.file("bad.exr")));
+  EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir.path()), std::filesystem::directory_iterator()), 1);
+}
+
 TEST(Lut, MetadataRoundTrip) {
   const Baked b = fit_of(MicrofacetBrdf(Ndf::isotropic(NdfType::beckmann, 0.3), Smith::correlated, Fresnel::schlick(Rgb(0.9, 0.6, 0.3))));
   const Lut lut = make_lut(b.fit, b.fitter.quadrature(), "/data/copper.binary", std::string(64, 'f'), 0.02, true);

@@ -431,7 +431,8 @@ std::vector<float> read_rgb(ImageReader& in, OneChannel one_channel) {
   return rgb_of(in.read_pixels(), in.spec(), in.path(), one_channel);
 }
 
-void write_image_atomic(const std::string& path, const ImageSpec& spec, const void* pixels) {
+void write_image_atomic(const std::string& path, const ImageSpec& spec, const void* pixels,
+                        const std::function<void(const std::string& temp_path)>& check) {
   AtomicFile out(path);
   if (has_extension(path, ".exr")) {
     errno = 0;
@@ -450,12 +451,19 @@ void write_image_atomic(const std::string& path, const ImageSpec& spec, const vo
   }
   // Some writers (PNG) report no error when the disk fills and leave a truncated file: read it back
   // whole before it takes the target's name.
+  const auto reason = [&](const Error& e) {  // the reader's message without the temporary's name
+    const std::string why = e.what(), own = out.temp_path() + ": ";
+    return why.rfind(own, 0) == 0 ? why.substr(own.size()) : why;
+  };
   try {
     ImageReader::open(out.temp_path()).read_pixels();
   } catch (const Error& e) {
-    const std::string why = e.what(), own = out.temp_path() + ": ";
-    fail(path, "cannot write: the written file does not read back whole (disk full?): " +
-                   (why.rfind(own, 0) == 0 ? why.substr(own.size()) : why));
+    fail(path, "cannot write: the written file does not read back whole (disk full?): " + reason(e));
+  }
+  try {
+    if (check) check(out.temp_path());
+  } catch (const Error& e) {
+    fail(path, "cannot write: its reader refuses what was written: " + reason(e));
   }
   out.commit();
 }

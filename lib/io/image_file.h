@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
 #include <optional>
@@ -102,8 +103,10 @@ std::vector<float> read_rgb(ImageReader& in, OneChannel one_channel);
 
 // Writes `pixels` (spec.format, interleaved as spec.channels) to `path` through an AtomicFile, read back
 // whole before it takes the name; the format follows the extension (.exr: float, ZIP compression, the
-// attributes in the header). Throws Error("<path>: cannot write: ...").
-void write_image_atomic(const std::string& path, const ImageSpec& spec, const void* pixels);
+// attributes in the header). `check`, if given, then reads the temporary as its own reader would and
+// throws Error where it refuses it. Throws Error("<path>: cannot write: ...").
+void write_image_atomic(const std::string& path, const ImageSpec& spec, const void* pixels,
+                        const std::function<void(const std::string& temp_path)>& check = {});
 
 // The interface of the module facetfit-oiio.so (io/oiio_codec.cpp): formats other than OpenEXR through
 // OpenImageIO. Errors come back as text, not exceptions, across the module's boundary.

@@ -291,7 +291,7 @@ void write_lut(const std::string& path, const Lut& lut) {
     spec.set(key("warnings"), text);
   }
 
-  write_image_atomic(path, spec, pixels.data());
+  write_image_atomic(path, spec, pixels.data(), [](const std::string& temp) { read_lut(temp); });
 }
 
 std::optional<ParametricBrdf> Lut::parametric(const std::string& family, Smith smith) const {
