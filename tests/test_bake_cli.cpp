@@ -147,9 +147,17 @@ TEST(Bake, CacheHitsAndMisses) {
   EXPECT_NE(facetfit("bake " + src + " --tolerance 0.1 --force -o " + dir).out.find("baked 1, cached 0"), std::string::npos);
   ASSERT_EQ(facetfit("convert builtin:gold-ggx-0.15 -o " + src).status, 0);
   EXPECT_NE(facetfit("bake " + src + " --tolerance 0.1 -o " + dir).out.find("baked 1, cached 0"), std::string::npos);
-  // A deleted LUT is rebaked even though its sidecar is current.
+  // A deleted, truncated or emptied LUT is rebaked even though its sidecar is current; the control: whole
+  // again, it is a hit.
   std::filesystem::remove(out.file("copper.exr"));
   EXPECT_NE(facetfit("bake " + src + " --tolerance 0.1 -o " + dir).out.find("baked 1, cached 0"), std::string::npos);
+  const auto lut_size = std::filesystem::file_size(out.file("copper.exr"));
+  for (std::uintmax_t size : {lut_size / 2, std::uintmax_t(0)}) {
+    std::filesystem::resize_file(out.file("copper.exr"), size);
+    EXPECT_NE(facetfit("bake " + src + " --tolerance 0.1 -o " + dir).out.find("baked 1, cached 0"), std::string::npos) << size;
+    EXPECT_EQ(facetfit("info " + out.file("copper.exr")).status, 0);  // the LUT is whole again
+  }
+  EXPECT_NE(facetfit("bake " + src + " --tolerance 0.1 -o " + dir).out.find("baked 0, cached 1"), std::string::npos);
 }
 
 TEST(Bake, MetadataRoundTripThroughInfo) {

@@ -51,12 +51,14 @@ std::string bake_cache_key(const std::string& sha256, const BakeOptions& o) {
 
 namespace {
 
-// The cached sidecar, if it is complete and was made from the same content with the same settings.
+// The cached sidecar, if it is complete, was made from the same content with the same settings, and the
+// LUT beside it is the one it wrote (a LUT truncated, emptied or replaced since is baked again).
 std::optional<nlohmann::json> cached_record(const fs::path& json_path, const fs::path& lut_path, const std::string& key) {
   std::error_code ec;
   if (!fs::is_regular_file(json_path, ec) || !fs::is_regular_file(lut_path, ec)) return std::nullopt;
   const nlohmann::json j = read_json_file(json_path.string());
   if (!j.is_object() || j.value("cache_key", "") != key) return std::nullopt;
+  if (j.value("lut_sha256", "") != sha256_file(lut_path.string())) return std::nullopt;
   return j;
 }
 
@@ -121,6 +123,7 @@ BakeOutcome bake_material(const std::string& source, const std::string& name, co
     nlohmann::json& r = out.record;
     r = fit_record(source, fit, out.seconds, options.tolerance);
     r["lut"] = lut_path.filename().string();
+    r["lut_sha256"] = sha256_file(lut_path.string());
     r["representation"] = to_string(lut.meta.representation);
     r["ndf_error_ggx"] = lut.meta.ndf_error_ggx;
     r["ndf_error_beckmann"] = lut.meta.ndf_error_beckmann;
