@@ -140,6 +140,22 @@ TEST(Report, UnchangedMaterialsAreNotRenderedAgain) {
   EXPECT_NE(first["materials"][0]["seconds"], third["materials"][0]["seconds"]);
 }
 
+// An entry whose images were emptied or removed since is rendered again; the untouched one is reused.
+TEST(Report, AnEntryWithAnImageEmptiedOrRemovedIsRenderedAgain) {
+  TempDir dir;
+  const json first = run_report(small(dir.path().string()));
+  ASSERT_EQ(first["materials"].size(), 3u);
+  const std::filesystem::path images = dir.path() / "images";
+  std::filesystem::resize_file(images / first["materials"][0]["name"].get<std::string>() / "ggx.png", 0);
+  std::filesystem::remove(images / first["materials"][1]["name"].get<std::string>() / "lsq.png");
+  const json second = run_report(small(dir.path().string()));
+  EXPECT_NE(first["materials"][0]["seconds"], second["materials"][0]["seconds"]);
+  EXPECT_NE(first["materials"][1]["seconds"], second["materials"][1]["seconds"]);
+  EXPECT_EQ(first["materials"][2], second["materials"][2]);  // control: untouched, reused
+  EXPECT_GT(std::filesystem::file_size(images / first["materials"][0]["name"].get<std::string>() / "ggx.png"), 0u);
+  EXPECT_TRUE(std::filesystem::exists(images / first["materials"][1]["name"].get<std::string>() / "lsq.png"));
+}
+
 TEST(Report, RegressionsAgainstThePreviousReport) {
   TempDir dir;
   json r = run_report(small(dir.path().string()));

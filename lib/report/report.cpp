@@ -264,15 +264,31 @@ void write_outputs(const json& report, const std::string& out_dir) {
   write_file_atomic((fs::path(out_dir) / "report.json").string(), json_text(report, 2) + "\n");
 }
 
-// images/NAME/complete holds the key of the entry whose images are all in the folder: written after the
-// last of them, removed before the first is replaced, so that a run killed in between leaves a folder
-// that is not reused (its images may be of other settings).
+// images/NAME/complete holds the key of the entry whose images are all in the folder, then a line
+// "SHA-256 FILE" for each of them: written after the last of them, removed before the first is replaced,
+// so that a run killed in between leaves a folder that is not reused (its images may be of other
+// settings), and a file removed, emptied or replaced since makes the entry render again.
 constexpr const char* kCompleteStamp = "complete";
+
+void stamp_complete(const fs::path& images, const std::string& key, const std::vector<std::string>& files) {
+  std::string stamp = key + "\n";
+  for (const std::string& file : files) stamp += sha256_file((images / file).string()) + " " + file + "\n";
+  write_file_atomic((images / kCompleteStamp).string(), stamp);
+}
 
 bool images_complete(const fs::path& images, const std::string& key) {
   std::ifstream in(images / kCompleteStamp);
-  std::string stamp;
-  return in && std::getline(in, stamp) && stamp == key;
+  std::string line;
+  if (!in || !std::getline(in, line) || line != key) return false;
+  int files = 0;
+  for (; std::getline(in, line); ++files) {
+    const std::size_t space = line.find(' ');
+    if (space == std::string::npos) return false;
+    const fs::path file = images / line.substr(space + 1);
+    std::error_code ec;
+    if (!fs::is_regular_file(file, ec) || sha256_file(file.string()) != line.substr(0, space)) return false;
+  }
+  return files > 0;
 }
 
 }  // namespace
@@ -381,25 +397,26 @@ json run_report(const ReportOptions& o) {
           settings.max_memory = o.max_memory;
           return render(report_scene(m, o), settings);
         };
+        std::vector<std::string> written;  // the entry's files, for its stamp
+        const auto image = [&](const std::string& file) { return (images / written.emplace_back(file)).string(); };
         const RenderedImage measured = render_as("measured", source);
         entry["seconds"]["render"]["measured"] = measured.seconds;
-        write_display_png((images / "measured.png").string(), measured.rgba.data(), measured.width, measured.height, 4, pictures);
+        write_display_png(image("measured.png"), measured.rgba.data(), measured.width, measured.height, 4, pictures);
         std::vector<bool> mask(std::size_t(measured.width) * measured.height);
         for (std::size_t p = 0; p < mask.size(); ++p) mask[p] = measured.rgba[p * 4 + 3] >= 1.0f;  // the sphere
         for (const std::string& r : report_representations()) {
           const RenderedImage img = render_as(r == "tabulated" ? "lut" : r, lut);
           entry["seconds"]["render"][r] = img.seconds;
-          write_display_png((images / (r + ".png")).string(), img.rgba.data(), img.width, img.height, 4, pictures);
+          write_display_png(image(r + ".png"), img.rgba.data(), img.width, img.height, 4, pictures);
           const ImageDiff diff = image_delta_e(measured.rgb(), false, img.rgb(), false, mask, display);
           entry["delta_e"][r] = diff.mean;
           entry["max_delta_e"][r] = diff.max;
-          write_heatmap_png((images / (r + "_delta_e.png")).string(), img.width, img.height, diff.delta_e, mask);
+          write_heatmap_png(image(r + "_delta_e.png"), img.width, img.height, diff.delta_e, mask);
         }
         // The figures the paper validates fits with: lobes in the plane of incidence, NDF, Fresnel.
         const HalfDiffTable table = load_table(source, o.bake.fit.merl_bins);
-        for (const auto& [file, svg] : material_figures(table, read_lut(lut)))
-          write_file_atomic((images / file).string(), svg);
-        write_file_atomic((images / kCompleteStamp).string(), key + "\n");
+        for (const auto& [file, svg] : material_figures(table, read_lut(lut))) write_file_atomic(image(file), svg);
+        stamp_complete(images, key, written);
         report["materials"].push_back(entry);
       }
     } catch (const Error& e) {
