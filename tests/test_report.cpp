@@ -112,6 +112,9 @@ TEST(Report, WritesEveryOutputAndTheRightOrder) {
   EXPECT_GT(entry("gold-ggx-0.15")["delta_e"]["beckmann"].get<double>(), 3.0);
   EXPECT_EQ(r["worst"][0]["name"], "gold-ggx-0.15");
   EXPECT_EQ(r["worst"][0]["representation"], "beckmann");
+  // Its figure is that representation's mean Delta E, under the mean's name (not the per-pixel maximum's).
+  EXPECT_EQ(r["worst"][0]["delta_e"], entry("gold-ggx-0.15")["delta_e"]["beckmann"]);
+  EXPECT_FALSE(r["worst"][0].contains("max_delta_e"));
   // What production shades with, beside the tabulated model, and what each costs to render.
   EXPECT_LT(entry("gold-ggx-0.15")["delta_e"]["closures"].get<double>(), 0.5);
   for (const char* column : {"tabulated", "ggx", "closures"}) EXPECT_GT(r["database_mean_render_seconds"][column].get<double>(), 0.0) << column;

@@ -60,7 +60,7 @@ SceneDesc report_scene(const MaterialDesc& m, const ReportOptions& o) {
   return s;
 }
 
-// Means per representation, and the worst materials by tabulated Delta E.
+// Means per representation, and the worst materials by the mean Delta E of their worst representation.
 void summarize(json& report) {
   json means = json::object();
   for (const std::string& r : report_representations()) {
@@ -93,7 +93,7 @@ void summarize(json& report) {
   std::sort(worst.rbegin(), worst.rend());
   report["worst"] = json::array();
   for (std::size_t k = 0; k < std::min<std::size_t>(5, worst.size()); ++k)
-    report["worst"].push_back({{"name", std::get<1>(worst[k])}, {"max_delta_e", std::get<0>(worst[k])}, {"representation", std::get<2>(worst[k])}});
+    report["worst"].push_back({{"name", std::get<1>(worst[k])}, {"delta_e", std::get<0>(worst[k])}, {"representation", std::get<2>(worst[k])}});
 }
 
 std::string html_escape(const std::string& s) {
@@ -208,7 +208,7 @@ std::string report_html(const json& report) {
   }
   h << "<h2>Worst materials</h2><ol>";
   for (const json& w : report["worst"])
-    h << "<li>" << html_escape(w["name"].get<std::string>()) << ": " << two_decimals(w["max_delta_e"].get<double>()) << " ("
+    h << "<li>" << html_escape(w["name"].get<std::string>()) << ": " << two_decimals(w["delta_e"].get<double>()) << " ("
       << html_escape(w.value("representation", std::string())) << ")</li>";
   h << "</ol><h2>Run time against error</h2>" << time_error_plot(report);
   // One cell per representation: its Delta E (what a click on the header sorts by), its render and its
