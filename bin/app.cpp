@@ -210,7 +210,11 @@ int run_app(int argc, char** argv, void (*register_more)(CLI::App& app, Context&
   // `facetfit help [COMMAND]` is --help.
   if (argc >= 2 && std::string(argv[1]) == "help") {
     const CLI::App* sub = argc >= 3 ? find_command(app, argv[2]) : nullptr;
-    std::cout << (sub ? sub->help() : app.help());
+    if (argc >= 3 && !sub) {  // as `facetfit WORD` would say
+      report_error(usage_error(app, argv[2], ""));
+      return 2;
+    }
+    std::cout << (sub ? sub->help("facetfit") : app.help());
     return 0;
   }
   try {

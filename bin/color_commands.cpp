@@ -41,8 +41,8 @@ void add_working_space_options(CLI::App* cmd, ColorSettings& s) {
 }
 
 void add_view_options(CLI::App* cmd, ColorSettings& s) {
-  cmd->add_option("--display", s.display, "Pictures through this display of the OpenColorIO config (default: sRGB of Rec.709)");
-  cmd->add_option("--view", s.view, "With --display: its view (default: the display's default view)");
+  CLI::Option* display = cmd->add_option("--display", s.display, "Pictures through this display of the OpenColorIO config (default: sRGB of Rec.709)");
+  cmd->add_option("--view", s.view, "With --display: its view (default: the display's default view)")->needs(display);
   add_ocio_config_option(cmd, s);
 }
 

@@ -271,6 +271,15 @@ TEST(Cli, UsageErrors) {
   const RunResult help = facetfit("help render");
   EXPECT_EQ(help.status, 0);
   EXPECT_NE(help.out.find("--material-type"), std::string::npos) << help.out;
+  EXPECT_NE(help.out.find("Usage: facetfit render"), std::string::npos) << help.out;  // as render --help
+  // Help of a command that does not exist is the usage error `facetfit WORD` gives.
+  const RunResult no_help = facetfit("help rendr");
+  EXPECT_EQ(no_help.status, 2);
+  EXPECT_EQ(no_help.out, "");
+  EXPECT_NE(no_help.err.find("unknown command 'rendr' (did you mean 'facetfit render'?)"), std::string::npos) << no_help.err;
+  const RunResult view = facetfit("render --view foo -o x.exr");  // a flag that needs another: usage
+  EXPECT_EQ(view.status, 2);
+  EXPECT_NE(view.err.find("--view requires --display (see facetfit render --help)"), std::string::npos) << view.err;
   // A path the system refuses is one line naming it, not "internal: filesystem error" (issue 47).
   const RunResult long_path = facetfit("bake builtin:gold-ggx-0.15 -o /tmp/" + std::string(300, 'b'));
   EXPECT_EQ(long_path.status, 1);
