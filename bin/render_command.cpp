@@ -12,6 +12,7 @@
 #include "color/image_diff.h"
 #include "core/error.h"
 #include "io/atomic_file.h"
+#include "io/image_file.h"
 #include "io/input.h"
 #include "lut/bake.h"
 #include "render/environment.h"
@@ -37,15 +38,21 @@ struct RenderArgs {
   ColorSettings color;
 };
 
-// The file a path names, for comparing two paths: a link and its target, "a/../b" and "b" are one file.
-fs::path file_key(const std::string& path) {
-  std::error_code ec;
-  const fs::path canonical = fs::weakly_canonical(fs::absolute(path), ec);
-  return ec ? fs::absolute(path).lexically_normal() : canonical;
-}
+// The image format each output flag writes, by its extension.
+struct OutputFormat {
+  const char* flag;
+  const char* extension;
+  const char* what;
+};
+constexpr OutputFormat kOutputFormats[] = {
+    {"-o", ".exr", "a linear OpenEXR image"},
+    {"--png", ".png", "a display-referred PNG image"},
+    {"--save-sky", ".exr", "a lat-long OpenEXR image"},
+};
 
-// The outputs (flag, path), checked before any work, since a render can take minutes: each can be
-// written (its folder exists; it is not a folder), the image is an EXR, and no two name the same file.
+// The outputs (flag, path), checked before any work, since a render can take minutes: each is of its
+// flag's format, its folder takes a new file (not a folder, not missing, not read-only), and no two name
+// the same file.
 void check_outputs(const std::vector<std::pair<std::string, std::string>>& outputs) {
   for (std::size_t a = 0; a < outputs.size(); ++a) {
     const auto& [flag, path] = outputs[a];
@@ -54,13 +61,14 @@ void check_outputs(const std::vector<std::pair<std::string, std::string>>& outpu
     if (fs::is_directory(path, ec)) fail(path, "cannot write " + flag + ": it is a folder");
     const fs::path dir = fs::absolute(path).parent_path();
     if (!fs::is_directory(dir, ec)) fail(path, "cannot write " + flag + ": folder " + dir.string() + " does not exist");
+    for (const OutputFormat& format : kOutputFormats)
+      if (flag == format.flag && !has_extension(path, format.extension))
+        fail(path, flag + " writes " + format.what + ": give it a " + format.extension + " name");
     for (std::size_t b = 0; b < a; ++b)
       if (!outputs[b].second.empty() && file_key(outputs[b].second) == file_key(path))
         fail(path, outputs[b].first + " and " + flag + " name the same file");
+    AtomicFile(path).probe();
   }
-  std::string ext = fs::path(outputs.front().second).extension().string();
-  for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
-  if (ext != ".exr") fail(outputs.front().second, "-o writes a linear OpenEXR image: give it a .exr name");
 }
 
 // No output may overwrite what the scene reads (its file, environment map, materials, textures, meshes).

@@ -600,6 +600,17 @@ TEST(Cli, HostileInputsGetOneLineAndAnExitStatus) {
   r = facetfit("render -o " + dir.file("y.png") + small);
   EXPECT_EQ(r.status, 1);
   one_line(r, "give it a .exr name");
+  // Each output of its flag's format, and a folder that takes no new file, refused before -o is written.
+  const std::pair<std::string, std::string> refused[] = {
+      {" --png " + dir.file("y"), "--png writes a display-referred PNG image: give it a .png name"},
+      {" --save-sky " + dir.file("sky.png"), "--save-sky writes a lat-long OpenEXR image: give it a .exr name"},
+      {" --png /proc/y.png", "/proc/y.png: cannot write: "}};
+  for (const auto& [flags, error] : refused) {
+    r = facetfit("render -o " + dir.file("z.exr") + flags + small);
+    EXPECT_EQ(r.status, 1) << flags;
+    one_line(r, error);
+    EXPECT_FALSE(std::filesystem::exists(dir.file("z.exr"))) << flags;
+  }
   ASSERT_EQ(facetfit("render -o " + dir.file("env.exr") + small).status, 0);
   test::write_bytes(dir.file("s.json"), R"({"environment": {"file": "env.exr"}, "materials": {"m": {"type": "lambert"}},
       "objects": [{"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "m"}]})");
@@ -610,6 +621,14 @@ TEST(Cli, HostileInputsGetOneLineAndAnExitStatus) {
   r = facetfit("render " + dir.file("s.json") + " --material builtin:red-plastic -o " + dir.file("t.exr") + small);
   EXPECT_EQ(r.status, 2);
   one_line(r, "shape the default scene");
+  // A heatmap never replaces one of the images it compares.
+  ASSERT_EQ(facetfit("render -o " + dir.file("w.exr") + " --png " + dir.file("w.png") + small).status, 0);
+  const auto before = std::filesystem::last_write_time(dir.file("w.png"));
+  r = facetfit("diff " + dir.file("w.png") + " " + dir.file("w.exr") + " --heatmap " + dir.path().string() + "/./w.png");
+  EXPECT_EQ(r.status, 1);
+  one_line(r, "--heatmap would overwrite an input of the diff");
+  EXPECT_EQ(std::filesystem::last_write_time(dir.file("w.png")), before);
+  EXPECT_EQ(facetfit("diff " + dir.file("w.png") + " " + dir.file("w.exr") + " --heatmap " + dir.file("h.png")).status, 0);
   // A small file whose header claims a huge image is refused before its pixels are read.
   r = facetfit("diff " + dir.file("env.exr") + " " + dir.file("env.exr") + " --max-memory 1K");
   EXPECT_EQ(r.status, 1);

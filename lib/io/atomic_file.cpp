@@ -51,6 +51,19 @@ void AtomicFile::commit() {
   committed_ = true;
 }
 
+void AtomicFile::probe() const {
+  const int fd = ::open(temp_.c_str(), O_WRONLY | O_CREAT | O_EXCL, 0644);
+  if (fd < 0) fail(path_, std::string("cannot write: ") + std::strerror(errno));
+  ::close(fd);
+  ::unlink(temp_.c_str());
+}
+
+std::string file_key(const std::string& path) {
+  std::error_code ec;
+  const fs::path canonical = fs::weakly_canonical(fs::absolute(path), ec);
+  return (ec ? fs::absolute(path).lexically_normal() : canonical).string();
+}
+
 void write_file_atomic(const std::string& path, const std::string& content) {
   AtomicFile out(path);
   std::FILE* f = std::fopen(out.temp_path().c_str(), "wb");

@@ -21,6 +21,9 @@ class AtomicFile {
   const std::string& temp_path() const { return temp_; }
   // Flushes the temporary to disk and renames it over the target. Throws Error naming the target.
   void commit();
+  // Creates the temporary and removes it again: whether this folder takes a new file at all, asked
+  // before work that takes minutes. Throws Error("<path>: cannot write: <reason>").
+  void probe() const;
 
  private:
   std::string path_;
@@ -35,6 +38,10 @@ int remove_stale_temporaries(const std::string& dir);
 // Makes the output folder `dir` (and its parents) where missing and removes the temporaries killed runs
 // left in it. Throws Error("<dir>: cannot create output folder[: reason]").
 void prepare_output_folder(const std::string& dir);
+
+// The file a path names, for telling an output from an input: a link and its target, "a/../b" and "b"
+// give the same key.
+std::string file_key(const std::string& path);
 
 // Writes `content` to `path` through an AtomicFile.
 void write_file_atomic(const std::string& path, const std::string& content);
