@@ -164,10 +164,12 @@ BakeCounts make_index(const std::string& out_dir, const std::vector<BakeOutcome>
   return counts;
 }
 
-// The batch's counts, and each failure's error again at the end (status 1 when there is one).
-void report_summary(const BakeCounts& counts, const std::vector<BakeOutcome>& outcomes, const std::string& out_dir, Context& ctx) {
+// The batch's counts, and each failure's error again at the end (status 1 when there is one); `index` is
+// where index.json went, empty when it could not be written (that error already said why).
+void report_summary(const BakeCounts& counts, const std::vector<BakeOutcome>& outcomes, const std::string& index, Context& ctx) {
   if (!ctx.quiet())
-    std::printf("baked %d, cached %d, failed %d: %s\n", counts.baked, counts.cached, counts.failed, (fs::path(out_dir) / "index.json").c_str());
+    std::printf("baked %d, cached %d, failed %d: %s\n", counts.baked, counts.cached, counts.failed,
+                index.empty() ? "no index.json written" : index.c_str());
   if (counts.failed > 0) {
     std::fprintf(stderr, "facetfit: %d of %zu inputs failed:\n", counts.failed, outcomes.size());
     for (const auto& o : outcomes)
@@ -181,6 +183,10 @@ void run_bake(const BakeArgs& args, Context& ctx) {
   const auto fit = fit_options(args.settings, status);
   if (!fit) return;
   const std::vector<std::string> inputs = select_inputs(args, ctx);
+  if (inputs.empty() && !args.scene.empty()) {  // a scene of LUTs and analytic materials needs no bake
+    if (!ctx.quiet()) std::fprintf(stderr, "facetfit: %s references no measurement to bake\n", args.scene.c_str());
+    return;
+  }
   if (inputs.empty()) {
     report_error("no input (give files, folders, globs, builtin:NAME or builtin:, or --scene)");
     status = 2;
@@ -207,14 +213,15 @@ void run_bake(const BakeArgs& args, Context& ctx) {
 
   // index.json is read, merged and written under the folder's lock, from the sidecars as they are on disk:
   // a concurrent bake of the same names may have replaced them since, and the index must agree with them.
+  // Whatever happens to it, the batch's summary follows.
   std::optional<FolderLock> lock;
-  if (!run_step(status, [&] { lock.emplace(args.out_dir); })) return;
-  reread_sidecars(args.out_dir, outcomes);
+  const std::string index_path = (fs::path(args.out_dir) / "index.json").string();
+  bool indexed = run_step(status, [&] { lock.emplace(args.out_dir); });
+  if (indexed) reread_sidecars(args.out_dir, outcomes);
   nlohmann::json index;
   const BakeCounts counts = make_index(args.out_dir, outcomes, index);
-  if (!run_step(status, [&] { write_file_atomic((fs::path(args.out_dir) / "index.json").string(), json_text(index, 2) + "\n"); }))
-    return;
-  report_summary(counts, outcomes, args.out_dir, ctx);
+  indexed = indexed && run_step(status, [&] { write_file_atomic(index_path, json_text(index, 2) + "\n"); });
+  report_summary(counts, outcomes, indexed ? index_path : "", ctx);
 }
 
 }  // namespace

@@ -95,6 +95,9 @@ TEST(Bake, ReadOnlyOutputFolderFailsEveryMaterialCleanly) {
   // The system's reason, not OpenImageIO's "Could not open" naming the temporary.
   EXPECT_NE(r.err.find(std::string("cannot write: ") + (root ? "Operation not permitted" : "Permission denied")), std::string::npos) << r.err;
   EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir), {}), 0);
+  // The batch still ends with its summary, index.json included in what failed.
+  EXPECT_NE(r.out.find("baked 0, cached 0, failed 2: no index.json written"), std::string::npos) << r.out;
+  EXPECT_NE(r.err.find("facetfit: 2 of 2 inputs failed:"), std::string::npos) << r.err;
 }
 
 TEST(Bake, KilledMidRunLeavesOnlyWholeFiles) {
@@ -253,6 +256,12 @@ TEST(Bake, SceneBakesOnlyWhatItReferences) {
   EXPECT_FALSE(std::filesystem::exists(out.file("render/gold.exr")));
   test::write_bytes(in.file("bad.json"), "{not json");
   EXPECT_NE(facetfit("bake --scene " + in.file("bad.json") + " -o " + out.file("x")).status, 0);
+  // A scene that measures nothing (a Lambertian plane) has nothing to bake: said, and a success.
+  test::write_bytes(in.file("plain.json"), R"({"materials": {"b": {"type": "lambert"}}, "objects": [{"type": "plane", "material": "b"}]})");
+  r = facetfit("bake --scene " + in.file("plain.json") + " -o " + out.file("plain"));
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("plain.json references no measurement to bake"), std::string::npos) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(out.file("plain")));
 }
 
 TEST(Bake, EvalOnlyAndDuplicateNames) {
