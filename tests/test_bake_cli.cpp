@@ -358,6 +358,11 @@ TEST(ReportCli, FailOnRegressionAndMerge) {
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_EQ(read_json(dir.file("m/report.json"))["materials"].size(), 2u);
   EXPECT_EQ(facetfit("report" + args + "--shard 3/2 -o " + dir.file("x")).status, 2);
+  // A merge into a folder that cannot be made names that folder, not a part.
+  test::write_bytes(dir.file("a_file"), "");
+  r = facetfit("report merge " + dir.file("s1") + " " + dir.file("s2") + " -o " + dir.file("a_file"));
+  EXPECT_EQ(r.status, 1);
+  EXPECT_EQ(r.err, "facetfit: error: " + dir.file("a_file") + ": cannot create output folder: Not a directory\n");
 }
 
 TEST(RenderCli, DefaultSceneToExrAndPng) {

@@ -467,11 +467,14 @@ json merge_reports(const std::vector<std::string>& parts, const std::string& out
         fail(parts.front(), "shard " + std::to_string(k) + "/" + std::to_string(n) + " of its split is not among the parts");
   }
 
-  refuse_link(fs::path(out_dir) / "images");
+  prepare_output_folder(out_dir);
+  const fs::path images = fs::path(out_dir) / "images";
+  refuse_link(images);
   for (const json& r : reports)
-    for (const json& m : r["materials"]) refuse_link(fs::path(out_dir) / "images" / m["name"].get<std::string>());
+    for (const json& m : r["materials"]) refuse_link(images / m["name"].get<std::string>());
   std::error_code ec;
-  fs::create_directories(fs::path(out_dir) / "images", ec);
+  fs::create_directories(images, ec);
+  if (!fs::is_directory(images)) fail(images.string(), "cannot create folder" + (ec ? ": " + ec.message() : std::string()));
   const json previous = read_json_file((fs::path(out_dir) / "report.json").string());
   json merged;
   merged["materials"] = json::array();
@@ -482,10 +485,9 @@ json merge_reports(const std::vector<std::string>& parts, const std::string& out
     merged["settings"] = r["settings"];
     for (const json& m : r["materials"]) {
       merged["materials"].push_back(m);
-      const fs::path from = fs::path(parts[p]) / "images" / m["name"].get<std::string>();
-      fs::copy(from, fs::path(out_dir) / "images" / m["name"].get<std::string>(),
-               fs::copy_options::recursive | fs::copy_options::overwrite_existing, ec);
-      if (ec) fail(from.string(), "cannot copy images: " + ec.message());
+      const fs::path from = fs::path(parts[p]) / "images" / m["name"].get<std::string>(), to = images / m["name"].get<std::string>();
+      fs::copy(from, to, fs::copy_options::recursive | fs::copy_options::overwrite_existing, ec);
+      if (ec) fail(to.string(), "cannot copy images from " + from.string() + ": " + ec.message());
     }
     for (const json& f : r.value("failures", json::array())) merged["failures"].push_back(f);
   }
