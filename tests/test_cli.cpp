@@ -213,6 +213,19 @@ TEST(Cli, ConvertToUtiaThenFitTheFile) {
   EXPECT_NEAR(a["alpha_ggx"]["angle_degrees"].get<double>(), 0.0, 2.0);
   const RunResult table = facetfit("fit " + other.file("a.bin"));
   EXPECT_NE(table.out.find("anisotropic: ggx 0."), std::string::npos) << table.out;
+  // Its LUT's anisotropic GGX fit, as info shows it, is the record's (to the LUT's float precision).
+  ASSERT_EQ(facetfit("bake " + other.file("a.bin") + " -o " + other.file("luts")).status, 0);
+  const RunResult info = facetfit("info " + other.file("luts/a.exr") + " --json");
+  ASSERT_EQ(info.status, 0) << info.err;
+  const nlohmann::json from_lut = nlohmann::json::parse(info.out)["metadata"]["anisotropic"], from_fit = a["ggx"];
+  ASSERT_TRUE(from_lut.is_object()) << info.out;
+  for (const char* key : {"alpha_x", "alpha_y", "angle_degrees", "error"})
+    EXPECT_NEAR(from_lut["ggx"][key].get<double>(), from_fit[key].get<double>(), 1e-5 * std::max(1.0, std::abs(from_fit[key].get<double>()))) << key;
+  EXPECT_EQ(from_lut["phi_count"].get<int>(), 48);
+  EXPECT_NE(facetfit("info " + other.file("luts/a.exr")).out.find("anisotropic     tabulated lobe on 90 x 48 nodes"), std::string::npos);
+  // An isotropic LUT has none.
+  ASSERT_EQ(facetfit("bake builtin:gold-ggx-0.15 --refine none -o " + other.file("luts")).status, 0);
+  EXPECT_TRUE(nlohmann::json::parse(facetfit("info " + other.file("luts/gold-ggx-0.15.exr") + " --json").out)["metadata"]["anisotropic"].is_null());
   const RunResult bad = facetfit("convert builtin:silver-ggx-0.60 -o " + dir.file("x.png"));
   EXPECT_EQ(bad.status, 1);
   EXPECT_NE(bad.err.find("x.png: unsupported output format '.png' (supported: .binary, .bin)"), std::string::npos) << bad.err;

@@ -13,6 +13,17 @@ nlohmann::json parametric_json(double alpha, const Rgb& body, const Rgb& f0, con
   return {{"alpha", alpha}, {"body", rgb(body)}, {"f0", rgb(f0)}, {"f82", rgb(f82)}, {"coat", coat_json(coat)}, {"error", error}};
 }
 
+nlohmann::json principal_json(const AnisotropicAlpha& alpha) {
+  return {{"alpha_x", alpha.alpha_x}, {"alpha_y", alpha.alpha_y}, {"angle_degrees", alpha.angle * 180.0 / kPi}};
+}
+
+nlohmann::json anisotropic_lobe_json(const AnisotropicParametricFit& lobe) {
+  const auto rgb = [](const Rgb& c) { return nlohmann::json{c.r, c.g, c.b}; };
+  nlohmann::json l = principal_json(lobe.alpha);
+  l["body"] = rgb(lobe.body), l["f0"] = rgb(lobe.f0), l["f82"] = rgb(lobe.f82), l["error"] = lobe.error;
+  return l;
+}
+
 nlohmann::json closures_json(const Closures& closures, double error) {
   const auto rgb = [](const Rgb& c) { return nlohmann::json{c.r, c.g, c.b}; };
   nlohmann::json lobes = nlohmann::json::array();
@@ -68,19 +79,10 @@ nlohmann::json fit_record(const std::string& source, const FitResult& fit, doubl
     j["closures"] = closures_json(fit.closures.closures, fit.closures.error);
     j["warnings"] = fit.warnings;
     j["anisotropic"] = nullptr;
-    if (const auto& a = fit.anisotropic) {
-      const auto principal = [](const AnisotropicAlpha& p) {
-        return nlohmann::json{{"alpha_x", p.alpha_x}, {"alpha_y", p.alpha_y}, {"angle_degrees", p.angle * 180.0 / kPi}};
-      };
-      const auto lobe = [&](const AnisotropicParametricFit& p) {
-        nlohmann::json l = principal(p.alpha);
-        l["body"] = rgb(p.body), l["f0"] = rgb(p.f0), l["f82"] = rgb(p.f82), l["error"] = p.error;
-        return l;
-      };
-      j["anisotropic"] = {{"alpha_ggx", principal(a->alpha_ggx)}, {"alpha_beckmann", principal(a->alpha_beckmann)},
-                          {"ggx", lobe(a->ggx)}, {"beckmann", lobe(a->beckmann)}, {"refine", a->refined ? "full" : "none"},
-                          {"iterations", a->iterations}, {"residual", a->residual}};
-    }
+    if (const auto& a = fit.anisotropic)
+      j["anisotropic"] = {{"alpha_ggx", principal_json(a->alpha_ggx)}, {"alpha_beckmann", principal_json(a->alpha_beckmann)},
+                          {"ggx", anisotropic_lobe_json(a->ggx)}, {"beckmann", anisotropic_lobe_json(a->beckmann)},
+                          {"refine", a->refined ? "full" : "none"}, {"iterations", a->iterations}, {"residual", a->residual}};
   } else {
     for (const char* k : {"recommended", "alpha_ggx", "alpha_beckmann", "f0", "f82"}) j[k] = nullptr;
   }

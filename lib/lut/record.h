@@ -35,6 +35,10 @@ nlohmann::json fit_record(const std::string& source, const FitResult& fit, doubl
 nlohmann::json coat_json(const Coat& coat);
 nlohmann::json parametric_json(double alpha, const Rgb& body, const Rgb& f0, const Rgb& f82, const Coat& coat, double error);
 nlohmann::json closures_json(const Closures& closures, double error);
+// Principal alphas as {alpha_x, alpha_y, angle_degrees}; an anisotropic lobe with its body as those and
+// {body, f0, f82, error}.
+nlohmann::json principal_json(const AnisotropicAlpha& alpha);
+nlohmann::json anisotropic_lobe_json(const AnisotropicParametricFit& lobe);
 // The recommended representation and its own parameters (fit/recommend.h): {representation, tolerance,
 // alpha (null for the tabulated one), body, f0, f82, coat, error}.
 nlohmann::json recommended_json(const RepresentationParameters& p, double tolerance);
