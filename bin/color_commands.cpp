@@ -172,9 +172,9 @@ void run_diff(const DiffArgs& args, Context& ctx) {
     return;
   }
   try {
-    for (const std::string* input : {&args.a, &args.b, &args.mask})
-      if (!args.heatmap.empty() && !input->empty() && file_key(args.heatmap) == file_key(*input))
-        fail(args.heatmap, "--heatmap would overwrite an input of the diff");
+    if (!args.heatmap.empty())
+      for (const std::string* input : {&args.a, &args.b, &args.mask})
+        if (!input->empty() && file_key(args.heatmap) == file_key(*input)) fail(args.heatmap, "--heatmap would overwrite an input of the diff");
     std::uint64_t left = args.max_memory > 0 ? args.max_memory : default_memory_budget();
     Image a = read_image(args.a, left);
     Image b = read_image(args.b, left);

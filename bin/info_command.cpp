@@ -34,9 +34,9 @@ nlohmann::json info_json(const Lut& lut) {
   // What the production OSL material renders: version 5's closures, or an older LUT's one lobe.
   j["metadata"]["closures"] = closures_json(lut.closures(), m.error_closures);
   j["metadata"]["anisotropic"] = nullptr;
-  if (const auto& a = lut.anisotropic)  // the anisotropic lobe's table and the anisotropic GGX fit (record.h)
+  if (const auto& a = lut.anisotropic)  // the anisotropic lobe's table and the GGX fit whose angle is its axis (record.h)
     j["metadata"]["anisotropic"] = {{"resolution", a->grid.resolution}, {"phi_count", a->phi_count},
-                                    {"axis_degrees", a->axis * 180.0 / kPi}, {"ggx", anisotropic_lobe_json(m.anisotropic_ggx)}};
+                                    {"ggx", anisotropic_lobe_json(m.anisotropic_ggx)}};
   const TabulatedNdf& ndf = lut.tables.ndf;
   nlohmann::json& t = j["ndf"];
   for (int k = 0; k < ndf.grid.size(); ++k) {
@@ -112,9 +112,9 @@ void print_info(const Lut& lut) {
   print_closures(lut.closures(), m.error_closures, m.format_version >= kLutClosuresVersion);
   if (const auto& a = lut.anisotropic) {
     const AnisotropicParametricFit& g = m.anisotropic_ggx;
-    std::printf("anisotropic     tabulated lobe on %d x %d nodes, axis %.1f deg; ggx alpha %.5f x %.5f at %.1f deg, body %.4f %.4f %.4f, "
+    std::printf("anisotropic     tabulated lobe on %d x %d nodes; ggx alpha %.5f x %.5f at %.1f deg (the lobe's axis), body %.4f %.4f %.4f, "
                 "f0 %.4f %.4f %.4f, f82 %.4f %.4f %.4f, distance %.4f\n",
-                a->grid.resolution, a->phi_count, a->axis * 180.0 / kPi, g.alpha.alpha_x, g.alpha.alpha_y, g.alpha.angle * 180.0 / kPi,
+                a->grid.resolution, a->phi_count, g.alpha.alpha_x, g.alpha.alpha_y, g.alpha.angle * 180.0 / kPi,
                 g.body.r, g.body.g, g.body.b, g.f0.r, g.f0.g, g.f0.b, g.f82.r, g.f82.g, g.f82.b, g.error);
   }
   std::printf("sampling tables %s\n", m.sampling ? "yes" : "no (--eval-only)");

@@ -94,21 +94,21 @@ MeasuredBins measured_bins(const HalfDiffTable& table, int stride_d, int stride_
     const double u = (i + 0.5) / HalfDiffTable::kThetaH;
     const double theta_h_mid = u * u * 0.5 * kPi;
     const double h_measure = std::sin(theta_h_mid) * u * kPi;
+    const CosSin h(HalfDiffTable::theta_h(i));
     for (int j = 0; j < HalfDiffTable::kThetaD; j += stride_d) {
       const double theta_d_mid = (j + 0.5) / HalfDiffTable::kThetaD * 0.5 * kPi;
       const double measure = 4.0 * std::cos(theta_d_mid) * std::sin(theta_d_mid) * h_measure;
       MeasuredBins::Row row{HalfDiffTable::theta_h(i), HalfDiffTable::theta_d(j), bins.size(), bins.size()};
-      const CosSin h(HalfDiffTable::theta_h(i)), d(HalfDiffTable::theta_d(j));
-      const double cos_h = h.cos, cos_d = d.cos;
+      const CosSin d(HalfDiffTable::theta_d(j));
       for (int k = 0; k < HalfDiffTable::kPhiD; k += stride_phi) {
         const auto [wo, wi] = from_half_diff(h, d, CosSin(HalfDiffTable::phi_d(k)));
         if (one_sided) {
-          total += add_one_sided(bins, *one_sided, wo, wi, cos_h, cos_d, measure);
+          total += add_one_sided(bins, *one_sided, wo, wi, h.cos, d.cos, measure);
           continue;
         }
         Rgb v;
         for (int c = 0; c < 3; ++c) v[c] = table.value(c, i, j, k);  // missing: NaN (HalfDiffTable::missing)
-        total += add_bin(bins, wo, wi, cos_h, cos_d, measure, v);
+        total += add_bin(bins, wo, wi, h.cos, d.cos, measure, v);
       }
       row.end = bins.size();
       if (row.end > row.begin) bins.rows.push_back(row);
