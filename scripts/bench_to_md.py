@@ -27,7 +27,7 @@ NOTES = {
     "BM_Sha256File": "SHA-256 of the 35 MB MERL file (OpenSSL; provenance in the LUT, bake cache key)",
     "BM_VisibleNormalTables": "the sampling tables of one material",
     "BM_VisibleSlopes": "the renderer's visible-slope tables of one material (once per render)",
-    "BM_WriteLut": "write one LUT EXR (float32, zip)",
+    "BM_WriteLut": "write one LUT EXR (float32, zip), read back as read_lut reads it before it takes its name",
     "BM_BakeBatch": "8 materials baked at once, as `bake --jobs` (the paper's method: the pipeline's overhead)",
     "BM_ClosureFit": "the closure representation's fit alone (fit/closure_fit.h) on the same RGL materials (felt, metallic), one core and both",
     "BM_ParseScene": "parse and check a 3.9 MB scene of 100k Lambert materials (issue 47's bar: 2 MB under 1 s)",
