@@ -1,8 +1,9 @@
 // Parity with the RGL format's reference evaluation: Mitsuba 3's `measured` BSDF (PyPI wheel, scalar_rgb,
 // in the venv of scripts/setup-mitsuba.sh) against facetfit's RglBsdf with view slices, on random
-// direction pairs of the six RGL materials and of anisotropic files written here, grazing pairs included.
+// direction pairs of every RGL material in the data folder and of anisotropic files written here, grazing pairs included.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -52,6 +53,12 @@ void expect_parity(const std::string& bsdf_file, const std::vector<std::pair<Vec
   ASSERT_EQ(reference.size(), pairs.size());
   RglBsdf bsdf = RglBsdf::read(bsdf_file);
   bsdf.set_slices(RglBsdf::Slices::view);
+  // The material's scale: the median magnitude of Mitsuba's values over the pairs.
+  std::vector<double> magnitudes;
+  for (const auto& value : reference)
+    for (int c = 0; c < 3; ++c) magnitudes.push_back(std::abs(value[std::size_t(c)].get<double>()));
+  std::nth_element(magnitudes.begin(), magnitudes.begin() + std::ptrdiff_t(magnitudes.size() / 2), magnitudes.end());
+  const double floor = std::max(1e-3 * magnitudes[magnitudes.size() / 2], 1e-9);
   double worst = 0.0;
   int negative = 0, beyond = 0, values = 0;
   for (std::size_t n = 0; n < pairs.size(); ++n) {
@@ -60,10 +67,13 @@ void expect_parity(const std::string& bsdf_file, const std::vector<std::pair<Vec
     for (int c = 0; c < 3; ++c) {
       const double m = reference[n][std::size_t(c)].get<double>();
       negative += m < 0.0;
-      // Relative, with a floor of 1e-6. Mitsuba evaluates in float32 (facetfit in double): its chain of
-      // interpolations and the inversion of the VNDF warp leave ~1e-4 of rounding on a few pairs, so
-      // 1e-4 is the bar for 99% of the values and 5e-4 for every one.
-      const double d = std::abs(f[c] - m) / std::max(std::abs(m), 1e-6);
+      // Relative, with a floor of a thousandth of the material's median value. Mitsuba evaluates in float32
+      // (facetfit in double): its chain of interpolations and the inversion of the VNDF warp leave ~1e-4 of
+      // rounding on a few pairs, so 1e-4 is the bar for 99% of the values and 5e-4 for every one. That
+      // rounding is relative to the table entries it interpolates, not to the result: where a value is
+      // far below them (cardboard_rgb near 83 degrees: 4e-6 where its median is 1e-2), turning the
+      // directions by 1e-7, float32's own rounding, moves Mitsuba's value by up to 8.5e-4 of itself.
+      const double d = std::abs(f[c] - m) / std::max(std::abs(m), floor);
       worst = std::max(worst, d);
       beyond += d > 1e-4;
       ++values;

@@ -1,5 +1,5 @@
 // RglBsdf: the reader's validation on synthetic and corrupted tensor files, the evaluator against a
-// synthetic material whose answer is known in closed form, and the six real database files.
+// synthetic material whose answer is known in closed form, and every real file of the database folder.
 #include <gtest/gtest.h>
 
 #include <algorithm>
