@@ -239,10 +239,10 @@ FacetfitLut facetfit_open(string file) {
   int res[2] = {0, 0};
   int version = 0, resolution = 0, sampling = 0;
   if (gettextureinfo(file, "resolution", res) && gettextureinfo(file, "facetfit:format_version", version) &&
-      gettextureinfo(file, "facetfit:resolution", resolution) && version >= 1 && version <= 5) {
+      gettextureinfo(file, "facetfit:resolution", resolution) && version >= 1 && version <= 6) {
     // Version 3 appends the anisotropic lobe's rows below version 2's, which read as before: the shaders
     // render the isotropic representation (the rows' t comes from the image's height, read here). Version
-    // 4 adds the body's exponent, version 5 the closures (the material shader's).
+    // 4 adds the body's exponent, version 5 the closures (the material shader's), version 6 their lobes along the view.
     gettextureinfo(file, "facetfit:sampling", sampling);
     lut.width = res[0];
     lut.height = res[1];

@@ -83,7 +83,7 @@ TEST(Refine, MinnaertBodyPlusGgxThroughTheMerlWriter) {
   const fs::path lut_file = fs::path(::testing::TempDir()) / "minnaert_ggx.exr";
   write_lut(lut_file.string(), make_lut(r, fitter.quadrature(), "minnaert", "0", 0.02, true));
   const Lut lut = read_lut(lut_file.string());
-  EXPECT_EQ(lut.meta.format_version, kLutClosuresVersion);  // 4's body exponent, and the closures
+  EXPECT_GE(lut.meta.format_version, kLutClosuresVersion);  // 4's body exponent, and the closures (6: lobes along the view)
   EXPECT_NEAR(lut.tables.body_exponent, r.lobe.body_exponent, 1e-6);
   const TabulatedMicrofacet model = lut.model();
   for (const double grazing : {0.0, 0.6, 1.2}) {  // theta_i 0 to 69 degrees, the view at 40
@@ -168,7 +168,7 @@ TEST(Refine, LutCarriesBodyCoatAndParametricFits) {
   const fs::path file = fs::path(::testing::TempDir()) / "coated.exr";
   write_lut(file.string(), make_lut(r, fitter.quadrature(), "coated", "0", 0.02, true));
   const Lut lut = read_lut(file.string());
-  EXPECT_EQ(lut.meta.format_version, kLutClosuresVersion);
+  EXPECT_GE(lut.meta.format_version, kLutClosuresVersion);
   expect_rgb_near(lut.tables.body, r.body(), 1e-6, "body");
   EXPECT_NEAR(lut.tables.coat.alpha, r.lobe.coat.alpha, 1e-6);
   EXPECT_NEAR(lut.meta.ggx.alpha, r.ggx.alpha, 1e-6);
@@ -308,19 +308,20 @@ TEST(MeasuredBinsOneSided, EachBinOncePerMeasuredEstimate) {
   const MeasuredBins bins = measured_bins(table, 9, 60);
   ASSERT_GT(bins.size(), reciprocal.size());
   std::size_t single = 0;
+  // Twins: the same bin's two estimates, each viewed from its own direction (o, i swapped).
+  const auto twins = [&](std::size_t a, std::size_t b) { return bins.o[a] == bins.i[b] && bins.i[a] == bins.o[b]; };
   for (std::size_t b = 0; b < bins.size(); ++b) {
-    // Which estimate: the cosine is that of q, the direction not read.
-    const bool view_o = bins.cosine[b] == bins.i[b].z;
-    const Vec3 p = view_o ? bins.o[b] : bins.i[b], q = view_o ? bins.i[b] : bins.o[b];
+    // Each estimate is viewed from the direction it was read from: o = p, i = q, the cosine that of q.
+    const Vec3 p = bins.o[b], q = bins.i[b];
+    ASSERT_EQ(bins.cosine[b], q.z) << b;
     ASSERT_GE(p.z, std::cos(70.0 * kPi / 180.0) - 1e-12);
     const Rgb t = *source->one_sided(p, q);
     for (int c = 0; c < 3; ++c) ASSERT_NEAR(bins.lightness[b][c], metric_transform(t[c]), 1e-12);
-    const bool twin = (b + 1 < bins.size() && bins.o[b + 1] == bins.o[b] && bins.i[b + 1] == bins.i[b]) ||
-                      (b > 0 && bins.o[b - 1] == bins.o[b] && bins.i[b - 1] == bins.i[b]);
+    const bool twin = (b + 1 < bins.size() && twins(b, b + 1)) || (b > 0 && twins(b - 1, b));
     const bool both_measured = std::min(bins.i[b].z, bins.o[b].z) >= std::cos(70.0 * kPi / 180.0);
     ASSERT_EQ(twin, both_measured) << b;
     if (!twin) ++single;
-    if (b > 0 && bins.o[b - 1] == bins.o[b] && bins.i[b - 1] == bins.i[b]) {
+    if (b > 0 && twins(b - 1, b)) {
       ASSERT_EQ(bins.weight[b - 1], bins.weight[b]);
     }
   }
@@ -363,7 +364,11 @@ TEST(MeasuredBinsSamples, AUtiaFileGivesItsNodes) {
 
 // The refinement must end no farther from the measurement than the paper's fit, on every real file.
 // The distances are recomputed here, from the fits' own models.
-TEST(RefineRgl, NeverWorseThanTheExtraction) {
+// Every representation ends no farther from the measurement than the one it starts from, on every real file:
+// the tabulated lobe than the paper's extraction and than the classical fit (both of which it holds, up to
+// its tabulation), by the bins' distance that chooses between its candidates; the closures than the GGX fit
+// they start from, by the judged distance (bins and albedo: FitResult's errors).
+TEST(RefineRgl, NoRepresentationFartherThanItsStart) {
   using test::rgl_dir;
   if (!fs::is_directory(rgl_dir()))
     GTEST_SKIP() << "RGL data folder " << rgl_dir().string() << " is absent (set FACETFIT_RGL_DIR)";
@@ -384,14 +389,14 @@ TEST(RefineRgl, NeverWorseThanTheExtraction) {
     ASSERT_TRUE(before.ok() && after.ok()) << entry.path();
     const double d_before = distance(before), d_after = distance(after);
     EXPECT_LE(d_after, d_before) << entry.path();
-    EXPECT_NEAR(d_after, after.error, 1e-9) << entry.path();
-    EXPECT_NEAR(d_before, after.error_extraction, 1e-9) << entry.path();
-    // The tabulated model holds the classical fit (up to its tabulation): never farther than it.
-    EXPECT_LE(after.error, 1.01 * after.lsq.error) << entry.path();
+    EXPECT_LE(d_after, 1.01 * parametric_error(bins, after.smith, after.lsq)) << entry.path();
+    EXPECT_LE(after.closures.error, after.ggx.error * (1.0 + 1e-6)) << entry.path();  // the same lobe as closures or as a fit
+    // The judged distance is the bins' and the albedo's: never below the bins' alone.
+    EXPECT_GE(after.error, d_after) << entry.path();
+    EXPECT_GE(after.closures.error, closure_error(bins, after.closures.closures)) << entry.path();
   }
   EXPECT_GT(files, 0);
 }
-
 
 // The anisotropic lobes' fit (fit/parametric_fit.h) on the lattice of an analytic anisotropic material
 // with a body, read at the lattice's own nodes: what the solver recovers when nothing is interpolated.

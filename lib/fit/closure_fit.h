@@ -3,7 +3,7 @@
 // the coat, in the metric of fit/measurement.h, with the closures' own formulas (height-correlated Smith
 // G2, as Cycles).
 //
-// Besides the bins, the closures match the measurement's directional albedo (AlbedoTarget below), beyond a
+// Besides the bins, the closures match the measurement's directional albedo (fit/measurement.h AlbedoTarget), beyond a
 // tolerance: the bins weigh grazing pairs down (fit/measurement.h) and an RGL file has none past 78.5
 // degrees, so a sum of closures fitted to them alone returned far more light at grazing views than the
 // measurement (0.95 of it at 85 degrees on ilm_l3_37_metallic, where the tabulated lobe returns 0.48): a
@@ -18,24 +18,14 @@
 // that does not pay for itself, and a material that is one lobe keeps one.
 #pragma once
 
+#include <functional>
+
 #include "fit/measurement.h"
 #include "fit/parametric_fit.h"
 #include "model/closures.h"
 #include "model/proposal.h"
 
 namespace facetfit {
-
-// The directional albedo rho(o) = integral of f(o, i) cos theta_i over i of what the closures should return
-// (the measurement), at views uniform in sin theta_o, each with its share of a sphere's pixels.
-struct AlbedoTarget {
-  std::vector<double> cos_o, weight;  // the weights sum to the albedo residuals' share beside the bins' 1
-  std::vector<Rgb> albedo, lightness;  // lightness: metric_transform(albedo / pi)
-};
-// `model`'s albedo by `proposal`'s draws (jittered in a 128 x 128 grid of strata per view, where the grid's
-// own midpoints, through a mixture's choice of part, were off by 1%) at 16 views. The residuals' share: 10
-// times the bins' (on the six RGL materials a share of 1 to 3 left a colour-shifting film's rendering
-// farther from Mitsuba's).
-AlbedoTarget albedo_target(const Brdf& model, const Proposal& proposal, double share = 10.0);
 
 struct ClosureFitOptions {
   int max_lobes = Closures::kMaxLobes;
@@ -46,6 +36,9 @@ struct ClosureFitOptions {
   // f82_tint: the start's lobe keeps its F82-tint Fresnel; schlick: it starts as the nearest generalized
   // Schlick (model/closures.h, without_f82), so that every lobe is one (what MaterialX's OSL renders exactly).
   ClosureLobe::Fresnel fresnel = ClosureLobe::Fresnel::f82_tint;
+  // What chooses between the fits of the two starts (the lobes added one at a time; three at once): the
+  // smaller of its values, else the smaller objective.
+  std::function<double(const Closures&)> judge;
 };
 
 struct ClosureFit {

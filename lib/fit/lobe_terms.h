@@ -107,6 +107,29 @@ inline FresnelTerms fresnel_terms(double f0, double f82, double mu, bool tint) {
   return f;
 }
 
+// GGX D G2 / (4 cos_i cos_o), height-correlated, of alphas (ax, ay) along the axes of the frame o, i and
+// h = normalize(o + i) are given in, and its derivatives in log ax and log ay:
+//   D = 1 / (pi ax ay t^2), t = hx^2 / ax^2 + hy^2 / ay^2 + hz^2: d log D / d log ax = 4 hx^2 / (ax^2 t) - 1;
+//   Lambda(v) = (sqrt(1 + q) - 1) / 2, q = (vx^2 ax^2 + vy^2 ay^2) / vz^2: d Lambda / d log ax = vx^2 ax^2 / (2 vz^2 sqrt(1 + q)).
+struct AnisotropicLobeTerms {
+  double value = 0.0, d_log_ax = 0.0, d_log_ay = 0.0;
+};
+inline AnisotropicLobeTerms ggx_anisotropic_terms(const Vec3& o, const Vec3& i, const Vec3& h, double ax, double ay) {
+  const double ax2 = ax * ax, ay2 = ay * ay;
+  const double hx = h.x * h.x / ax2, hy = h.y * h.y / ay2, t = hx + hy + h.z * h.z;
+  const double d = 1.0 / (kPi * ax * ay * t * t);
+  struct Lambda {
+    double value = 0.0, d_x = 0.0, d_y = 0.0;
+  };
+  const auto lambda = [&](const Vec3& v) {
+    const double x = v.x * v.x * ax2 / (v.z * v.z), y = v.y * v.y * ay2 / (v.z * v.z), root = std::sqrt(1.0 + x + y);
+    return Lambda{0.5 * (root - 1.0), 0.5 * x / root, 0.5 * y / root};
+  };
+  const Lambda lo = lambda(o), li = lambda(i);
+  const double g = 1.0 / (1.0 + lo.value + li.value), inv4 = 1.0 / (4.0 * i.z * o.z), value = d * g * inv4;
+  return {value, value * (4.0 * hx / t - 1.0 - g * (lo.d_x + li.d_x)), value * (4.0 * hy / t - 1.0 - g * (lo.d_y + li.d_y))};
+}
+
 // The clear coat's term, Schlick(f0, mu) D G2 / (4 cos_i cos_o) of GGX `alpha` (height-correlated), at
 // cos theta_h, cos theta_i, cos theta_o and mu = cos theta_d, and its derivatives in log alpha and f0.
 struct CoatTerms {

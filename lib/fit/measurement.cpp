@@ -1,8 +1,11 @@
 #include "fit/measurement.h"
 
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <cmath>
 #include <optional>
+#include <random>
 #include <utility>
 
 #include "core/halfdiff.h"
@@ -29,7 +32,7 @@ double add_bin(MeasuredBins& bins, const Vec3& wo, const Vec3& wi, double cos_h,
   bins.cos_h.push_back(cos_h);
   bins.cos_d.push_back(cos_d);
   bins.lightness.push_back(lightness);
-  bins.weight.push_back(measure * wi.z * wo.z);
+  bins.weight.push_back(measure * (wi.z * wo.z));  // the same for a bin's two estimates, o and i swapped
   bins.valid.push_back(valid);
   return measure;
 }
@@ -40,14 +43,14 @@ double add_bin(MeasuredBins& bins, const Vec3& wo, const Vec3& wi, double cos_h,
   return add_bin(bins, wo, wi, cos_h, cos_d, measure, y * cosine, cosine);
 }
 
-// The bin's two one-sided estimates, each with half its measure; one past the measured elevations is
-// left out.
+// The bin's two one-sided estimates, each with half its measure and its own view: o the direction p whose
+// data it was read from (a renderer's viewer), i the other; one past the measured elevations is left out.
 double add_one_sided(MeasuredBins& bins, const OneSidedMeasurement& source, const Vec3& wo, const Vec3& wi, double cos_h,
                      double cos_d, double measure) {
   if (wi.z <= 1e-6 || wo.z <= 1e-6) return 0.0;
   double added = 0.0;
   for (const auto& [p, q] : {std::pair{wo, wi}, std::pair{wi, wo}})
-    if (const std::optional<Rgb> t = source.one_sided(p, q)) added += add_bin(bins, wo, wi, cos_h, cos_d, 0.5 * measure, *t, q.z);
+    if (const std::optional<Rgb> t = source.one_sided(p, q)) added += add_bin(bins, p, q, cos_h, cos_d, 0.5 * measure, *t, q.z);
   return added;
 }
 
@@ -178,6 +181,64 @@ double measurement_error(const MeasuredBins& bins, const Brdf& model) {
     }
   }
   return norm > 0.0 ? std::sqrt(sum / norm) : 0.0;
+}
+
+std::vector<Rgb> directional_albedo(const Brdf& model, const Proposal& proposal, const std::vector<double>& cos_o, int grid) {
+  std::vector<Rgb> albedo(cos_o.size(), Rgb(0.0));
+  // Views concurrently, each with its own numbers: jitter within the strata (a grid's midpoints, through the
+  // mixture's choice of part, alias).
+  tbb::parallel_for(std::size_t(0), cos_o.size(), [&](std::size_t j) {
+    std::mt19937_64 rng(std::uint64_t(j) + 1);
+    std::uniform_real_distribution<double> jitter(0.0, 1.0);
+    const Vec3 o(std::sqrt(std::max(0.0, 1.0 - cos_o[j] * cos_o[j])), 0.0, cos_o[j]);
+    Rgb sum(0.0);
+    for (int a = 0; a < grid; ++a)
+      for (int b = 0; b < grid; ++b) {
+        const auto i = proposal.sample_direction(o, (a + jitter(rng)) / grid, (b + jitter(rng)) / grid);
+        const double pdf = i ? proposal.pdf(o, *i) : 0.0;
+        const auto f = i && pdf > 0.0 ? model.eval(o, *i) : std::nullopt;
+        if (f) sum += *f * (i->z / pdf);
+      }
+    albedo[j] = sum / double(grid * grid);
+  });
+  return albedo;
+}
+
+AlbedoTarget albedo_target(const Brdf& model, const Proposal& proposal, double share, int grid) {
+  constexpr int kViews = 16;
+  AlbedoTarget t;
+  t.grid = grid;
+  for (int j = 0; j < kViews; ++j) {
+    // Nodes uniform in r = sin theta_o, a sphere's image radius: each stands for an annulus of its pixels.
+    const double r = (j + 0.5) / kViews;
+    t.cos_o.push_back(std::sqrt(1.0 - r * r));
+    t.weight.push_back(share * 2.0 * r / kViews);
+  }
+  t.albedo = directional_albedo(model, proposal, t.cos_o, grid);
+  for (const Rgb& albedo : t.albedo)
+    t.lightness.push_back(Rgb(metric_transform(albedo.r * kInvPi), metric_transform(albedo.g * kInvPi), metric_transform(albedo.b * kInvPi)));
+  return t;
+}
+
+double albedo_distance(const AlbedoTarget& target, const std::vector<Rgb>& albedo) {
+  double sum = 0.0;
+  for (std::size_t j = 0; j < target.cos_o.size(); ++j)
+    for (int c = 0; c < 3; ++c) {
+      const double d = metric_transform(albedo[j][c] * kInvPi) - target.lightness[j][c];
+      sum += target.weight[j] * d * d;
+    }
+  return std::sqrt(sum / 3.0);
+}
+
+double albedo_distance(const AlbedoTarget& target, const Brdf& model, const Proposal& proposal) {
+  return albedo_distance(target, directional_albedo(model, proposal, target.cos_o, target.grid));
+}
+
+MetricResidual albedo_residual(const AlbedoTarget& target, std::size_t view, int channel, double rho) {
+  double slope = 0.0;
+  const double difference = metric_transform(rho * kInvPi, &slope) - target.lightness[view][channel];
+  const double beyond = std::max(0.0, std::abs(difference) - kAlbedoTolerance), w = std::sqrt(target.weight[view]);
+  return {w * std::copysign(beyond, difference), beyond > 0.0 ? w * slope * kInvPi : 0.0};
 }
 
 }  // namespace facetfit

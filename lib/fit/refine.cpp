@@ -1,15 +1,19 @@
 #include "fit/refine.h"
 
 #include <ceres/ceres.h>
+#include <tbb/parallel_for.h>
 
 #include <cmath>
 #include <algorithm>
 #include <array>
 #include <map>
 #include <memory>
+#include <random>
 
 #include "fit/small_problem.h"
+#include "fit/visible_moments.h"
 #include "model/body.h"
+#include "model/visible_slopes.h"
 
 namespace facetfit {
 
@@ -159,6 +163,73 @@ SecondDifference<3> fresnel_smoothness(double weight, int e0, int e1, int e2) {
   return {k / h0, -k * (1.0 / h0 + 1.0 / h1), k / h1};
 }
 
+// The albedo of body + lobe + coat at the views of an AlbedoTarget, one residual per view and channel
+// (albedo_residual), with what a pass holds fixed (G2, the coat) summed into coefficients:
+//   rho_c(o) = body_c cos_o^(k - 1) + sum_n sum_m B[n][m] D_n F_m,c + coat(o),
+// D_n the NDF's nodes and F_m the Fresnel knots (each a spline or linear weight of what a direction reads),
+// B[n][m] the draws' sum of those weights times G2 cos_i / (4 cos_i cos_o pdf) over the lobe's visible
+// normals. Parameter blocks: body (3), exponent (1), the knots (3 each), the nodes (1 each).
+class AlbedoRefineCost final : public ceres::CostFunction {
+ public:
+  struct View {
+    double cos_o = 1.0, coat = 0.0;
+    std::vector<double> b;  // [node][knot]
+  };
+  AlbedoRefineCost(const AlbedoTarget& target, std::vector<View> views, std::size_t knots, std::size_t nodes)
+      : target_(target), views_(std::move(views)), knots_(knots), nodes_(nodes) {
+    set_num_residuals(int(3 * views_.size()));
+    mutable_parameter_block_sizes()->push_back(3);
+    mutable_parameter_block_sizes()->push_back(1);
+    for (std::size_t m = 0; m < knots; ++m) mutable_parameter_block_sizes()->push_back(3);
+    for (std::size_t n = 0; n < nodes; ++n) mutable_parameter_block_sizes()->push_back(1);
+  }
+
+  bool Evaluate(double const* const* p, double* residuals, double** jacobians) const override {
+    const double* body = p[0];
+    const double k = p[1][0];
+    const std::size_t first_knot = 2, first_node = first_knot + knots_;
+    std::vector<double> dn(nodes_ * 3), fm(knots_ * 3);  // d rho_c / d D_n and d rho_c / d F_m,c
+    for (std::size_t j = 0; j < views_.size(); ++j) {
+      const View& v = views_[j];
+      std::fill(dn.begin(), dn.end(), 0.0), std::fill(fm.begin(), fm.end(), 0.0);
+      double rho[3] = {v.coat, v.coat, v.coat};
+      for (std::size_t n = 0; n < nodes_; ++n)
+        for (std::size_t m = 0; m < knots_; ++m) {
+          const double b = v.b[n * knots_ + m];
+          if (b == 0.0) continue;
+          for (std::size_t c = 0; c < 3; ++c) {
+            rho[c] += b * p[first_node + n][0] * p[first_knot + m][c];
+            dn[3 * n + c] += b * p[first_knot + m][c];
+            fm[3 * m + c] += b * p[first_node + n][0];
+          }
+        }
+      const double power = std::pow(v.cos_o, k - 1.0), log_cos = std::log(v.cos_o);
+      for (std::size_t c = 0; c < 3; ++c) {
+        rho[c] += body[c] * power;
+        const std::size_t r = 3 * j + c;
+        const MetricResidual res = albedo_residual(target_, j, int(c), rho[c]);
+        residuals[r] = res.value;
+        if (!jacobians) continue;
+        for (std::size_t b = 0; b < parameter_block_sizes().size(); ++b)
+          if (jacobians[b]) std::fill_n(jacobians[b] + r * std::size_t(parameter_block_sizes()[b]), parameter_block_sizes()[b], 0.0);
+        if (res.slope == 0.0) continue;
+        if (jacobians[0]) jacobians[0][3 * r + c] = res.slope * power;
+        if (jacobians[1]) jacobians[1][r] = res.slope * body[c] * power * log_cos;
+        for (std::size_t m = 0; m < knots_; ++m)
+          if (jacobians[first_knot + m]) jacobians[first_knot + m][3 * r + c] = res.slope * fm[3 * m + c];
+        for (std::size_t n = 0; n < nodes_; ++n)
+          if (jacobians[first_node + n]) jacobians[first_node + n][r] = res.slope * dn[3 * n + c];
+      }
+    }
+    return true;
+  }
+
+ private:
+  const AlbedoTarget& target_;
+  std::vector<View> views_;
+  std::size_t knots_, nodes_;
+};
+
 // Per bin, what a pass holds fixed: G2 / (4 cos_i cos_o) of the lobe's NDF, its coat's f, and
 // ln(cos_i cos_o) for the body's factor.
 PassTerms pass_terms(const MeasuredBins& bins, Smith smith, const LobeFit& lobe) {
@@ -229,6 +300,54 @@ LobeFit refine_lobe(const MeasuredBins& bins, const Quadrature& quad, Smith smit
     w[1] = (x - e[0]) / double(e[1] - e[0]), w[0] = 1.0 - w[1];
   };
 
+  // The albedo's coefficients of the current lobe (AlbedoRefineCost): its visible normals drawn from each view
+  // on a jittered 32 x 32 grid, each direction's spline weights on the nodes times its linear weights on
+  // the knots (through the Fresnel entries between them).
+  const auto albedo_views = [&](const LobeFit& lobe) {
+    std::vector<AlbedoRefineCost::View> views(options.albedo->cos_o.size());
+    const MicrofacetTables tables = lobe.tables(smith);
+    const VisibleSlopeProposal proposal(tables);
+    const G1Table g1(lobe.ndf);
+    const double step = FresnelCurve::theta_d(1);
+    tbb::parallel_for(std::size_t(0), views.size(), [&](std::size_t j) {
+      constexpr int kGrid = 32;
+      AlbedoRefineCost::View& v = views[j];
+      v.cos_o = options.albedo->cos_o[j];
+      v.b.assign(lobe.ndf.ndf.size() * knots.size(), 0.0);
+      const Vec3 o(std::sqrt(std::max(0.0, 1.0 - v.cos_o * v.cos_o)), 0.0, v.cos_o);
+      std::mt19937_64 rng(j + 1);
+      std::uniform_real_distribution<double> jitter(0.0, 1.0);
+      for (int a = 0; a < kGrid; ++a)
+        for (int c = 0; c < kGrid; ++c) {
+          const auto i = proposal.sample_direction(o, (a + jitter(rng)) / kGrid, (c + jitter(rng)) / kGrid);
+          const double pdf = i ? proposal.pdf(o, *i) : 0.0;
+          if (!(pdf > 0.0)) continue;
+          const Vec3 h = glm::normalize(*i + o);
+          const double g = smith_g2_from_g1(smith, g1(o.z), g1(i->z)) / (4.0 * o.z * pdf * kGrid * kGrid);
+          const NodeWeights nodes = ndf_nodes(grid, std::acos(clamp(h.z, -1.0, 1.0)));
+          // F at theta_d: linear between entries x0 and x0 + 1, each linear between its bracketing knots.
+          const double x = clamp(std::acos(clamp(glm::dot(*i, h), 0.0, 1.0)) / step, 0.0, double(FresnelCurve::kSize - 1));
+          const int x0 = std::min(int(x), FresnelCurve::kSize - 2);
+          for (int side = 0; side < 2; ++side) {
+            const double along = side == 0 ? x0 + 1 - x : x - x0;
+            int e[2];
+            double w[2];
+            bracket(x0 + side, e, w);
+            for (int q = 0; q < 2; ++q) {
+              const std::size_t m = std::size_t(std::lower_bound(knots.begin(), knots.end(), e[q]) - knots.begin());
+              for (std::size_t t = 0; t < nodes.node.size(); ++t)
+                v.b[std::size_t(nodes.node[t]) * knots.size() + m] += g * along * w[q] * nodes.weight[t];
+            }
+          }
+        }
+      const Coat& coat = lobe.coat;
+      if (coat.present())
+        VisibleMoments::for_each_visible_normal(v.cos_o, coat.alpha, coat.alpha,
+                                                [&](double mu, double ratio) { v.coat += fresnel_schlick(Rgb(coat.f0), mu).r * ratio; });
+    });
+    return views;
+  };
+
   for (int pass = 0; pass < options.passes; ++pass) {
     terms = pass_terms(bins, smith, fit);  // G2 of the current NDF (the coat is held: the same every pass)
     SmallProblem problem;
@@ -241,6 +360,12 @@ LobeFit refine_lobe(const MeasuredBins& bins, const Quadrature& quad, Smith smit
     std::vector<double*> all_nodes;
     for (double& v : d) all_nodes.push_back(&v);
     problem.AddResidualBlock(new NormalizationCost(quad.projected_area(), 10.0), nullptr, all_nodes);
+    if (options.albedo && !options.albedo->cos_o.empty()) {
+      std::vector<double*> blocks{body.data(), &exponent};
+      for (int e : knots) blocks.push_back(fresnel[std::size_t(e)].data());
+      blocks.insert(blocks.end(), all_nodes.begin(), all_nodes.end());
+      problem.AddResidualBlock(new AlbedoRefineCost(*options.albedo, albedo_views(fit), knots.size(), d.size()), nullptr, blocks);
+    }
     for (std::size_t k = 1; k + 1 < knots.size(); ++k)
       problem.AddResidualBlock(
           new ceres::AutoDiffCostFunction<SecondDifference<3>, 3, 3, 3, 3>(

@@ -50,6 +50,10 @@ struct RefineOptions {
   // the lobe from trading kinks near the peak against a coat or noise (a spline through kinks is also
   // what a float renderer evaluates least accurately).
   double ndf_smoothness = 0.01;
+  // Where given, the lobe also matches the measurement's directional albedo (fit/measurement.h): a lobe whose
+  // shape is shared by the three channels otherwise spends a colour that only the directions the bins weigh
+  // least hold (chm_light_blue: a blue peak a degree wide over a grey haze, whose tabulated fit rendered grey).
+  const AlbedoTarget* albedo = nullptr;
 };
 
 // sigma(theta_j) of the NDF nodes (the projected-area integral), and the NDF renormalized to unit

@@ -74,6 +74,7 @@ void write_closures(ImageSpec& spec, const LutMetadata& m) {
     set_color(spec, lobe_key(k, "f82").c_str(), l.f82);
     set_color(spec, lobe_key(k, "f90").c_str(), l.f90);
     spec.set(key(lobe_key(k, "exponent").c_str()), float(l.exponent));
+    if (m.format_version >= kLutViewLobesVersion) spec.set(key(lobe_key(k, "view_exponent").c_str()), float(l.view_exponent));
   }
 }
 
@@ -112,6 +113,7 @@ void read_closures(const std::string& path, const ImageSpec& spec, LutMetadata& 
                        number(lobe_key(k, "weight"), 0.0, 1e3),
                        fresnel == 1 ? ClosureLobe::Fresnel::f82_tint : ClosureLobe::Fresnel::schlick, colour(lobe_key(k, "f0")),
                        colour(lobe_key(k, "f82")), colour(lobe_key(k, "f90")), number(lobe_key(k, "exponent"), 0.0, 100.0)});
+    if (m.format_version >= kLutViewLobesVersion) c.lobes.back().view_exponent = number(lobe_key(k, "view_exponent"), 0.0, 4.0);
   }
 }
 
@@ -169,6 +171,8 @@ Lut make_lut(const FitResult& fit, const Quadrature& quadrature, const std::stri
   m.closures = fit.closures.closures;
   m.error_closures = fit.closures.error;
   if (!m.closures.empty()) m.format_version = kLutClosuresVersion;
+  for (const ClosureLobe& l : m.closures.lobes)
+    if (l.view_aligned()) m.format_version = kLutViewLobesVersion;
   return lut;
 }
 
@@ -373,9 +377,9 @@ void read_colorspace(const std::string& path, const ImageSpec& spec, LutMetadata
 int read_format_version(const std::string& path, const ImageSpec& spec) {
   const int version = spec.get_int(key("format_version"), -1);
   if (version < 0) fail(path, "not a facetfit LUT (no facetfit:format_version attribute)");
-  if (version < 1 || version > kLutClosuresVersion)
+  if (version < 1 || version > kLutViewLobesVersion)
     fail(path, "LUT format version " + std::to_string(version) + "; this facetfit reads versions 1 to " +
-                   std::to_string(kLutClosuresVersion));
+                   std::to_string(kLutViewLobesVersion));
   return version;
 }
 

@@ -26,6 +26,7 @@ constexpr int kLutFormatVersion = 2;
 constexpr int kLutAnisotropicVersion = 3;
 constexpr int kLutBodyExponentVersion = 4;
 constexpr int kLutClosuresVersion = 5;
+constexpr int kLutViewLobesVersion = 6;  // 5, with closure lobes that follow the view (model/closures.h)
 
 
 struct LutMetadata {

@@ -29,7 +29,8 @@ nlohmann::json closures_json(const Closures& closures, double error) {
   nlohmann::json lobes = nlohmann::json::array();
   for (const ClosureLobe& l : closures.lobes) {
     nlohmann::json lobe = {{"family", to_string(l.type)}, {"alpha_x", l.alpha_x}, {"alpha_y", l.alpha_y},
-                           {"angle_degrees", l.angle * 180.0 / kPi}, {"weight", l.weight}, {"f0", rgb(l.f0)}};
+                           {"angle_degrees", l.angle * 180.0 / kPi}, {"view_exponent", l.view_exponent}, {"weight", l.weight},
+                           {"f0", rgb(l.f0)}};
     if (l.fresnel == ClosureLobe::Fresnel::f82_tint)
       lobe["fresnel"] = "f82_tint", lobe["f82"] = rgb(l.f82);
     else

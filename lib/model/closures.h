@@ -12,6 +12,13 @@
 //   f0 + (f90 - f0) (1 - mu)^exponent, whose exponent bends the colour over the middle angles, where
 //   F82-tint is flat (a colour-shifting film's reflectance changes there).
 // The coat is GGX with a grey Schlick Fresnel (model/coat.h): microfacet_f82_tint with a tint of 1.
+//
+// A lobe with a view exponent k follows the view (view_aligned()): its x axis lies along the azimuth of o, and
+// its alpha across the view grows as the view grazes, alpha_y / cos(theta_o)^k (at most 1, as renderers clamp a
+// closure's roughness). A film with a clear top (vinyl wrap, lacquer) reflects a highlight wider across the
+// plane of incidence than along it, the more so the more the view grazes (1.3x at theta_d 10 degrees, 1.7x at
+// 28, 4x at 45 on a colour-shifting vinyl); a lobe of D(theta_h) alone cannot (docs/extraction.md). A shader
+// builds the same frame from its view vector (osl/facetfit_material.osl).
 #pragma once
 
 #include <memory>
@@ -38,10 +45,17 @@ struct ClosureLobe {
   Rgb f82{0.04};        // f82_tint: the reflectance at acos(1/7)
   Rgb f90{1.0};         // schlick: the reflectance at grazing, and the exponent
   double exponent = 5.0;
+  double view_exponent = 0.0;  // k: 0 for a lobe along the tangent's axes
 
-  Ndf ndf() const { return {type, alpha_x, alpha_y}; }
+  bool view_aligned() const { return view_exponent != 0.0; }
+  // The distribution seen from a view at cos theta_o: for a view-aligned lobe, along the axes of
+  // TurnedFrame::of_azimuth(o).
+  Ndf ndf(double cos_o = 1.0) const;
   Rgb fresnel_at(double cos_d) const;
 };
+
+// alpha / cos_o^k clamped to [alpha, 1] for k >= 0 (to (0, 1] for k < 0): the alpha across the view.
+double alpha_across_view(double alpha, double k, double cos_o);
 
 // The lobe for a renderer without the F82 term (MaterialX's OSL generator drops color82): an F82-tint lobe
 // becomes the generalized Schlick lobe whose curve is nearest, f0 kept, f90 per channel in [0, 1] and one
@@ -57,7 +71,8 @@ struct Closures {
 
   bool empty() const { return lobes.empty(); }
   // The artist's control (osl/facetfit_material.osl does the same): every lobe's alphas scaled by
-  // (x, y) along its own axes, and the axes turned by `rotation` radians more from the tangent.
+  // (x, y) along its own axes, and the axes turned by `rotation` radians more from the tangent; a
+  // view-aligned lobe, whose axes are the view's, has both alphas scaled by sqrt(x y) and is not turned.
   Closures stretched(double x, double y, double rotation) const;
 };
 
@@ -69,19 +84,16 @@ class ClosureBrdf final : public Brdf {
   const Closures& closures() const { return closures_; }
 
  private:
-  struct Lobe {
-    Ndf ndf;
-    TurnedFrame axes;
-  };
+  std::vector<TurnedFrame> axes_;  // of each lobe along the tangent
   Closures closures_;
-  std::vector<Lobe> lobes_;
 };
 
 // Samples the closures as a renderer samples a sum of closures: u1 picks a lobe, the body or the coat with
 // probabilities by albedo (a lobe's weight times the luminance of its F at 60 degrees, at least 0.05; the body's
 // luminance; the coat's f0, at least 0.1) and is rescaled within it; a lobe draws the visible normals of
-// the isotropic lobe of the same area (alpha = sqrt(alpha_x alpha_y): GGX in closed form, Beckmann
-// tabulated), the body the cosine, the coat its GGX visible normals. pdf() is the mixture's.
+// the lobe seen from o in its own frame (GGX's in closed form; an older LUT's Beckmann lobe, those of the
+// isotropic lobe of the same area, tabulated), the body the cosine, the coat its GGX visible normals. pdf()
+// is the mixture's.
 class ClosureProposal final : public Proposal {
  public:
   explicit ClosureProposal(const Closures& closures);
@@ -89,7 +101,13 @@ class ClosureProposal final : public Proposal {
   double pdf(const Vec3& o, const Vec3& i) const override;
 
  private:
-  std::vector<std::pair<double, std::shared_ptr<const Proposal>>> lobes_;  // probability, proposal
+  struct Lobe {
+    double probability = 0.0;
+    ClosureLobe lobe;
+    TurnedFrame axes;                          // of a lobe along the tangent
+    std::shared_ptr<const Proposal> beckmann;  // a Beckmann lobe's tabulated visible normals
+  };
+  std::vector<Lobe> lobes_;
   double body_ = 0.0, coat_probability_ = 0.0;
   Coat coat_;
 };

@@ -13,21 +13,27 @@
 
 namespace facetfit {
 
-// The same from the point (r cos phi, r sin phi) of the unit disk the two numbers map to (r = sqrt(u1),
-// phi = 2 pi u2), for callers that draw on a fixed grid and keep the cosines.
-inline std::optional<Vec3> ggx_visible_direction_of_disk(const Vec3& o, double alpha, double r, double cos_phi, double sin_phi) {
+// The reflected direction of a visible normal of GGX (alpha_x, alpha_y along the frame's axes) seen from o,
+// from the point (r cos phi, r sin phi) of the unit disk that ggx_visible_direction's two numbers map to
+// (r = sqrt(u1), phi = 2 pi u2), for callers that draw on a fixed grid and keep the cosines.
+inline std::optional<Vec3> ggx_visible_direction_of_disk(const Vec3& o, double alpha_x, double alpha_y, double r, double cos_phi,
+                                                         double sin_phi) {
   if (o.z <= 0.0) return std::nullopt;
-  const Vec3 v = glm::normalize(Vec3(alpha * o.x, alpha * o.y, o.z));  // to the unit-roughness frame
+  const Vec3 v = glm::normalize(Vec3(alpha_x * o.x, alpha_y * o.y, o.z));  // to the unit-roughness frame
   const double len2 = v.x * v.x + v.y * v.y;
   const Vec3 t1 = len2 > 0.0 ? Vec3(-v.y, v.x, 0.0) / std::sqrt(len2) : Vec3(1.0, 0.0, 0.0);
   const Vec3 t2 = glm::cross(v, t1);
   const double p1 = r * cos_phi, s = 0.5 * (1.0 + v.z);
   const double p2 = (1.0 - s) * std::sqrt(std::max(0.0, 1.0 - p1 * p1)) + s * r * sin_phi;
   const Vec3 n = p1 * t1 + p2 * t2 + std::sqrt(std::max(0.0, 1.0 - p1 * p1 - p2 * p2)) * v;
-  const Vec3 h = glm::normalize(Vec3(alpha * n.x, alpha * n.y, std::max(0.0, n.z)));
+  const Vec3 h = glm::normalize(Vec3(alpha_x * n.x, alpha_y * n.y, std::max(0.0, n.z)));
   const Vec3 i = reflect_about(o, h);
   if (i.z <= 0.0) return std::nullopt;
   return i;
+}
+
+inline std::optional<Vec3> ggx_visible_direction_of_disk(const Vec3& o, double alpha, double r, double cos_phi, double sin_phi) {
+  return ggx_visible_direction_of_disk(o, alpha, alpha, r, cos_phi, sin_phi);
 }
 
 inline std::optional<Vec3> ggx_visible_direction(const Vec3& o, double alpha, double u1, double u2) {
@@ -45,6 +51,17 @@ inline double ggx_visible_pdf(const Vec3& o, const Vec3& i, double alpha) {
   if (o.z <= 0.0 || i.z <= 0.0) return 0.0;
   const Vec3 h = glm::normalize(i + o);
   const Ndf ndf = Ndf::isotropic(NdfType::ggx, alpha);
+  return ggx_visible_pdf_of(o, h, ndf.D(h), ndf.g1(o));
+}
+
+// The same of GGX `ndf` (alpha_x, alpha_y along the frame's axes; o and i in that frame).
+inline std::optional<Vec3> ggx_visible_direction(const Vec3& o, const Ndf& ndf, double u1, double u2) {
+  const double phi = 2.0 * kPi * u2;
+  return ggx_visible_direction_of_disk(o, ndf.alpha_x, ndf.alpha_y, std::sqrt(u1), std::cos(phi), std::sin(phi));
+}
+inline double ggx_visible_pdf(const Vec3& o, const Vec3& i, const Ndf& ndf) {
+  if (o.z <= 0.0 || i.z <= 0.0) return 0.0;
+  const Vec3 h = glm::normalize(i + o);
   return ggx_visible_pdf_of(o, h, ndf.D(h), ndf.g1(o));
 }
 
