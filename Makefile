@@ -82,8 +82,8 @@ bench: build
 	scripts/bench.sh $(BUILD)
 
 # Regenerates docs/accuracy.md: ground-truth fits, then the real RGL materials against Mitsuba 3's renders
-# (facetfit's renderer, and the production OSL material in Cycles).
-accuracy: build osl-host
+# (facetfit's renderer, the production OSL material in Cycles, and each material's neural BRDF, the anchor).
+accuracy: build osl-host python
 	$(BUILD)/bench/facetfit_accuracy docs/accuracy.md ../shared/data/rgl
 	scripts/real_accuracy.sh $(BUILD)/bin/facetfit docs/accuracy.md ../shared/data
 

@@ -29,8 +29,9 @@ namespace facetfit {
 // passes, a UTIA file's isotropic fits on its own nodes; 5: its anisotropic lobes on its node pairs;
 // 6: the grazing pairs' soft L1 loss (fit/measurement.h); 7: the tabulated body's Minnaert exponent (model/body.h);
 // 8: the closure representation (fit/closure_fit.h); 9: the paper's representations measured too
-// (their distances choose the recommended one, fit/recommend.h).
-constexpr int kFitRevision = 9;
+// (their distances choose the recommended one, fit/recommend.h); 10: closure lobes that follow the view, the
+// tabulated lobe matching the albedo, distances judged with the albedo's (fit/measurement.h judged_distance).
+constexpr int kFitRevision = 10;
 
 // The range of FitOptions::resolution. Below 16 intervals the grid misses narrow lobes: the built-in
 // aluminium (GGX 0.05) is extracted at alpha 0.030 with 8 and with a negative E|x| with 5 or 6, and
