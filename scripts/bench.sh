@@ -17,6 +17,9 @@ python3 "$root/bench/report_noise.py" "$build/bin/facetfit" "$root/docs/report-n
 # Cycles through Blender's bpy wheel, in a venv of the build.
 py=$("$root/scripts/setup-bpy.sh" "$build/../bpy-venv" | tail -n 1)
 "$py" "$root/scripts/cycles_compare.py" "$build/bin/facetfit" "$root/docs/cycles.md"
+# The production material beside a Principled BSDF and MaterialX's OSL of its closures, in Cycles.
+"$root/scripts/setup-python.sh" "$build/../py-venv" >/dev/null
+BPY_PYTHON="$py" "$root/bench/osl_speed.sh" "$build/bin/facetfit" "$root/docs/osl-speed.md" "$root/../shared/data/rgl/cc_ibiza_sunset_rgb.bsdf"
 # Mitsuba 3 (PyPI; llvm_ad_rgb through Debian's libllvm19) on the realref scene, with an RGL sphere where
 # the shared data is present.
 mpy=$("$root/scripts/setup-mitsuba.sh" "$build/../mitsuba-venv" | tail -n 1)

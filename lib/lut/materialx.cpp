@@ -39,6 +39,28 @@ struct Node {
   }
 };
 
+// A view-aligned lobe's frame and alphas (model/closures.h) as nodes: the tangent NAME_tangent along the view's
+// azimuth, normalize(v - n (n.v)) (either sign: the ellipse is symmetric), and NAME_roughness, (alpha_x,
+// min(alpha_y max(cos theta_o, 1e-3)^-k, max(alpha_y, 1))) with cos theta_o = |n.v|: MaterialX's view direction
+// points from the camera, OSL's I as Cycles gives it toward the camera, and the generated OSL reads I.
+void view_frame_nodes(const std::string& name, const ClosureLobe& l, std::vector<Node>& nodes) {
+  const auto at = [&](const std::string& suffix) { return "@" + name + suffix; };
+  nodes.push_back({"normal", name + "_n", "vector3", {{"space", "string", "world"}}});
+  nodes.push_back({"viewdirection", name + "_v", "vector3", {{"space", "string", "world"}}});
+  nodes.push_back({"dotproduct", name + "_nv", "float", {{"in1", "vector3", at("_n")}, {"in2", "vector3", at("_v")}}});
+  nodes.push_back({"multiply", name + "_n_nv", "vector3", {{"in1", "vector3", at("_n")}, {"in2", "float", at("_nv")}}});
+  nodes.push_back({"subtract", name + "_along", "vector3", {{"in1", "vector3", at("_v")}, {"in2", "vector3", at("_n_nv")}}});
+  nodes.push_back({"normalize", name + "_tangent", "vector3", {{"in", "vector3", at("_along")}}});
+  nodes.push_back({"absval", name + "_cos", "float", {{"in", "float", at("_nv")}}});
+  nodes.push_back({"max", name + "_cos_clamped", "float", {{"in1", "float", at("_cos")}, {"in2", "float", "0.001"}}});
+  nodes.push_back({"power", name + "_grow", "float", {{"in1", "float", at("_cos_clamped")}, {"in2", "float", number(-l.view_exponent)}}});
+  nodes.push_back({"multiply", name + "_across", "float", {{"in1", "float", at("_grow")}, {"in2", "float", number(l.alpha_y)}}});
+  nodes.push_back({"min", name + "_across_clamped", "float",
+                   {{"in1", "float", at("_across")}, {"in2", "float", number(std::max(l.alpha_y, 1.0))}}});
+  nodes.push_back({"combine2", name + "_roughness", "vector2",
+                   {{"in1", "float", number(l.alpha_x)}, {"in2", "float", at("_across_clamped")}}});
+}
+
 // The generalized_schlick_bsdf of a lobe (its tangent node when it is anisotropic, added to `nodes`).
 Node lobe_node(const std::string& name, const ClosureLobe& lobe, bool color82, std::vector<Node>& nodes) {
   const ClosureLobe l = color82 ? lobe : without_f82(lobe);
@@ -50,8 +72,14 @@ Node lobe_node(const std::string& name, const ClosureLobe& lobe, bool color82, s
   n.inputs.push_back({"color82", "color3", tint ? colour(l.f82 / fresnel_schlick(l.f0, 1.0 / 7.0)) : colour(Rgb(1.0))});
   n.inputs.push_back({"color90", "color3", tint ? colour(Rgb(1.0)) : colour(l.f90)});
   n.inputs.push_back({"exponent", "float", number(tint ? 5.0 : l.exponent)});
-  n.inputs.push_back({"roughness", "vector2", number(l.alpha_x) + ", " + number(l.alpha_y)});
   n.inputs.push_back({"scatter_mode", "string", "R"});
+  if (l.view_aligned()) {
+    view_frame_nodes(name, l, nodes);
+    n.inputs.push_back({"roughness", "vector2", "@" + name + "_roughness"});
+    n.inputs.push_back({"tangent", "vector3", "@" + name + "_tangent"});
+    return n;
+  }
+  n.inputs.push_back({"roughness", "vector2", number(l.alpha_x) + ", " + number(l.alpha_y)});
   if (l.alpha_x != l.alpha_y && l.angle != 0.0) {
     nodes.push_back({"tangent", name + "_surface_tangent", "vector3", {{"space", "string", "world"}}});
     nodes.push_back({"normal", name + "_surface_normal", "vector3", {{"space", "string", "world"}}});
@@ -64,6 +92,21 @@ Node lobe_node(const std::string& name, const ClosureLobe& lobe, bool color82, s
 }
 
 }  // namespace
+
+std::string materialx_colorspace(const std::string& space) {
+  // MaterialX's standard colour spaces (its specification, "Color Spaces"), matched without case, '_' or ' '.
+  static const char* const kStandard[] = {"lin_rec709", "acescg", "lin_ap1", "srgb_texture", "lin_adobergb", "lin_displayp3",
+                                          "srgb_displayp3", "g22_rec709", "g18_rec709", "g22_ap1", "g22_adobergb", "adobergb"};
+  const auto key = [](const std::string& s) {
+    std::string k;
+    for (char c : s)
+      if (std::isalnum(static_cast<unsigned char>(c))) k += char(std::tolower(static_cast<unsigned char>(c)));
+    return k;
+  };
+  for (const char* standard : kStandard)
+    if (key(standard) == key(space)) return standard;
+  return space;  // another (the studio config's name): kept as the LUT names it
+}
 
 std::string materialx_name(const std::string& stem) {
   std::string out;
@@ -105,7 +148,8 @@ std::string materialx_document(const std::string& name, const Lut& lut, bool col
   nodes.push_back({"surface", name + "_surface", "surfaceshader", {{"bsdf", "BSDF", "@" + sum}}});
   nodes.push_back({"surfacematerial", name, "material", {{"surfaceshader", "surfaceshader", "@" + name + "_surface"}}});
   std::ostringstream out;
-  out << "<?xml version=\"1.0\"?>\n<materialx version=\"1.39\">\n";
+  // The colours' space, as the LUT was baked (MaterialX's own name where the space is one of its standard ones).
+  out << "<?xml version=\"1.0\"?>\n<materialx version=\"1.39\" colorspace=\"" << materialx_colorspace(lut.meta.colorspace) << "\">\n";
   for (const Node& n : nodes) n.write(out);
   out << "</materialx>\n";
   return out.str();

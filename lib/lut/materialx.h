@@ -7,8 +7,11 @@
 // (without_f82, model/closures.h), since MaterialX's OSL generator drops color82, or, with `color82`,
 // exactly: color0 = f0, color82 = the closure's tint (f82 over Schlick's value at acos(1/7)), color90 = 1,
 // exponent 5. An anisotropic lobe's tangent is the surface tangent turned about the normal by the lobe's
-// angle (`rotate3d`). The coat is one more generalized_schlick_bsdf (grey f0, Schlick). All summed by `add`
-// into a `surface` and a `surfacematerial` named after the material.
+// angle (`rotate3d`); a lobe that follows the view (format 6) has its tangent and its alpha across the view
+// from `viewdirection` and `normal` nodes, as the OSL material computes them. The coat is one more
+// generalized_schlick_bsdf (grey f0, Schlick). All summed by `add` into a `surface` and a `surfacematerial`
+// named after the material. The document's `colorspace` is the LUT's working space (MaterialX's standard name
+// where it is one of them, lin_rec709 for a LUT baked without --working-space).
 #pragma once
 
 #include <string>
@@ -23,5 +26,9 @@ std::string materialx_document(const std::string& name, const Lut& lut, bool col
 
 // `stem` as a MaterialX element name: other characters become underscores, a leading digit gets one before it.
 std::string materialx_name(const std::string& stem);
+
+// A working space's name as a MaterialX document names it: MaterialX's standard name where the space is one of
+// them (matched without case and punctuation: "ACEScg" is "acescg"), else as given.
+std::string materialx_colorspace(const std::string& space);
 
 }  // namespace facetfit
