@@ -61,8 +61,12 @@ void print_closures(const Closures& c, double error, bool fitted) {
   if (c.coat.present()) std::printf(", coat alpha %.5f f0 %.4f", c.coat.alpha, c.coat.f0);
   std::printf("\n");
   for (const ClosureLobe& l : c.lobes) {
-    std::printf("  lobe          %s alpha %.5f x %.5f at %.1f deg, weight %.4f, f0 %.4f %.4f %.4f", to_string(l.type), l.alpha_x, l.alpha_y,
-                l.angle * 180.0 / kPi, l.weight, l.f0.r, l.f0.g, l.f0.b);
+    if (l.view_aligned())
+      std::printf("  lobe          %s alpha %.5f x %.5f / cos(theta_o)^%.3f along the view, weight %.4f, f0 %.4f %.4f %.4f", to_string(l.type),
+                  l.alpha_x, l.alpha_y, l.view_exponent, l.weight, l.f0.r, l.f0.g, l.f0.b);
+    else
+      std::printf("  lobe          %s alpha %.5f x %.5f at %.1f deg, weight %.4f, f0 %.4f %.4f %.4f", to_string(l.type), l.alpha_x, l.alpha_y,
+                  l.angle * 180.0 / kPi, l.weight, l.f0.r, l.f0.g, l.f0.b);
     if (l.fresnel == ClosureLobe::Fresnel::f82_tint)
       std::printf(", F82-tint f82 %.4f %.4f %.4f\n", l.f82.r, l.f82.g, l.f82.b);
     else

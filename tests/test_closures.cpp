@@ -99,10 +99,15 @@ TEST(Closures, ProposalSamplesItsDensity) {
   Closures c = two_lobes();
   c.coat = Coat{0.15, 0.05};
   c.lobes[0].alpha_x = c.lobes[0].alpha_y = 0.25;
-  c.lobes[1].alpha_x = 0.6, c.lobes[1].alpha_y = 0.2;  // anisotropic: drawn as the isotropic GGX of the same area
+  c.lobes[1].alpha_x = 0.6, c.lobes[1].alpha_y = 0.2;  // anisotropic along the tangent turned 0.4
+  c.lobes[1].angle = 0.4;
+  ClosureLobe view = c.lobes[0];  // and one that follows the view (wider across it the more the view grazes)
+  view.alpha_x = view.alpha_y = 0.2;
+  view.view_exponent = 1.5;
+  c.lobes.push_back(view);
   const ClosureProposal proposal(c);
   for (const double theta : {0.0, 0.7, 1.4}) {
-    const Vec3 o(std::sin(theta), 0.0, std::cos(theta));
+    const Vec3 o(std::sin(theta) * std::cos(2.0 * theta), std::sin(theta) * std::sin(2.0 * theta), std::cos(theta));
     const test::ChiSquareResult r = test::chi_square_in_directions(
         [&](double u1, double u2) { return proposal.sample_direction(o, u1, u2); }, [&](const Vec3& i) { return proposal.pdf(o, i); },
         200000, 11);
@@ -162,10 +167,41 @@ TEST(Closures, WithoutF82IsTheNearestGeneralizedSchlick) {
   EXPECT_EQ(without_f82(broad).f90, broad.f90);
 }
 
+// A lobe that follows the view is, seen from any view, the anisotropic lobe of its alphas at that view along
+// the view's azimuth: the same f whatever the view's azimuth, alpha across clamped at 1.
+TEST(Closures, ViewAlignedLobeTurnsWithTheView) {
+  Closures c;
+  ClosureLobe l;
+  l.alpha_x = l.alpha_y = 0.1;
+  l.view_exponent = 2.0;
+  l.fresnel = ClosureLobe::Fresnel::schlick;
+  l.f0 = Rgb(0.5), l.f90 = Rgb(1.0);
+  c.lobes = {l};
+  const ClosureBrdf brdf(c);
+  std::mt19937 rng(5);
+  for (int k = 0; k < 200; ++k) {
+    const Vec3 o = test::random_direction(rng), i = test::random_direction(rng);
+    const double turn = 6.0 * k / 200.0, c2 = std::cos(turn), s2 = std::sin(turn);
+    const auto turned = [&](const Vec3& v) { return Vec3(c2 * v.x - s2 * v.y, s2 * v.x + c2 * v.y, v.z); };
+    const Rgb a = *brdf.eval(o, i), b = *brdf.eval(turned(o), turned(i));
+    EXPECT_NEAR(a.r, b.r, 1e-9 * std::max(1.0, a.r)) << k;
+    // The lobe as a plain anisotropic GGX in the view's frame.
+    const TurnedFrame axes = TurnedFrame::of_azimuth(o);
+    const Ndf ndf{NdfType::ggx, 0.1, std::min(0.1 / (o.z * o.z), 1.0)};
+    const Vec3 lo = axes.to_frame(o), li = axes.to_frame(i), h = glm::normalize(lo + li);
+    const double want = o.z > 0.0 && i.z > 0.0
+                            ? (0.5 + 0.5 * std::pow(1.0 - clamp(glm::dot(li, h), 0.0, 1.0), 5.0)) * ndf.D(h) *
+                                  smith_g2(Smith::correlated, ndf.lambda(lo), ndf.lambda(li)) / (4.0 * o.z * i.z)
+                            : 0.0;
+    EXPECT_NEAR(a.r, want, 1e-9 * std::max(1.0, want)) << k;
+  }
+}
+
 TEST(ClosureFit, AlbedoSumAgreesWithTheBrdf) {
   // The fit's albedo (visible normals on a fixed grid) against the BRDF's as albedo_target draws it: within
   // 1% at every view (0.75% at most when written), under the fit's tolerance of 0.5 L* (about 1.3%).
-  const Closures c = two_lobes();
+  Closures c = two_lobes();
+  c.lobes[1].view_exponent = 1.5;  // following the view, which the sums take along the view's azimuth
   const AlbedoTarget brdf = albedo_target(ClosureBrdf(c), ClosureProposal(c));
   for (std::size_t j = 0; j < brdf.cos_o.size(); ++j) {
     const Rgb sum = closure_albedo(c, brdf.cos_o[j]);
@@ -209,6 +245,7 @@ TEST(ClosureFit, DerivativesMatchDifferences) {
   at.coat = Coat{0.04, 0.05};
   at.lobes[0].alpha_x = at.lobes[0].alpha_y = 0.1;  // away from the optimum: nonzero residuals
   at.lobes[1].exponent = 3.3;                         // between the table's nodes
+  at.lobes[1].view_exponent = 1.3;                    // following the view: the derivatives in k too
   // The albedo's residuals too, against a target they are beyond the tolerance of (the lobes half as bright).
   Closures dim = two_lobes();
   for (ClosureLobe& l : dim.lobes) l.weight *= 0.5, l.f0 = 0.5 * l.f0, l.f90 = 0.5 * l.f90;

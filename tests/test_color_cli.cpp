@@ -402,6 +402,10 @@ TEST(WorkingSpace, AnAcesCgBakeRendersAsTheRec709Bake) {
   // The LUT says its space; the render's EXR names it and carries its chromaticities as the config's
   // conversion places them: AP1's primaries adapted to the D65 white (core/color_space.h).
   EXPECT_NE(facetfit("info " + dir.file("acescg/red-plastic.exr")).out.find("colour space    ACEScg"), std::string::npos);
+  // Its MaterialX document says the space in MaterialX's own name; a Rec.709 bake's says lin_rec709.
+  ASSERT_EQ(facetfit("export " + dir.file("acescg/red-plastic.exr") + " " + dir.file("rec709/gold-ggx-0.15.exr") + " -o " + dir.file("mtlx")).status, 0);
+  EXPECT_NE(test::read_bytes(dir.file("mtlx/red_plastic.mtlx")).find("colorspace=\"acescg\""), std::string::npos);
+  EXPECT_NE(test::read_bytes(dir.file("mtlx/gold_ggx_0_15.mtlx")).find("colorspace=\"lin_rec709\""), std::string::npos);
   std::unique_ptr<OIIO::ImageInput> in = OIIO::ImageInput::open(dir.file("red-plastic-acescg.exr"));
   ASSERT_TRUE(in);
   EXPECT_EQ(in->spec().get_string_attribute("oiio:ColorSpace"), "ACEScg");

@@ -144,6 +144,34 @@ TEST(Lut, MetadataRoundTrip) {
   }
 }
 
+// Closure lobes that follow the view make the LUT version 6, their exponents read back to float precision; a
+// version 6 LUT without an exponent, or with one outside [0, 4], is refused with one line naming it.
+TEST(Lut, ViewExponentsMakeVersionSix) {
+  Baked b = fit_of(MicrofacetBrdf(Ndf::isotropic(NdfType::ggx, 0.2), Smith::correlated, Fresnel::schlick(Rgb(0.9, 0.6, 0.3))));
+  ASSERT_EQ(b.fit.closures.closures.lobes.size(), 1u);
+  b.fit.closures.closures.lobes[0].view_exponent = 1.25;
+  TempDir dir;
+  const RewritableLut original(dir.file("v.exr"), b);
+  const Lut lut = read_lut(dir.file("v.exr"));
+  EXPECT_EQ(lut.meta.format_version, kLutViewLobesVersion);
+  EXPECT_FLOAT_EQ(float(lut.meta.closures.lobes[0].view_exponent), 1.25f);
+  for (const float bad : {-0.5f, 4.5f, std::nanf("")}) {
+    OIIO::ImageSpec spec = original.spec;
+    spec.attribute("facetfit:closures_lobe0_view_exponent", bad);
+    original.write(dir.file("bad.exr"), spec);
+    EXPECT_NE(error_of([&] { read_lut(dir.file("bad.exr")); }).find("bad.exr: facetfit:closures_lobe0_view_exponent is missing or outside"),
+              std::string::npos) << bad;
+  }
+  OIIO::ImageSpec spec = original.spec;
+  spec.erase_attribute("facetfit:closures_lobe0_view_exponent");
+  original.write(dir.file("bad.exr"), spec);
+  EXPECT_NE(error_of([&] { read_lut(dir.file("bad.exr")); }).find("facetfit:closures_lobe0_view_exponent is missing"), std::string::npos);
+  // The control: the same LUT with the exponent 0 is version 5's.
+  b.fit.closures.closures.lobes[0].view_exponent = 0.0;
+  const RewritableLut along(dir.file("t.exr"), b);
+  EXPECT_EQ(read_lut(dir.file("t.exr")).meta.format_version, kLutClosuresVersion);
+}
+
 // Version 5's closures: each attribute is checked on reading, and a LUT without them (versions 1 to 4)
 // gives its recommended family's fit as one lobe, what the material shader rendered of it.
 TEST(Lut, ClosuresAreValidatedAndOlderLutsGetOneLobe) {
