@@ -38,8 +38,10 @@ void print_row(const std::string& source, const FitResult& r, double tolerance, 
     return;
   }
   const RepresentationParameters p = parameters_of(r, recommend(r, tolerance));
-  char alpha[16] = "table";  // the tabulated NDF has no alpha
+  char alpha[16] = "table";  // the tabulated NDF has no alpha, the closures one per lobe
   if (p.alpha) std::snprintf(alpha, sizeof alpha, "%.4f", *p.alpha);
+  if (p.representation == Representation::closures) std::snprintf(alpha, sizeof alpha, "%zu lobe%s", r.closures.closures.lobes.size(),
+                                                                  r.closures.closures.lobes.size() > 1 ? "s" : "");
   std::printf("%-28s  %-11s  %7s  %5.3f %5.3f %5.3f  %5.3f %5.3f %5.3f  %5.3f %5.3f %5.3f  %8.4f  %7.4f %7.4f  %7.1f\n",
               source.c_str(), to_string(p.representation), alpha, p.f0.r, p.f0.g, p.f0.b, p.f82.r, p.f82.g, p.f82.b,
               p.body.r, p.body.g, p.body.b, p.error, r.alpha_ggx, r.alpha_beckmann, seconds * 1e3);

@@ -187,9 +187,8 @@ TEST(Bake, MetadataRoundTripThroughInfo) {
 }
 
 // One truth for the recommended representation (fit/recommend.h): `fit`'s table and JSON, the bake's sidecar
-// and `info` of its LUT name the same representation with the same own parameters. red-plastic: a GGX fit
-// recommended (alpha 0.12, a body); black-glossy-ggx-0.08: the tabulated one (no alpha), whose distance is
-// near 0, so that even --tolerance 100 keeps it; with the paper's method alone the distances are measured too.
+// and `info` of its LUT name the same representation with the same own parameters, and it is the one the
+// definition gives from the record's distances; with the paper's method alone the distances are measured too.
 TEST(Bake, RecommendedParametersAgreeEverywhere) {
   for (const std::string flags : {"", " --refine none", " --tolerance 100"})
     for (const std::string material : {"red-plastic", "black-glossy-ggx-0.08"}) {
@@ -206,14 +205,17 @@ TEST(Bake, RecommendedParametersAgreeEverywhere) {
       EXPECT_EQ(sidecar["recommended"], from_fit);
       EXPECT_EQ(sidecar["representation"], from_fit["representation"]);
       EXPECT_EQ(from_info["representation"], from_fit["representation"]);
-      EXPECT_EQ(from_info["alpha"].is_null(), from_fit["representation"] == "tabulated");
-      // The one definition: the nearer parametric fit when within max((1 + T) d, d + 0.005) of the tabulated d.
+      EXPECT_EQ(from_info["alpha"].is_null(), from_fit["representation"] == "tabulated" || from_fit["representation"] == "closures");
+      // The one definition: the cheapest representation within max((1 + T) d, d + 0.005) of the nearest one's d,
+      // the nearer parametric fit, else the closures (where fitted), else the tabulated lobe.
       const nlohmann::json record = nlohmann::json::parse(fit.out);
-      const double d = record["error"], ggx = record["ggx"]["error"], beckmann = record["beckmann"]["error"];
-      const double tolerance = flags == " --tolerance 100" ? 100.0 : 0.02;
-      const std::string expected = std::min(ggx, beckmann) > std::max((1.0 + tolerance) * d, d + 0.005) ? "tabulated"
-                                   : ggx <= beckmann                                                      ? "ggx"
-                                                                                                          : "beckmann";
+      const double tab = record["error"], ggx = record["ggx"]["error"], beckmann = record["beckmann"]["error"];
+      const double closures = record["closures"]["error"];
+      const double d = std::min({tab, ggx, beckmann, closures > 0.0 ? closures : tab});
+      const double tolerance = flags == " --tolerance 100" ? 100.0 : 0.02, bar = std::max((1.0 + tolerance) * d, d + 0.005);
+      const std::string expected = std::min(ggx, beckmann) <= bar ? (ggx <= beckmann ? "ggx" : "beckmann")
+                                   : closures > 0.0 && closures <= bar ? "closures"
+                                                                       : "tabulated";
       EXPECT_EQ(from_fit["representation"], expected) << "d " << d << ", ggx " << ggx << ", beckmann " << beckmann;
       // The LUT stores its attributes as floats.
       const auto near = [](const nlohmann::json& a, const nlohmann::json& b) { EXPECT_NEAR(a.get<double>(), b.get<double>(), 1e-6 + 1e-6 * std::abs(b.get<double>())); };
@@ -225,6 +227,8 @@ TEST(Bake, RecommendedParametersAgreeEverywhere) {
       const RunResult table = facetfit("fit builtin:" + material + flags);
       char alpha[32] = "table";
       if (!from_fit["alpha"].is_null()) std::snprintf(alpha, sizeof alpha, "%.4f", from_fit["alpha"].get<double>());
+      const std::size_t lobes = record["closures"]["lobes"].size();
+      if (from_fit["representation"] == "closures") std::snprintf(alpha, sizeof alpha, "%zu lobe%s", lobes, lobes > 1 ? "s" : "");
       const std::string row = material + std::string(28 - material.size(), ' ') + "  " + from_fit["representation"].get<std::string>();
       EXPECT_NE(table.out.find(row), std::string::npos) << table.out;
       EXPECT_NE(table.out.find(std::string(alpha) + "  "), std::string::npos) << table.out;

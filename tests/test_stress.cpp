@@ -99,11 +99,23 @@ TEST(Stress, CoarsestResolutionOnNarrowLobes) {
 // A distance that is NaN (a parametric fit that failed) never wins the recommendation.
 TEST(Stress, ANaNDistanceIsNeverRecommended) {
   const double nan = std::numeric_limits<double>::quiet_NaN();
-  EXPECT_EQ(recommend(0.2, 0.133, nan, 0.02), Representation::ggx);
-  EXPECT_EQ(recommend(0.2, nan, 0.133, 0.02), Representation::beckmann);
-  EXPECT_EQ(recommend(0.2, nan, nan, 0.02), Representation::tabulated);
-  EXPECT_EQ(recommend(nan, 0.1, 0.1, 0.02), Representation::tabulated);
-  EXPECT_EQ(recommend(0.2, 0.15, 0.14, 0.02), Representation::beckmann);  // control: both finite, nearer wins
+  EXPECT_EQ(recommend(0.2, 0.133, nan, 0.0, 0.02), Representation::ggx);
+  EXPECT_EQ(recommend(0.2, nan, 0.133, 0.0, 0.02), Representation::beckmann);
+  EXPECT_EQ(recommend(0.2, nan, nan, 0.0, 0.02), Representation::tabulated);
+  EXPECT_EQ(recommend(nan, 0.1, 0.1, 0.0, 0.02), Representation::tabulated);
+  EXPECT_EQ(recommend(0.2, 0.15, 0.14, 0.0, 0.02), Representation::beckmann);  // control: both finite, nearer wins
+  EXPECT_EQ(recommend(0.2, 0.3, 0.3, nan, 0.02), Representation::tabulated);
+  EXPECT_EQ(recommend(0.2, 0.3, 0.3, 0.15, 0.02), Representation::closures);  // control: the closures nearest
+}
+
+// The cheapest representation within the tolerance of the nearest: a one-lobe fit over the closures over the
+// tabulated lobe; closures that were not fitted (distance 0, --refine none) are not a candidate.
+TEST(Stress, RecommendationIsTheCheapestNearEnough) {
+  EXPECT_EQ(recommend(0.100, 0.102, 0.2, 0.101, 0.02), Representation::ggx);
+  EXPECT_EQ(recommend(0.100, 0.2, 0.2, 0.104, 0.02), Representation::closures);
+  EXPECT_EQ(recommend(0.100, 0.2, 0.2, 0.2, 0.02), Representation::tabulated);
+  EXPECT_EQ(recommend(0.2, 0.1, 0.2, 0.0, 0.02), Representation::ggx);
+  EXPECT_EQ(recommend(0.2, 0.3, 0.3, 0.0, 0.02), Representation::tabulated);
 }
 
 TEST(Stress, FresnelFromDarkToWhite) {

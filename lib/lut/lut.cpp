@@ -44,6 +44,7 @@ int representation_code(Representation r) {
     case Representation::tabulated: return 0;
     case Representation::ggx: return 1;
     case Representation::beckmann: return 2;
+    case Representation::closures: return 3;
   }
   return -1;
 }
@@ -173,6 +174,8 @@ Lut make_lut(const FitResult& fit, const Quadrature& quadrature, const std::stri
   if (!m.closures.empty()) m.format_version = kLutClosuresVersion;
   for (const ClosureLobe& l : m.closures.lobes)
     if (l.view_aligned()) m.format_version = kLutViewLobesVersion;
+  // A reader of version 5 knows no closures representation.
+  if (m.representation == Representation::closures) m.format_version = kLutViewLobesVersion;
   return lut;
 }
 
@@ -199,6 +202,7 @@ Lut in_colorspace(Lut lut, const std::string& space, const ColorMatrix& from_rec
 RepresentationParameters recommended_parameters(const LutMetadata& m) {
   const Representation r = m.representation;
   if (r == Representation::tabulated) return {r, std::nullopt, m.f0, m.f82, m.body, m.coat, m.error};
+  if (r == Representation::closures) return closures_parameters(m.closures, m.error_closures);
   const bool ggx = r == Representation::ggx;
   const LutMetadata::Parametric& p = ggx ? m.ggx : m.beckmann;
   return {r, p.alpha, p.f0, p.f82, p.body, p.coat, ggx ? m.error_ggx : m.error_beckmann};
@@ -394,7 +398,7 @@ void read_lut_header(const std::string& path, const ImageSpec& spec, LutMetadata
   const auto representation = parse_representation(spec.get_string(key("representation")));
   const auto f0 = get_color(spec, "f0"), f82 = get_color(spec, "f82");
   if (!smith) fail(path, "facetfit:smith is missing or not masking, correlated or separable");
-  if (!representation) fail(path, "facetfit:representation is missing or not tabulated, ggx or beckmann");
+  if (!representation) fail(path, "facetfit:representation is missing or not tabulated, ggx, beckmann or closures");
   if (!f0 || !f82) fail(path, std::string("facetfit:") + (!f0 ? "f0" : "f82") + " is missing or not a colour");
   if (m.resolution < 4 || m.resolution > 4096)
     fail(path, "facetfit:resolution is " + std::to_string(m.resolution) + ": must be between 4 and 4096");
@@ -497,6 +501,9 @@ LutMetadata read_lut_attributes(const std::string& path, const ImageSpec& spec, 
     read_parametric_attributes(path, spec, version, m);
   }
   if (version >= kLutClosuresVersion) read_closures(path, spec, m);
+  if (m.representation == Representation::closures && (version < kLutViewLobesVersion || m.closures.empty()))
+    fail(path, "facetfit:representation is closures in a LUT of version " + std::to_string(version) + " (closures are recommended from version " +
+                   std::to_string(kLutViewLobesVersion) + ")");
   if (has_anisotropic_rows(spec, version)) read_anisotropic_attributes(path, spec, m);
   read_colorspace(path, spec, m);
   return m;

@@ -60,7 +60,7 @@ SceneDesc report_scene(const MaterialDesc& m, const ReportOptions& o) {
   return s;
 }
 
-// Means per representation, and the worst materials by the mean Delta E of their worst representation.
+// Means per representation, and the worst materials by the mean Delta E of their recommended representation.
 void summarize(json& report) {
   json means = json::object();
   for (const std::string& r : report_representations()) {
@@ -81,9 +81,15 @@ void summarize(json& report) {
     seconds[r] = n > 0 ? json(sum / n) : json(nullptr);
   }
   report["database_mean_render_seconds"] = seconds;
-  // Each material's worst representation, the worst five materials first.
+  // Each material's recommended representation (what a renderer is told to ship; without one in the entry,
+  // its worst), the worst five materials first.
   std::vector<std::tuple<double, std::string, std::string>> worst;
   for (const json& m : report["materials"]) {
+    const std::string recommended = m.value("representation", std::string());
+    if (m["delta_e"].contains(recommended)) {
+      worst.emplace_back(m["delta_e"][recommended].get<double>(), m["name"].get<std::string>(), recommended);
+      continue;
+    }
     double w = 0.0;
     std::string of;
     for (const auto& [r, v] : m["delta_e"].items())
