@@ -1,4 +1,5 @@
 // facetfit convert INPUT -o OUT.binary|OUT.bin : any input in MERL layout, or sampled at UTIA's nodes.
+#include <array>
 #include <cstdio>
 #include <filesystem>
 
@@ -25,7 +26,10 @@ void add_convert_command(CLI::App& app, Context& ctx) {
       if (extension == ".bin") {
         UtiaBrdf::tabulate(*load_brdf(*input)).write(*output);
       } else if (extension == ".binary") {
-        load_table(*input).write(*output);
+        const std::array<std::size_t, 3> clamped = load_table(*input).write(*output);
+        if (clamped[0] + clamped[1] + clamped[2] > 0)
+          std::fprintf(stderr, "facetfit: warning: %s: %zu red, %zu green and %zu blue values below zero (noise on a measurement near zero) written as 0: a MERL table holds no negative value\n",
+                       output->c_str(), clamped[0], clamped[1], clamped[2]);
       } else {
         fail(*output, "unsupported output format '" + extension + "' (supported: .binary, .bin)");
       }

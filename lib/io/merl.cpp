@@ -232,25 +232,28 @@ HalfDiffTable HalfDiffTable::tabulate(const Brdf& brdf, BinPoint at) {
   return table;
 }
 
-void HalfDiffTable::write(const std::string& path) const {
+std::array<std::size_t, 3> HalfDiffTable::write(const std::string& path) const {
   AtomicFile out(path);
   File file(std::fopen(out.temp_path().c_str(), "wb"));
   if (!file) fail(path, std::string("cannot write: ") + std::strerror(errno));
   const std::int32_t dims[3] = {kThetaH, kThetaD, kPhiD};
   bool ok = std::fwrite(dims, sizeof(std::int32_t), 3, file.get()) == 3;
   std::vector<double> buf(kPhiD * kThetaD);
+  std::array<std::size_t, 3> clamped{};
   for (int c = 0; c < 3 && ok; ++c) {
     const float* in = channel(c);
     for (std::size_t done = 0; done < kBins && ok; done += buf.size()) {
       for (std::size_t t = 0; t < buf.size(); ++t) {
         const float v = in[done + t];
-        buf[t] = missing(v) ? -1.0 : double(v) / kScale[c];  // a negative measurement reads back as missing
+        clamped[std::size_t(c)] += v < 0.0f;
+        buf[t] = missing(v) ? -1.0 : std::max(0.0, double(v) / kScale[c]);  // negative: read back as missing
       }
       ok = std::fwrite(buf.data(), sizeof(double), buf.size(), file.get()) == buf.size();
     }
   }
   if (std::fclose(file.release()) != 0 || !ok) fail(path, "cannot write: short write (disk full?)");
   out.commit();
+  return clamped;
 }
 
 std::optional<Rgb> HalfDiffTable::eval(const Vec3& o, const Vec3& i) const {
@@ -266,11 +269,12 @@ std::optional<Rgb> HalfDiffTable::eval_nearest(double x_h, double x_d, double x_
   const int j = std::min(int(x_d), kThetaD - 1);
   const int k = std::min(int(x_p), kPhiD - 1);
   const std::size_t n = index(i, j, k);
-  Rgb v;
-  for (int c = 0; c < 3; ++c) {
-    if (missing(channel(c)[n])) return std::nullopt;
-    v[c] = channel(c)[n];
-  }
+  // A missing channel is 0 beside the others; all three missing, the bin is.
+  Rgb v(0.0);
+  int found = 0;
+  for (int c = 0; c < 3; ++c)
+    if (!missing(channel(c)[n])) v[c] = channel(c)[n], ++found;
+  if (found == 0) return std::nullopt;
   return v;
 }
 
@@ -302,8 +306,13 @@ std::optional<Rgb> HalfDiffTable::eval_linear(double x_h, double x_d, double x_p
       weight[c] += w;
     }
   }
-  if (weight.r <= 0.0 || weight.g <= 0.0 || weight.b <= 0.0) return std::nullopt;
-  return sum / weight;
+  // A channel with no measured neighbour is 0 beside the others (a dark channel whose noise was below zero,
+  // MERL's missing); all three without one, the pair is not measured.
+  if (weight.r <= 0.0 && weight.g <= 0.0 && weight.b <= 0.0) return std::nullopt;
+  Rgb v(0.0);
+  for (int c = 0; c < 3; ++c)
+    if (weight[c] > 0.0) v[c] = sum[c] / weight[c];
+  return v;
 }
 
 }  // namespace facetfit

@@ -8,9 +8,11 @@
 // (which truncates). Values are held in 1/sr, already multiplied by MERL's channel scales. A missing
 // measurement is NaN (missing()): no computation reads it as zero. Negative values are measurements
 // (RGL's noise around zero, tabulated as it is); MERL files mark missing bins with negative numbers, so
-// the reader makes those missing and the writer writes missing bins as -1.
+// the reader makes those missing, and the writer writes missing bins as -1 and negative measurements as 0.
+// A channel is missing on its own: a lookup keeps the channels it has.
 #pragma once
 
+#include <array>
 #include <cmath>
 #include <cstddef>
 #include <limits>
@@ -58,8 +60,10 @@ class HalfDiffTable final : public Brdf {
   // The table of values at the bins' centres moved to their lower edges: each value the mean of the
   // valid centre values around it (2 per axis; theta axes clamp at 0, phi_d wraps with period pi).
   HalfDiffTable centres_to_edges() const;
-  // Writes MERL layout through a temporary file; missing bins are written as -1.
-  void write(const std::string& path) const;
+  // Writes MERL layout through a temporary file; missing bins are written as -1. MERL's readers take every
+  // negative number for a missing bin, so a negative measurement (noise around zero, as an RGL file's) is
+  // written as 0: returns how many were, per channel (the caller says so).
+  std::array<std::size_t, 3> write(const std::string& path) const;
 
   std::optional<Rgb> eval(const Vec3& o, const Vec3& i) const override;
   Lookup lookup() const { return lookup_; }
