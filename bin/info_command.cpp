@@ -122,8 +122,9 @@ void print_info(const Lut& lut) {
                 g.body.r, g.body.g, g.body.b, g.f0.r, g.f0.g, g.f0.b, g.f82.r, g.f82.g, g.f82.b, g.error);
   }
   std::printf("sampling tables %s\n", m.sampling ? "yes" : "no (--eval-only)");
-  std::printf("colour space    %s (of every colour above)\n", m.colorspace.c_str());
-  for (const std::string& w : m.warnings) std::printf("warning         %s\n", w.c_str());
+  // Text from the file, printed without its control characters (an escape sequence reaches no terminal).
+  std::printf("colour space    %s (of every colour above)\n", excerpt(m.colorspace, 256).c_str());
+  for (const std::string& w : m.warnings) std::printf("warning         %s\n", excerpt(w, 1024).c_str());
   std::printf("\n");
   std::printf("%4s %8s %10s %14s %14s %10s\n", "node", "u", "theta_deg", "ndf", "slope_pdf", "sigma");
   const TabulatedNdf& ndf = lut.tables.ndf;

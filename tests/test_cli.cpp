@@ -1,5 +1,6 @@
 // The facetfit command as users run it: bad inputs, batches, JSON output.
 #include <gtest/gtest.h>
+#include <OpenImageIO/imageio.h>
 
 #include <algorithm>
 #include <cstdint>
@@ -92,6 +93,18 @@ TEST(Cli, WithoutThePluginCoreCommandsRunAndOthersFailInOneLine) {
   EXPECT_NE(bake.err.find("facetfit: error: cannot load the command plugin facetfit-commands.so"), std::string::npos) << bake.err;
 }
 
+// `lut` written again to `out` with string attributes set (a crafted LUT).
+void with_attributes(const std::string& lut, const std::string& out, const std::vector<std::pair<std::string, std::string>>& attributes) {
+  auto in = OIIO::ImageInput::open(lut);
+  ASSERT_TRUE(in);
+  OIIO::ImageSpec spec = in->spec();
+  std::vector<float> pixels(std::size_t(spec.width) * std::size_t(spec.height) * std::size_t(spec.nchannels));
+  ASSERT_TRUE(in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, pixels.data()));
+  for (const auto& [name, value] : attributes) spec.attribute(name, value);
+  auto o = OIIO::ImageOutput::create(out);
+  ASSERT_TRUE(o && o->open(out, spec) && o->write_image(OIIO::TypeDesc::FLOAT, pixels.data()) && o->close());
+}
+
 // A LUT's source holding a newline and a terminal escape (an edited file): info prints them as text
 // (issue 47: they reached the terminal).
 TEST(Cli, InfoPrintsMetadataAsText) {
@@ -103,6 +116,32 @@ TEST(Cli, InfoPrintsMetadataAsText) {
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_EQ(r.out.find('\x1b'), std::string::npos);
   EXPECT_NE(r.out.find("source          evil?[2J?forged line\n"), std::string::npos) << r.out;
+  // Its warnings too (issue 61: they were printed raw).
+  with_attributes(dir.file("evil.exr"), dir.file("evil2.exr"), {{"facetfit:warnings", "odd\x1b[31m red"}});
+  const RunResult w = facetfit("info " + dir.file("evil2.exr"));
+  EXPECT_EQ(w.out.find('\x1b'), std::string::npos) << w.out;
+  EXPECT_NE(w.out.find("warning         odd?[31m red"), std::string::npos) << w.out;
+}
+
+// LUT metadata is read in one pass with a size bound: 2 MB of warning lines (a crafted LUT) took 40 s in info
+// when each line copied the rest; now such a LUT is refused at once with one line, and 60 KB of them read.
+TEST(Cli, ManyWarningLinesAreReadInOnePassWithABound) {
+  TempDir dir;
+  const Fitter fitter{FitOptions::paper()};
+  write_lut(dir.file("l.exr"), make_lut(fitter.fit(HalfDiffTable::tabulate(LambertBrdf(Rgb(0.5)))), fitter.quadrature(), "l", "x", 0.02, false));
+  const auto with_warnings = [&](std::size_t bytes, const std::string& out) {
+    std::string lines;
+    while (lines.size() + 2 <= bytes) lines += "w\n";
+    with_attributes(dir.file("l.exr"), out, {{"facetfit:warnings", lines}});
+  };
+  with_warnings(2 << 20, dir.file("big.exr"));
+  const RunResult big = facetfit("info " + dir.file("big.exr"));
+  EXPECT_EQ(big.status, 1);
+  EXPECT_NE(big.err.find("facetfit:warnings is 2097"), std::string::npos) << big.err;
+  with_warnings(60 << 10, dir.file("many.exr"));
+  const RunResult many = facetfit("info " + dir.file("many.exr"));
+  ASSERT_EQ(many.status, 0) << many.err;
+  EXPECT_GT(std::count(many.out.begin(), many.out.end(), '\n'), 30000);
 }
 
 TEST(Cli, InfoOnAMeasurementSaysWhatToRun) {

@@ -413,8 +413,9 @@ void read_lut_header(const std::string& path, const ImageSpec& spec, LutMetadata
 }
 
 // The paper's fit (iterations, residual, moment alphas and NDF distances), the settings and the warnings,
-// one a line.
-void read_extraction_attributes(const ImageSpec& spec, LutMetadata& m) {
+// one a line: at most kMaxWarningBytes of them (a bake writes a few lines of some 100 bytes), split in one pass.
+constexpr std::size_t kMaxWarningBytes = 64 * 1024;
+void read_extraction_attributes(const std::string& path, const ImageSpec& spec, LutMetadata& m) {
   m.iterations = spec.get_int(key("iterations"));
   m.residual = spec.get_float(key("residual"));
   m.alpha_ggx = spec.get_float(key("alpha_ggx"));
@@ -423,10 +424,13 @@ void read_extraction_attributes(const ImageSpec& spec, LutMetadata& m) {
   m.ndf_error_beckmann = spec.get_float(key("ndf_error_beckmann"));
   m.tolerance = spec.get_float(key("tolerance"));
   m.sampling = spec.get_int(key("sampling")) != 0;
-  for (std::string text = spec.get_string(key("warnings")); !text.empty();) {
-    const std::size_t end = text.find('\n');
-    m.warnings.push_back(text.substr(0, end));
-    text = end == std::string::npos ? "" : text.substr(end + 1);
+  const std::string text = spec.get_string(key("warnings"));
+  if (text.size() > kMaxWarningBytes)
+    fail(path, "facetfit:warnings is " + std::to_string(text.size()) + " bytes: at most " + std::to_string(kMaxWarningBytes));
+  for (std::size_t begin = 0; begin < text.size();) {
+    const std::size_t end = std::min(text.find('\n', begin), text.size());
+    m.warnings.push_back(text.substr(begin, end - begin));
+    begin = end + 1;
   }
 }
 
@@ -492,7 +496,7 @@ LutMetadata read_lut_attributes(const std::string& path, const ImageSpec& spec, 
   LutMetadata m;
   m.format_version = version;
   read_lut_header(path, spec, m);
-  read_extraction_attributes(spec, m);
+  read_extraction_attributes(path, spec, m);
   if (version == 1) {  // no body; the parametric fits are the moment alphas with the curve's f0 and f82
     m.ggx = {m.alpha_ggx, Rgb(0.0), m.f0, m.f82, {}};
     m.beckmann = {m.alpha_beckmann, Rgb(0.0), m.f0, m.f82, {}};
