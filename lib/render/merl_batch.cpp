@@ -99,8 +99,9 @@ void EvalMerlBatch(const MerlBatchModel& model, EvaluationBatch& batch) {
         weight[ch] = hn::IfThenElse(valid, weight[ch] + w, weight[ch]);
       }
     }
-    const auto measured = hn::And(above, hn::And(hn::And(weight[0] > zero, weight[1] > zero), weight[2] > zero));
+    // A channel with no measured neighbour is 0 beside the others (HalfDiffTable::eval_linear).
     for (int ch = 0; ch < 3; ++ch) {
+      const auto measured = hn::And(above, weight[ch] > zero);
       hn::StoreU(hn::IfThenElseZero(measured, lanes::divide(d, sum[ch], hn::IfThenElse(measured, weight[ch], one))), d, out[ch] + k);
     }
   }
