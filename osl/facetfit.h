@@ -39,19 +39,19 @@ struct FacetfitLut {
 };
 
 // The LUT's Smith model (0 masking, 1 correlated, 2 separable) and recommended representation (0
-// tabulated, 1 ggx, 2 beckmann): the integer attributes, or the string ones for renderers that read
-// strings (Cycles' OSL returns string attributes empty; LUTs before the integers have only strings); -1
-// when neither says.
-int facetfit_code(string file, string attribute, string name0, string name1, string name2) {
+// tabulated, 1 ggx, 2 beckmann, 3 closures): the integer attributes, or the string ones for renderers that
+// read strings (Cycles' OSL returns string attributes empty; LUTs before the integers have only strings);
+// -1 when neither says.
+int facetfit_code(string file, string attribute, string name0, string name1, string name2, string name3) {
   int code = -1;
   if (gettextureinfo(file, concat("facetfit:", attribute, "_code"), code)) return code;
   string name = "";
   gettextureinfo(file, concat("facetfit:", attribute), name);
-  return name == name0 ? 0 : (name == name1 ? 1 : (name == name2 ? 2 : -1));
+  return name == name0 ? 0 : (name == name1 ? 1 : (name == name2 ? 2 : (name != "" && name == name3 ? 3 : -1)));
 }
 
-int facetfit_smith_code(string file) { return facetfit_code(file, "smith", "masking", "correlated", "separable"); }
-int facetfit_representation_code(string file) { return facetfit_code(file, "representation", "tabulated", "ggx", "beckmann"); }
+int facetfit_smith_code(string file) { return facetfit_code(file, "smith", "masking", "correlated", "separable", ""); }
+int facetfit_representation_code(string file) { return facetfit_code(file, "representation", "tabulated", "ggx", "beckmann", "closures"); }
 
 
 // ---- accurate angles ----

@@ -378,7 +378,7 @@ TEST_P(OslModel, MetadataEqualsLibrary) {
   cases.second.assign(kGrid * kGrid, Vec3(0.0, 0.0, 1.0));
   const Image img = probe(5, cases);
   const int smith = table.meta.smith == Smith::masking ? 0 : (table.meta.smith == Smith::correlated ? 1 : 2);
-  const int representation = table.meta.representation == Representation::tabulated ? 0 : (table.meta.representation == Representation::ggx ? 1 : 2);
+  const int representation = static_cast<int>(table.meta.representation);  // Representation's order is the code's
   EXPECT_EQ(img.at(0, 0)[0], float(smith));
   EXPECT_EQ(img.at(0, 0)[1], float(representation));
   EXPECT_EQ(img.at(0, 0)[2], float(table.meta.resolution));
@@ -819,7 +819,7 @@ TEST_F(OslSphere, MaterialShaderEmitsTheClosures) {
   std::vector<Case> cases;
   for (const std::string material : {"gold-ggx-0.15", "silver-ggx-0.60", "copper-beckmann-0.30", "red-plastic", "blue-clearcoat-paint"}) {
     const std::string lut = bake(material);
-    cases.push_back({material, lut, "", {{"type", "closures"}, {"file", lut}}});
+    cases.push_back({material, lut, "", {{"type", "material"}, {"file", lut}}});
   }
   for (const std::string rgl : {"cc_ibiza_sunset_rgb", "ilm_l3_37_metallic_rgb"}) {
     const std::filesystem::path source = test::rgl_dir() / (rgl + ".bsdf");
@@ -830,7 +830,7 @@ TEST_F(OslSphere, MaterialShaderEmitsTheClosures) {
     const RunResult r = facetfit("bake " + source.string() + " -o " + work_->path().string());
     ASSERT_EQ(r.status, 0) << r.err;
     const std::string lut = work_->file(rgl + ".exr");
-    cases.push_back({rgl, lut, "", {{"type", "closures"}, {"file", lut}}});
+    cases.push_back({rgl, lut, "", {{"type", "material"}, {"file", lut}}});
     if (rgl != "cc_ibiza_sunset_rgb") continue;
     // Its lobes follow the view (format 6). The control: the reference of the same lobes along the tangent (their
     // view exponents set to 0) is far from the material's render, so the shader does turn them with the view.
@@ -840,7 +840,7 @@ TEST_F(OslSphere, MaterialShaderEmitsTheClosures) {
     for (std::size_t k = 0; k < film.meta.closures.lobes.size(); ++k)
       zeroed += " --attrib:type=float facetfit:closures_lobe" + std::to_string(k) + "_view_exponent 0";
     ASSERT_EQ(test::run_command(zeroed + " -o " + work_->file("along-the-tangent.exr")).status, 0);
-    cases.push_back({rgl + "-along-the-tangent", lut, "", {{"type", "closures"}, {"file", work_->file("along-the-tangent.exr")}}});
+    cases.push_back({rgl + "-along-the-tangent", lut, "", {{"type", "material"}, {"file", work_->file("along-the-tangent.exr")}}});
   }
   // An RGL file of GGX 0.45 x 0.2 turned 30 degrees, F = 1 (the tests' tensor writer): one anisotropic lobe,
   // along world up (Blender's z), turned 20 degrees more and scaled (1.5, 0.75) along its axes.
@@ -853,7 +853,7 @@ TEST_F(OslSphere, MaterialShaderEmitsTheClosures) {
   ASSERT_EQ(aniso_lut.meta.format_version, kLutClosuresVersion);
   ASSERT_EQ(aniso_lut.meta.closures.lobes.size(), 1u);
   EXPECT_GT(aniso_lut.meta.closures.lobes[0].alpha_x, 1.5 * aniso_lut.meta.closures.lobes[0].alpha_y);
-  const nlohmann::json turned = {{"type", "closures"}, {"file", aniso}, {"tangent", {0.0, 1.0, 0.0}},
+  const nlohmann::json turned = {{"type", "material"}, {"file", aniso}, {"tangent", {0.0, 1.0, 0.0}},
                                  {"stretch", {1.5, 0.75}}, {"rotation", 20.0}};
   const std::string artist = " tangent=0,0,1 roughness_scale_x=1.5 roughness_scale_y=0.75 rotation=";
   cases.push_back({"aniso-ggx", aniso, artist + "20", turned});
@@ -877,7 +877,7 @@ TEST_F(OslSphere, MaterialShaderEmitsTheClosures) {
       continue;
     }
     EXPECT_LE(d.mean, 0.5) << c.name << ": max " << d.max;
-    const std::size_t lobes = read_lut(c.lut).closures().lobes.size();
+    const std::size_t lobes = read_lut(c.lut).production_closures().lobes.size();
     record("| " + c.name + " | material (closures: " + std::to_string(lobes) + (lobes > 1 ? " lobes" : " lobe") + ", " +
            std::to_string(kCyclesSpp) + " spp, sun) | " + std::to_string(d.mean) + " | " + std::to_string(d.max) + " | " +
            std::to_string(cycles_seconds) + " |");

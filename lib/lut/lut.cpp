@@ -309,8 +309,14 @@ std::optional<ParametricBrdf> Lut::parametric(const std::string& family, Smith s
   return ParametricBrdf(Ndf::isotropic(type, p->alpha), smith, p->f0, p->f82, p->body, p->coat);
 }
 
-Closures Lut::closures() const {
-  if (!meta.closures.empty()) return meta.closures;
+Closures Lut::closures() const { return meta.closures.empty() ? recommended_fit_closures() : meta.closures; }
+
+Closures Lut::production_closures() const {
+  const bool one_lobe = meta.representation == Representation::ggx || meta.representation == Representation::beckmann;
+  return one_lobe ? recommended_fit_closures() : closures();
+}
+
+Closures Lut::recommended_fit_closures() const {
   if (anisotropic && meta.representation != Representation::beckmann) return closures_of(meta.anisotropic_ggx);
   const bool beckmann = meta.representation == Representation::beckmann ||
                         (meta.representation == Representation::tabulated && meta.error_beckmann < meta.error_ggx);

@@ -102,6 +102,12 @@ struct Lut {
   // The closure representation: version 5's, or for an older LUT its recommended family's fit as one
   // lobe (the anisotropic GGX fit where it has one), what the material shader rendered of it.
   Closures closures() const;
+  // What the production material (osl/facetfit_material.osl) and the MaterialX export emit: the
+  // recommended GGX or Beckmann fit as one lobe, else (closures or tabulated recommended) closures().
+  Closures production_closures() const;
+
+ private:
+  Closures recommended_fit_closures() const;  // the recommended family's fit as one lobe
 };
 
 // Builds the LUT of a fit, its representation recommended under `tolerance` (fit/recommend.h).

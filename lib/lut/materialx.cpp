@@ -116,7 +116,7 @@ std::string materialx_name(const std::string& stem) {
 }
 
 std::string materialx_document(const std::string& name, const Lut& lut, bool color82) {
-  const Closures c = lut.closures();
+  const Closures c = lut.production_closures();
   std::vector<Node> nodes;
   std::vector<std::string> parts;
   if (c.body.r > 0.0 || c.body.g > 0.0 || c.body.b > 0.0) {

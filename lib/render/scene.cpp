@@ -148,8 +148,8 @@ void parse_material_sampling(const json& j, const std::string& what, const std::
 
 // The tangent and whether an anisotropic lobe renders as one.
 void parse_material_orientation(const json& j, const std::string& what, const std::string& path, MaterialDesc& m) {
-  if (j.contains("tangent") && !one_of(m.type, {"lut", "measured", "ggx", "closures"}))
-    fail(path, what + ": \"tangent\" is for lut, ggx, closures and measured materials (an anisotropic fit or measurement turns with it)");
+  if (j.contains("tangent") && !one_of(m.type, {"lut", "measured", "ggx", "closures", "material"}))
+    fail(path, what + ": \"tangent\" is for lut, ggx, closures, material and measured materials (an anisotropic fit or measurement turns with it)");
   if (j.contains("tangent")) m.tangent = direction(j["tangent"], what + ": tangent", path);
   if (j.contains("anisotropic")) {
     if (!one_of(m.type, {"lut", "ggx"}) || !j["anisotropic"].is_boolean())
@@ -169,8 +169,9 @@ std::pair<double, double> parse_stretch_factors(const json& st, const std::strin
 
 // The artist's stretch, rotation and stretch texture of a lut or closures material.
 void parse_material_stretch(const json& j, const std::string& what, const std::string& path, MaterialDesc& m) {
-  if (m.type != "lut" && m.type != "closures") fail(path, what + ": \"stretch\" and \"rotation\" are for lut and closures materials");
-  if (m.type == "closures" && j.contains("stretch_texture")) fail(path, what + ": \"stretch_texture\" is for lut materials");
+  if (!one_of(m.type, {"lut", "closures", "material"}))
+    fail(path, what + ": \"stretch\" and \"rotation\" are for lut, closures and material materials");
+  if (m.type != "lut" && j.contains("stretch_texture")) fail(path, what + ": \"stretch_texture\" is for lut materials");
   m.stretch_texture = get<std::string>(j, "stretch_texture", "", path);
   if (j.contains("stretch_texture") && m.stretch_texture.empty()) fail(path, what + ": stretch_texture must name an image");
   const auto [sx, sy] = j.contains("stretch") ? parse_stretch_factors(j["stretch"], what, path) : std::pair{1.0, 1.0};
@@ -555,15 +556,16 @@ std::shared_ptr<const ShadingModel> load_material(const SceneDesc& scene, const 
     const auto model = sampled_lut_model(std::move(lut));
     return std::make_shared<ShadingModel>(model, VisibleSlopeProposal::of(*model));
   }
-  if (m.type == "closures") {
-    // The LUT's closure representation as the production shader emits it (osl/facetfit_material.osl), the
-    // artist's scales along each lobe's axes, turned by the rotation. Unstretched, it is drawn by the LUT's
+  if (m.type == "closures" || m.type == "material") {
+    // The LUT's closure representation, or (material) what the production shader emits of the LUT
+    // (osl/facetfit_material.osl: Lut::production_closures), the artist's scales along each lobe's axes,
+    // turned by the rotation. Unstretched, it is drawn by the LUT's
     // own tabulated proposal, as the `lut` and `measured` materials of the LUT are: the same random numbers
     // then give nearly the same directions, and most of the noise cancels in their differences (the
     // report's; with its own proposal, the closures of gold at the report test's 4 spp stood 5.4 from the
     // measurement where the ggx fit stood 0.3).
     Lut lut = scene_lut(scene, m.file);
-    const Closures closures = lut.closures().stretched(m.stretch.x, m.stretch.y, m.stretch.rotation());
+    const Closures closures = (m.type == "material" ? lut.production_closures() : lut.closures()).stretched(m.stretch.x, m.stretch.y, m.stretch.rotation());
     const auto brdf = std::make_shared<ClosureBrdf>(closures);
     if (!m.stretch.unscaled()) return std::make_shared<ShadingModel>(brdf, std::make_shared<ClosureProposal>(closures));
     return std::make_shared<ShadingModel>(brdf, VisibleSlopeProposal::of(*sampled_lut_model(std::move(lut))));

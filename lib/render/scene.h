@@ -54,6 +54,7 @@ inline constexpr MaterialType kMaterialTypes[] = {
     {"beckmann", false, true, MaterialType::Lanes::sampling},
     {"lsq", true, true, MaterialType::Lanes::sampling},
     {"closures", true, true, MaterialType::Lanes::sampling},
+    {"material", true, true, MaterialType::Lanes::sampling},  // closures, as the production material picks them
     {"lambert", false, false, MaterialType::Lanes::all},
     {"analytic", true, false, MaterialType::Lanes::sampling},
 };
