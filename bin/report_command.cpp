@@ -2,6 +2,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <charconv>
 #include <cstdio>
 #include <filesystem>
 
@@ -19,12 +20,28 @@ namespace {
 
 namespace fs = std::filesystem;
 
+constexpr int kMaxShards = 100000;
+
+// "K/N", the whole text, 1 <= K <= N <= kMaxShards: digits only, so no sign, space or overflow gets through.
+bool parse_shard(const std::string& text, int& k, int& n) {
+  const std::size_t slash = text.find('/');
+  if (slash == std::string::npos) return false;
+  const auto number = [](const char* begin, const char* end, int& value) {
+    if (begin == end || end - begin > 6) return false;
+    const auto [p, ec] = std::from_chars(begin, end, value);
+    return ec == std::errc() && p == end && *begin != '-' && *begin != '+';
+  };
+  const char* s = text.data();
+  return number(s, s + slash, k) && number(s + slash + 1, s + text.size(), n) && k >= 1 && n >= k && n <= kMaxShards;
+}
+
 struct ReportArgs {
   std::vector<std::string> inputs;
   std::string out_dir, luts_dir;
   int size = ReportOptions{}.size, spp = ReportOptions{}.spp;
   std::string shard = "1/1";
   bool fail_on_regression = false;
+  bool accept = false;
   bool force = false;
   double tolerance = kDefaultTolerance;
   std::uint64_t max_memory = 0;
@@ -81,8 +98,10 @@ void run_farm_command(const ReportArgs& args, Context& ctx) {
   std::vector<std::string> absolute;
   for (const std::string& s : sources) absolute.push_back(is_builtin(s) ? s : fs::absolute(s).lexically_normal().string());
   const std::string luts_dir = args.luts_dir.empty() ? "" : fs::absolute(args.luts_dir).lexically_normal().string();
-  const FarmPlan plan = plan_report_farm(absolute, args.shards, out_dir, luts_dir, shard_settings(args),
-                                         args.fail_on_regression ? std::vector<std::string>{"--fail-on-regression"} : std::vector<std::string>{});
+  std::vector<std::string> merge_flags;
+  if (args.fail_on_regression) merge_flags.push_back("--fail-on-regression");
+  if (args.accept) merge_flags.push_back("--accept");
+  const FarmPlan plan = plan_report_farm(absolute, args.shards, out_dir, luts_dir, shard_settings(args), merge_flags);
   if (args.dry_run) {
     if (args.farm == "slurm") {
       std::printf("# %s/.farm/shards.sbatch: sbatch --array=1-%zu shards.sbatch\n%s\n", out_dir.c_str(), plan.shards.size(),
@@ -109,12 +128,17 @@ void finish(const nlohmann::json& report, const std::string& out_dir, bool fail_
   for (const auto& [r, v] : report["database_mean_delta_e"].items())
     if (!ctx.quiet()) std::printf("  mean Delta E 2000 %-10s %s\n", r.c_str(), v.is_null() ? "-" : std::to_string(v.get<double>()).c_str());
   for (const auto& f : report["failures"]) report_error(f["error"].get<std::string>());
+  const bool accepted = report.value("accepted", false);
   for (const auto& g : report["regressions"])
-    std::fprintf(stderr, "facetfit: regression: %s %s %.4f -> %.4f\n", g["name"].get<std::string>().c_str(),
-                 g["representation"].get<std::string>().c_str(), g["before"].get<double>(), g["after"].get<double>());
+    std::fprintf(stderr, "facetfit: regression%s: %s %s %.4f -> %.4f (%s)\n", accepted ? " (accepted)" : "", g["name"].get<std::string>().c_str(),
+                 g["representation"].get<std::string>().c_str(), g["before"].get<double>(), g["after"].get<double>(),
+                 g.value("cause", std::string()).c_str());
+  for (const auto& name : report.value("removed", nlohmann::json::array()))
+    std::fprintf(stderr, "facetfit: removed: %s is in the baseline but not in this report (--accept drops it)\n", name.get<std::string>().c_str());
+  const bool regressed = !report["regressions"].empty() || !report.value("removed", nlohmann::json::array()).empty();
   if (!report["failures"].empty())
     ctx.status = 1;
-  else if (fail_on_regression && !report["regressions"].empty())
+  else if (fail_on_regression && regressed && !accepted)
     ctx.status = 3;
 }
 
@@ -130,6 +154,7 @@ void run_report_command(const ReportArgs& args, Context& ctx) {
   o.spp = args.spp;
   o.max_memory = args.max_memory;
   o.force = args.force;
+  o.accept = args.accept;
   o.bake.fit = *fit;
   o.bake.tolerance = args.tolerance;
   if (!args.color.display.empty() || !args.color.view.empty()) {
@@ -142,10 +167,8 @@ void run_report_command(const ReportArgs& args, Context& ctx) {
     }
     o.pictures_name = "display " + args.color.display + ", view " + (args.color.view.empty() ? "(its default)" : args.color.view);
   }
-  int used = 0;  // the whole text is K/N: "1/2/3" is not 1/2
-  if (std::sscanf(args.shard.c_str(), "%d/%d%n", &o.shard, &o.shards, &used) != 2 || used != int(args.shard.size()) || o.shards < 1 ||
-      o.shard < 1 || o.shard > o.shards) {
-    report_error("--shard " + args.shard + ": must be K/N with 1 <= K <= N");
+  if (!parse_shard(args.shard, o.shard, o.shards)) {
+    report_error("--shard " + excerpt(args.shard, 40) + ": must be K/N with 1 <= K <= N <= " + std::to_string(kMaxShards));
     status = 2;
     return;
   }
@@ -182,7 +205,9 @@ void add_report_command(CLI::App& app, Context& ctx) {
   add_max_memory_option(cmd, args->max_memory);
   cmd->add_option("--shard", args->shard, "K/N: render the K-th of N deterministic subsets (merge them with report merge)")
       ->capture_default_str();
-  cmd->add_flag("--fail-on-regression", args->fail_on_regression, "Exit 3 when a material got worse than in the previous report");
+  cmd->add_flag("--fail-on-regression", args->fail_on_regression,
+                "Exit 3 when a material got worse than its baseline (the last accepted figures) or left the database");
+  cmd->add_flag("--accept", args->accept, "This run's figures become the baseline, regressions and removed materials included");
   cmd->add_flag("--force", args->force, "Render even the materials whose previous entry is current");
   add_tolerance_option(cmd, args->tolerance);
   add_fit_settings(cmd, args->settings);
@@ -200,14 +225,15 @@ void add_report_command(CLI::App& app, Context& ctx) {
 
   auto parts = std::make_shared<std::vector<std::string>>();
   auto merged = std::make_shared<std::string>();
-  auto fail_merge = std::make_shared<bool>(false);
+  auto fail_merge = std::make_shared<bool>(false), accept_merge = std::make_shared<bool>(false);
   CLI::App* merge = cmd->add_subcommand("merge", "Join shard reports into one");
   merge->add_option("parts", *parts, "Report folders written with --shard")->required();
   merge->add_option("-o,--output", *merged, "Merged report folder")->required();
-  merge->add_flag("--fail-on-regression", *fail_merge, "Exit 3 on regressions against the previous merged report");
-  merge->callback([parts, merged, fail_merge, &ctx] {
+  merge->add_flag("--fail-on-regression", *fail_merge, "Exit 3 on regressions against the merged folder's baseline");
+  merge->add_flag("--accept", *accept_merge, "This merge's figures become the baseline");
+  merge->callback([parts, merged, fail_merge, accept_merge, &ctx] {
     try {
-      finish(merge_reports(*parts, *merged), *merged, *fail_merge, ctx);
+      finish(merge_reports(*parts, *merged, *accept_merge), *merged, *fail_merge, ctx);
     } catch (const Error& e) {
       report_error(e.what());
       ctx.status = 1;

@@ -390,13 +390,24 @@ TEST(ReportCli, FailOnRegressionAndMerge) {
   RunResult r = facetfit("report" + args + "-o " + out);
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.out.find(out + "/index.html"), std::string::npos);
-  // Make the previous report better than anything this run can do.
+  // Make the baseline better than anything this run can do.
   nlohmann::json previous = read_json(out + "/report.json");
-  for (auto& m : previous["materials"]) m["delta_e"]["ggx"] = 0.0;
+  for (auto& [name, b] : previous["baseline"].items()) b["delta_e"]["ggx"] = 0.0;
   test::write_bytes(out + "/report.json", previous.dump());
   r = facetfit("report" + args + "--force --fail-on-regression -o " + out);
   EXPECT_EQ(r.status, 3);  // regressions, nothing failed
   EXPECT_NE(r.err.find("regression: red-plastic ggx"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("(neither input file nor facetfit changed)"), std::string::npos) << r.err;
+  // The same nightly run again fails again; accepted, it passes, and so does the next.
+  EXPECT_EQ(facetfit("report" + args + "--fail-on-regression -o " + out).status, 3);
+  r = facetfit("report" + args + "--fail-on-regression --accept -o " + out);
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("regression (accepted): red-plastic ggx"), std::string::npos) << r.err;
+  EXPECT_EQ(facetfit("report" + args + "--fail-on-regression -o " + out).status, 0);
+  // A material that left the database fails the nightly until accepted.
+  r = facetfit("report builtin:gold-ggx-0.15 --size 16 --spp 2 --fail-on-regression -o " + out);
+  EXPECT_EQ(r.status, 3);
+  EXPECT_NE(r.err.find("removed: red-plastic is in the baseline"), std::string::npos) << r.err;
   // Shards and merge through the command.
   ASSERT_EQ(facetfit("report" + args + "--shard 1/2 -o " + dir.file("s1")).status, 0);
   ASSERT_EQ(facetfit("report" + args + "--shard 2/2 -o " + dir.file("s2")).status, 0);

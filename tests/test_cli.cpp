@@ -308,6 +308,8 @@ TEST(Cli, UsageErrors) {
   // Values CLI11 or sscanf would have wrapped or cut short (issue 47).
   for (const char* args : {"render --seed -1 -o x.exr", "render --seed 18446744073709551616 -o x.exr", "render --seed 1e3 -o x.exr",
                            "render --max-memory 0x10G -o x.exr", "report builtin:gold-ggx-0.15 -o r --shard 1/2/3",
+                           "report builtin:gold-ggx-0.15 -o r --shard 1/4294967297", "report builtin:gold-ggx-0.15 -o r --shard 1/+2",
+                           "report builtin:gold-ggx-0.15 -o r --shard 2/1",
                            "report builtin:gold-ggx-0.15 -o r --spp 2000000"}) {
     const RunResult r = facetfit(args);
     EXPECT_EQ(r.status, 2) << args << ": " << r.err;

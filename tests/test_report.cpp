@@ -7,6 +7,8 @@
 #include <regex>
 
 #include "io/atomic_file.h"
+#include "io/folder_lock.h"
+#include "io/input.h"
 #include "io/merl.h"
 #include "model/analytic.h"
 #include "report/report.h"
@@ -77,6 +79,24 @@ TEST(Report, SymlinkedFoldersAreNotFollowed) {
   std::filesystem::rename(dir.path() / "out2-luts", dir.path() / "out2" / "luts");
   EXPECT_NE(test::error_of([&] { run_report(small(dir.file("out2"))); }).find("luts: is a symbolic link"), std::string::npos);
   EXPECT_TRUE(std::filesystem::is_empty(dir.path() / "outside"));
+}
+
+TEST(Report, ASecondReportIntoTheSameFolderIsRefused) {
+  // Another process's report holds the folder (its images/ locked): this one is refused at once, naming
+  // the folder, and writes nothing; a merge into it too. Once released, the report runs.
+  TempDir dir;
+  ReportOptions o = small(dir.file("part"));
+  o.inputs = {"builtin:gold-ggx-0.15"};
+  ASSERT_EQ(run_report(o)["materials"].size(), 1u);
+  std::filesystem::create_directories(dir.path() / "out" / "images");
+  o.out_dir = dir.file("out");
+  {
+    const FolderLock other((dir.path() / "out" / "images").string());
+    EXPECT_NE(test::error_of([&] { run_report(o); }).find("images: is being written by another facetfit process"), std::string::npos);
+    EXPECT_NE(test::error_of([&] { merge_reports({dir.file("part")}, dir.file("out")); }).find("is being written by another"), std::string::npos);
+    EXPECT_FALSE(std::filesystem::exists(dir.path() / "out" / "report.json"));
+  }
+  EXPECT_EQ(run_report(o)["materials"].size(), 1u);
 }
 
 json read_json(const std::string& path) {
@@ -169,8 +189,7 @@ TEST(Report, RegressionsAgainstThePreviousReport) {
   TempDir dir;
   json r = run_report(small(dir.path().string()));
   // Pretend the previous night was much better for gold's GGX fit.
-  for (json& m : r["materials"])
-    if (m["name"] == "gold-ggx-0.15") m["delta_e"]["ggx"] = 0.0;
+  r["baseline"]["gold-ggx-0.15"]["delta_e"]["ggx"] = 0.0;
   test::write_bytes(dir.file("report.json"), r.dump());
   ReportOptions again = small(dir.path().string());
   again.force = true;
@@ -183,10 +202,62 @@ TEST(Report, RegressionsAgainstThePreviousReport) {
   // A regression needs +10% and +0.1: from the pretended 0, exactly when gold's Delta E exceeds 0.1.
   EXPECT_EQ(found, gold_ggx > 0.1);
   json previous = now, current = now;
+  previous.erase("baseline");  // reports from before baselines: judged against their own figures
+  current.erase("baseline");
   previous["materials"][2]["delta_e"]["ggx"] = 1.0;
   current["materials"][2]["delta_e"]["ggx"] = 2.0;
   ASSERT_EQ(find_regressions(previous, current).size(), 1u);
   EXPECT_EQ(find_regressions(current, previous).size(), 0u);  // getting better is not a regression
+}
+
+TEST(Report, AFailedNightlyStaysFailedUntilAccepted) {
+  TempDir dir;
+  ReportOptions o = small(dir.path().string());
+  json r = run_report(o);
+  ASSERT_EQ(r["baseline"].size(), 3u);
+  EXPECT_TRUE(r["regressions"].empty());
+  // The baseline pretends the worst figure of the report was 0: this run regresses on it.
+  std::string name, representation;
+  double worst = 0.0;
+  for (const json& m : r["materials"])
+    for (const auto& [rep, v] : m["delta_e"].items())
+      if (v.get<double>() > worst) worst = v.get<double>(), name = m["name"], representation = rep;
+  ASSERT_GT(worst, 0.2);
+  r["baseline"][name]["delta_e"][representation] = 0.0;
+  test::write_bytes(dir.file("report.json"), r.dump());
+  const auto regressed = [&](const json& report) {
+    for (const json& g : report["regressions"])
+      if (g["name"] == name && g["representation"] == representation) return g.value("cause", std::string());
+    return std::string();
+  };
+  // Failed, and failed again on the rerun (its entries reused): the failed figures did not become the baseline.
+  for (int night = 0; night < 2; ++night) {
+    const json again = run_report(o);
+    EXPECT_EQ(regressed(again), "neither input file nor facetfit changed") << night;
+    EXPECT_EQ(again["baseline"][name]["delta_e"][representation].get<double>(), 0.0) << night;
+  }
+  // A changed input file is named as the cause.
+  json edited = read_json(dir.file("report.json"));
+  edited["baseline"][name]["source_sha256"] = std::string(64, '0');
+  test::write_bytes(dir.file("report.json"), edited.dump());
+  EXPECT_EQ(regressed(run_report(o)), "input file changed");
+  // Accepted: still listed this once, then the baseline.
+  ReportOptions accept = o;
+  accept.accept = true;
+  const json accepted = run_report(accept);
+  EXPECT_TRUE(accepted["accepted"].get<bool>());
+  EXPECT_FALSE(regressed(accepted).empty());
+  EXPECT_NEAR(accepted["baseline"][name]["delta_e"][representation].get<double>(), worst, 1e-12);
+  EXPECT_TRUE(run_report(o)["regressions"].empty());
+  // A material that leaves the database is listed until accepted.
+  ReportOptions fewer = o;
+  fewer.inputs.pop_back();
+  const std::string gone = source_name(o.inputs.back());
+  for (int night = 0; night < 2; ++night) EXPECT_EQ(run_report(fewer)["removed"], json::array({gone})) << night;
+  fewer.accept = true;
+  EXPECT_EQ(run_report(fewer)["removed"], json::array());
+  fewer.accept = false;
+  EXPECT_EQ(run_report(fewer)["removed"], json::array());
 }
 
 TEST(Report, ShardsMergeIntoTheWholeReport) {

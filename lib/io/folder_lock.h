@@ -9,8 +9,10 @@ namespace facetfit {
 
 class FolderLock {
  public:
-  // Blocks until the lock is held. Throws Error("<folder>: cannot lock: <reason>").
-  explicit FolderLock(const std::string& folder);
+  // Blocks until the lock is held (Wait::no: throws Error("<folder>: is being written by another facetfit
+  // process") when another holds it). Throws Error("<folder>: cannot lock: <reason>").
+  enum class Wait { yes, no };
+  explicit FolderLock(const std::string& folder, Wait wait = Wait::yes);
   ~FolderLock();
   FolderLock(const FolderLock&) = delete;
   FolderLock& operator=(const FolderLock&) = delete;

@@ -6,12 +6,14 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <set>
 #include <sstream>
 #include <tuple>
 
 #include "color/image_diff.h"
 #include "core/error.h"
 #include "io/atomic_file.h"
+#include "io/folder_lock.h"
 #include "io/input.h"
 #include "io/sha256.h"
 #include "lut/lut.h"
@@ -205,11 +207,18 @@ std::string report_html(const json& report) {
     h << "<td>" << label << "</td></tr>";
   }
   h << "</table>";
+  const bool accepted = report.value("accepted", false);
   if (!report["regressions"].empty()) {
-    h << "<h2 class='bad'>Regressions against the previous report</h2><ul>";
+    h << "<h2 class='bad'>Regressions against the baseline" << (accepted ? " (accepted: the new baseline)" : "") << "</h2><ul>";
     for (const json& g : report["regressions"])
       h << "<li class='bad'>" << html_escape(g["name"].get<std::string>()) << " " << g["representation"].get<std::string>() << ": "
-        << two_decimals(g["before"].get<double>()) << " &rarr; " << two_decimals(g["after"].get<double>()) << "</li>";
+        << two_decimals(g["before"].get<double>()) << " &rarr; " << two_decimals(g["after"].get<double>()) << " ("
+        << html_escape(g.value("cause", std::string())) << ")</li>";
+    h << "</ul>";
+  }
+  if (!report.value("removed", json::array()).empty()) {
+    h << "<h2 class='bad'>In the baseline, not in this report</h2><ul>";
+    for (const json& name : report["removed"]) h << "<li class='bad'>" << html_escape(name.get<std::string>()) << "</li>";
     h << "</ul>";
   }
   h << "<h2>Worst materials</h2><ol>";
@@ -299,21 +308,74 @@ bool images_complete(const fs::path& images, const std::string& key) {
 
 }  // namespace
 
+json baseline_of(const json& previous) {
+  if (!previous.is_object()) return json::object();
+  if (previous.contains("baseline") && previous["baseline"].is_object()) return previous["baseline"];
+  json base = json::object();  // a report written before baselines: its own values
+  for (const json& m : previous.value("materials", json::array()))
+    base[m["name"].get<std::string>()] = {{"delta_e", m["delta_e"]},
+                                          {"source_sha256", m.value("source_sha256", "")},
+                                          {"facetfit_version", previous.value("facetfit_version", "")}};
+  return base;
+}
+
+namespace {
+
+// Why a material's figures moved: its input file, facetfit, both, or neither (the settings or noise).
+std::string regression_cause(const json& before, const json& material, const std::string& version) {
+  const std::string sha = before.value("source_sha256", ""), version_before = before.value("facetfit_version", "");
+  const bool data = !sha.empty() && sha != material.value("source_sha256", "");
+  const bool code = !version_before.empty() && version_before != version;
+  if (data && code) return "input file and facetfit changed";
+  if (data) return "input file changed";
+  if (code) return "facetfit changed (" + version_before + " -> " + version + ")";
+  return "neither input file nor facetfit changed";
+}
+
+}  // namespace
+
 json find_regressions(const json& previous, const json& current) {
   json out = json::array();
-  if (!previous.is_object() || !previous.contains("materials")) return out;
-  std::map<std::string, json> before;
-  for (const json& m : previous["materials"]) before[m["name"].get<std::string>()] = m["delta_e"];
+  const json base = baseline_of(previous);
+  const std::string version = current.value("facetfit_version", "");
   for (const json& m : current["materials"]) {
-    const auto it = before.find(m["name"].get<std::string>());
-    if (it == before.end()) continue;
+    const auto it = base.find(m["name"].get<std::string>());
+    if (it == base.end()) continue;
+    const json& before = (*it)["delta_e"];
     for (const auto& [r, v] : m["delta_e"].items()) {
-      if (!it->second.contains(r)) continue;
-      const double a = it->second[r].get<double>(), b = v.get<double>();
-      if (b > a * 1.1 && b > a + 0.1) out.push_back({{"name", m["name"]}, {"representation", r}, {"before", a}, {"after", b}});
+      if (!before.contains(r)) continue;
+      const double a = before[r].get<double>(), b = v.get<double>();
+      if (b > a * 1.1 && b > a + 0.1)
+        out.push_back({{"name", m["name"]}, {"representation", r}, {"before", a}, {"after", b}, {"cause", regression_cause(*it, m, version)}});
     }
   }
   return out;
+}
+
+void judge_against_baseline(const json& previous, json& report, bool accept) {
+  report["regressions"] = find_regressions(previous, report);
+  json base = baseline_of(previous);
+  std::set<std::string> regressed, present;
+  for (const json& g : report["regressions"]) regressed.insert(g["name"].get<std::string>());
+  for (const json& m : report["materials"]) {
+    const std::string name = m["name"].get<std::string>();
+    present.insert(name);
+    if (accept || !regressed.count(name))
+      base[name] = {{"delta_e", m["delta_e"]}, {"source_sha256", m.value("source_sha256", "")}, {"facetfit_version", report["facetfit_version"]}};
+  }
+  report["removed"] = json::array();
+  for (auto it = base.begin(); it != base.end();) {
+    if (present.count(it.key())) {
+      ++it;
+    } else if (accept) {
+      it = base.erase(it);
+    } else {
+      report["removed"].push_back(it.key());
+      ++it;
+    }
+  }
+  report["baseline"] = base;
+  report["accepted"] = accept;
 }
 
 namespace {
@@ -323,6 +385,18 @@ namespace {
 void refuse_link(const fs::path& p) {
   std::error_code ec;
   if (fs::is_symlink(p, ec)) fail(p.string(), "is a symbolic link; a report writes only into folders of its own");
+}
+
+// The report folder's images/, created and held for the whole run: a second report or merge into the same
+// folder is refused at once rather than mixing its files with this one's (the LUTs' folder has its own lock,
+// taken per bake).
+FolderLock lock_report(const fs::path& out_dir) {
+  const fs::path images = out_dir / "images";
+  refuse_link(images);
+  std::error_code ec;
+  fs::create_directories(images, ec);
+  if (!fs::is_directory(images)) fail(images.string(), "cannot create folder" + (ec ? ": " + ec.message() : std::string()));
+  return FolderLock(images.string(), FolderLock::Wait::no);
 }
 
 }  // namespace
@@ -336,6 +410,7 @@ json run_report(const ReportOptions& o) {
   fs::create_directories(luts, ec);
   if (!fs::is_directory(o.out_dir) || !fs::is_directory(luts))
     fail(fs::is_directory(o.out_dir) ? luts.string() : o.out_dir, "cannot create folder" + (ec ? ": " + ec.message() : std::string()));
+  const FolderLock lock = lock_report(o.out_dir);
   remove_stale_temporaries(o.out_dir);
   remove_stale_temporaries(luts.string());
   for (const auto& entry : fs::directory_iterator(fs::path(o.out_dir) / "images", ec))
@@ -391,6 +466,7 @@ json run_report(const ReportOptions& o) {
         entry["name"] = name;
         entry["source"] = source;
         entry["key"] = key;
+        entry["source_sha256"] = baked.record.value("source_sha256", "");
         entry["representation"] = baked.record["representation"];
         entry["warnings"] = baked.record.value("warnings", json::array());
         entry["seconds"]["bake"] = bake_seconds;
@@ -431,12 +507,12 @@ json run_report(const ReportOptions& o) {
     if (o.progress) o.progress(name, ++done, mine.size());
   }
   summarize(report);
-  report["regressions"] = find_regressions(previous, report);
+  judge_against_baseline(previous, report, o.accept);
   write_outputs(report, o.out_dir);
   return report;
 }
 
-json merge_reports(const std::vector<std::string>& parts, const std::string& out_dir) {
+json merge_reports(const std::vector<std::string>& parts, const std::string& out_dir, bool accept) {
   // Every part is read and checked before anything is written: a refused merge leaves no output. No
   // material may come from two parts (a shard given twice), and the shards of a K/N split must all be
   // there; a farm's parts are whole reports of disjoint lists (1/1) and cannot be checked for that.
@@ -474,13 +550,11 @@ json merge_reports(const std::vector<std::string>& parts, const std::string& out
   }
 
   prepare_output_folder(out_dir);
+  const FolderLock lock = lock_report(out_dir);
   const fs::path images = fs::path(out_dir) / "images";
-  refuse_link(images);
   for (const json& r : reports)
     for (const json& m : r["materials"]) refuse_link(images / m["name"].get<std::string>());
   std::error_code ec;
-  fs::create_directories(images, ec);
-  if (!fs::is_directory(images)) fail(images.string(), "cannot create folder" + (ec ? ": " + ec.message() : std::string()));
   const json previous = read_json_file((fs::path(out_dir) / "report.json").string());
   json merged;
   merged["materials"] = json::array();
@@ -501,7 +575,7 @@ json merge_reports(const std::vector<std::string>& parts, const std::string& out
             [](const json& a, const json& b) { return a["name"].get<std::string>() < b["name"].get<std::string>(); });
   merged["shard"] = "merged";
   summarize(merged);
-  merged["regressions"] = find_regressions(previous, merged);
+  judge_against_baseline(previous, merged, accept);
   write_outputs(merged, out_dir);
   return merged;
 }

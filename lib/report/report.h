@@ -25,6 +25,7 @@ struct ReportOptions {
   std::uint64_t max_memory = 0;  // per render (render/renderer.h); 0: half of the machine's
   int shard = 1, shards = 1;  // this run renders materials k with k % shards == shard - 1
   bool force = false;
+  bool accept = false;  // this run's figures become the baseline, regressions and removed materials included
   BakeOptions bake;
   // The pictures' display and view (a studio's, color/display.h) and its name; null: the sRGB display,
   // through which Delta E is measured whatever the pictures show.
@@ -41,11 +42,23 @@ const std::vector<std::string>& report_representations();
 // Materials that fail are listed under "failures"; the run goes on.
 nlohmann::json run_report(const ReportOptions& options);
 
-// Joins shard reports (their report.json folders) into one, copying their images.
-nlohmann::json merge_reports(const std::vector<std::string>& parts, const std::string& out_dir);
+// Joins shard reports (their report.json folders) into one, copying their images; judged against the
+// merged folder's previous baseline.
+nlohmann::json merge_reports(const std::vector<std::string>& parts, const std::string& out_dir, bool accept = false);
 
-// Materials whose Delta E rose against `previous` (same name and representation): by more than 10%
-// and more than 0.1. Each entry: {name, representation, before, after}.
+// The figures a report is judged against (report.json's "baseline": per material its Delta E, the input's
+// SHA-256 and the facetfit version): the previous report's baseline, or for a report written before
+// baselines, its own figures.
+nlohmann::json baseline_of(const nlohmann::json& previous);
+
+// Materials whose Delta E rose against baseline_of(previous) (same name and representation): by more than
+// 10% and more than 0.1. Each entry: {name, representation, before, after, cause}, the cause whether the
+// input file, facetfit, both or neither changed since the baseline.
 nlohmann::json find_regressions(const nlohmann::json& previous, const nlohmann::json& current);
+
+// Sets report's "regressions", "removed" (baseline materials absent from it), "accepted" and the next
+// "baseline": a regressed material keeps its baseline figures, so a failed nightly run again fails again,
+// and a removed one stays listed, until a run with `accept` takes this run's figures as they are.
+void judge_against_baseline(const nlohmann::json& previous, nlohmann::json& report, bool accept);
 
 }  // namespace facetfit
