@@ -293,6 +293,7 @@ using namespace facetfit::python;
 PYBIND11_MODULE(_facetfit, m) {
   m.doc() = "facetfit: microfacet fits of measured BRDFs (Dupuy et al. 2015), LUTs, rendering, Delta E 2000";
   m.attr("__version__") = FACETFIT_VERSION;
+  m.attr("lut_format_version") = kLutViewLobesVersion;  // the newest LUT format it writes; the shaders in shader_dir() read it
   // facetfit.Error, its message decoded as os.fsdecode does: a path in it that is not UTF-8 stays readable.
   static py::exception<Error> error_type(m, "Error", PyExc_RuntimeError);
   py::register_exception_translator([](std::exception_ptr p) {
@@ -426,6 +427,7 @@ PYBIND11_MODULE(_facetfit, m) {
       .def_property_readonly("body", [](const Lut& l) { return rgb_array(l.tables.body); })
       .def_property_readonly("body_exponent", [](const Lut& l) { return l.tables.body_exponent; })
       .def_property_readonly("source", [](const Lut& l) { return l.meta.source; })
+      .def_property_readonly("format_version", [](const Lut& l) { return l.meta.format_version; }, "facetfit:format_version (docs/lut-format.md)")
       .def_property_readonly("representation", [](const Lut& l) { return std::string(to_string(l.meta.representation)); })
       .def_property_readonly("recommended", [](const Lut& l) { return to_python(recommended_json(recommended_parameters(l.meta), l.meta.tolerance)); },
                              "the recommended representation and its own parameters, as Fit.recommended() with the bake's tolerance")
