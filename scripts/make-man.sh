@@ -27,7 +27,7 @@ the OpenColorIO config that names working spaces and views, unless \-\-ocio\-con
 .B FACETFIT_RGL_DIR
 where the tests find the RGL database.
 [SEE ALSO]
-The documentation in docs/ of the facetfit sources: README.md, docs/lut-format.md, docs/scene-format.md,
+The documentation in docs/ of the facetfit sources: README.md, docs/commands.md, docs/lut-format.md, docs/scene-format.md,
 docs/colour.md.
 TEXT
 } > "$work/include"
