@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <limits>
+#include <map>
 #include <sstream>
 
 #include <glm/matrix.hpp>
@@ -81,19 +82,11 @@ void write_closures(ImageSpec& spec, const LutMetadata& m) {
 
 // Version 5's closures, each attribute present and in range, or one line naming it.
 void read_closures(const std::string& path, const ImageSpec& spec, LutMetadata& m) {
-  const auto number = [&](const std::string& name, double lo, double hi) {
-    const double v = spec.get_float(key(name.c_str()), std::numeric_limits<float>::quiet_NaN());
-    if (!(v >= lo && v <= hi)) {
-      std::ostringstream s;
-      s << "facetfit:" << name << " is missing or outside [" << lo << ", " << hi << "]";
-      fail(path, s.str());
-    }
-    return v;
-  };
+  // Missing numbers read as NaN, which validate() refuses by name with the ranges of visit_limits().
+  const auto number = [&](const std::string& name) { return double(spec.get_float(key(name.c_str()), std::numeric_limits<float>::quiet_NaN())); };
   const auto colour = [&](const std::string& name) {
     const auto c = get_color(spec, name.c_str());
-    if (!c || !(std::min({c->r, c->g, c->b}) >= 0.0 && std::max({c->r, c->g, c->b}) <= 1e3))
-      fail(path, "facetfit:" + name + " is missing or not a colour in [0, 1000]");
+    if (!c) fail(path, "facetfit:" + name + " is missing or not a colour");
     return *c;
   };
   Closures& c = m.closures;
@@ -101,20 +94,19 @@ void read_closures(const std::string& path, const ImageSpec& spec, LutMetadata& 
   if (lobes < 1 || lobes > Closures::kMaxLobes)
     fail(path, "facetfit:closures_lobes is " + std::to_string(lobes) + ": must be 1 to " + std::to_string(Closures::kMaxLobes));
   c.body = colour("closures_body");
-  c.coat = {number("closures_coat_alpha", 0.0, 10.0), number("closures_coat_f0", 0.0, 1.0)};
-  m.error_closures = number("closures_error", 0.0, 1e30);
+  c.coat = {number("closures_coat_alpha"), number("closures_coat_f0")};
+  m.error_closures = number("closures_error");
   for (std::size_t k = 0; k < std::size_t(lobes); ++k) {
     const int code = spec.get_int(key(lobe_key(k, "family_code").c_str()), -1);
     if (code != 1 && code != 2) fail(path, "facetfit:" + lobe_key(k, "family_code") + " is missing or not 1 (GGX) or 2 (Beckmann)");
     const int fresnel = spec.get_int(key(lobe_key(k, "fresnel_code").c_str()), -1);
     if (fresnel != 1 && fresnel != 2)
       fail(path, "facetfit:" + lobe_key(k, "fresnel_code") + " is missing or not 1 (F82-tint) or 2 (generalized Schlick)");
-    c.lobes.push_back({code == 1 ? NdfType::ggx : NdfType::beckmann, number(lobe_key(k, "alpha_x"), 1e-4, 10.0),
-                       number(lobe_key(k, "alpha_y"), 1e-4, 10.0), number(lobe_key(k, "angle"), -kPi, kPi),
-                       number(lobe_key(k, "weight"), 0.0, 1e3),
+    c.lobes.push_back({code == 1 ? NdfType::ggx : NdfType::beckmann, number(lobe_key(k, "alpha_x")), number(lobe_key(k, "alpha_y")),
+                       number(lobe_key(k, "angle")), number(lobe_key(k, "weight")),
                        fresnel == 1 ? ClosureLobe::Fresnel::f82_tint : ClosureLobe::Fresnel::schlick, colour(lobe_key(k, "f0")),
-                       colour(lobe_key(k, "f82")), colour(lobe_key(k, "f90")), number(lobe_key(k, "exponent"), 0.0, 100.0)});
-    if (m.format_version >= kLutViewLobesVersion) c.lobes.back().view_exponent = number(lobe_key(k, "view_exponent"), 0.0, 4.0);
+                       colour(lobe_key(k, "f82")), colour(lobe_key(k, "f90")), number(lobe_key(k, "exponent"))});
+    if (m.format_version >= kLutViewLobesVersion) c.lobes.back().view_exponent = number(lobe_key(k, "view_exponent"));
   }
 }
 
@@ -176,7 +168,76 @@ Lut make_lut(const FitResult& fit, const Quadrature& quadrature, const std::stri
     if (l.view_aligned()) m.format_version = kLutViewLobesVersion;
   // A reader of version 5 knows no closures representation.
   if (m.representation == Representation::closures) m.format_version = kLutViewLobesVersion;
+  clamp_to_limits(m);
   return lut;
+}
+
+void visit_limits(LutMetadata& m, const std::function<void(const std::string& name, double& value, double lo, double hi)>& visit) {
+  constexpr double kAlpha = 10.0, kColour = 1e3, kDistance = 1e30;
+  const auto colour = [&](const std::string& name, Rgb& c, double hi) {
+    for (int k = 0; k < 3; ++k) visit(name, c[k], 0.0, hi);  // an implausible measurement may give F > 1: kept finite
+  };
+  const auto coat = [&](const std::string& prefix, Coat& c) {
+    visit(prefix + "coat_alpha", c.alpha, 0.0, kAlpha);
+    visit(prefix + "coat_f0", c.f0, 0.0, 1.0);
+  };
+  visit("alpha_ggx", m.alpha_ggx, 0.0, kAlpha);
+  visit("alpha_beckmann", m.alpha_beckmann, 0.0, kAlpha);
+  visit("anisotropic_ggx_alpha_x", m.anisotropic_ggx.alpha.alpha_x, 0.0, kAlpha);
+  visit("anisotropic_ggx_alpha_y", m.anisotropic_ggx.alpha.alpha_y, 0.0, kAlpha);
+  visit("anisotropic_ggx_angle", m.anisotropic_ggx.alpha.angle, -kPi, kPi);
+  colour("anisotropic_ggx_body", m.anisotropic_ggx.body, kColour);
+  colour("anisotropic_ggx_f0", m.anisotropic_ggx.f0, kColour);
+  colour("anisotropic_ggx_f82", m.anisotropic_ggx.f82, kColour);
+  colour("f0", m.f0, kColour);
+  colour("f82", m.f82, kColour);
+  colour("body", m.body, kColour);
+  coat("", m.coat);
+  for (const auto& [name, p] : {std::pair{"ggx_", &m.ggx}, {"beckmann_", &m.beckmann}, {"lsq_", &m.lsq}}) {
+    const std::string n = name;
+    visit(n + "alpha", p->alpha, 0.0, kAlpha);
+    colour(n + "body", p->body, kColour);
+    colour(n + "f0", p->f0, kColour);
+    colour(n + "f82", p->f82, kColour);
+    coat(n, p->coat);
+  }
+  for (const auto& [name, v] : {std::pair{"tolerance", &m.tolerance}, {"residual", &m.residual}, {"error", &m.error},
+                                {"error_ggx", &m.error_ggx}, {"error_beckmann", &m.error_beckmann}, {"error_lsq", &m.error_lsq},
+                                {"error_extraction", &m.error_extraction}, {"ndf_error_ggx", &m.ndf_error_ggx},
+                                {"ndf_error_beckmann", &m.ndf_error_beckmann}, {"anisotropic_ggx_error", &m.anisotropic_ggx.error},
+                                {"closures_error", &m.error_closures}})
+    visit(name, *v, 0.0, kDistance);
+  Closures& c = m.closures;
+  colour("closures_body", c.body, kColour);
+  coat("closures_", c.coat);
+  for (std::size_t k = 0; k < c.lobes.size(); ++k) {
+    ClosureLobe& l = c.lobes[k];
+    visit(lobe_key(k, "alpha_x"), l.alpha_x, 1e-4, kAlpha);
+    visit(lobe_key(k, "alpha_y"), l.alpha_y, 1e-4, kAlpha);
+    visit(lobe_key(k, "angle"), l.angle, -kPi, kPi);
+    visit(lobe_key(k, "weight"), l.weight, 0.0, kColour);
+    colour(lobe_key(k, "f0"), l.f0, kColour);
+    colour(lobe_key(k, "f82"), l.f82, kColour);
+    colour(lobe_key(k, "f90"), l.f90, kColour);
+    visit(lobe_key(k, "exponent"), l.exponent, 0.0, 100.0);
+    visit(lobe_key(k, "view_exponent"), l.view_exponent, 0.0, 4.0);
+  }
+}
+
+void clamp_to_limits(LutMetadata& m) {
+  std::map<std::string, std::pair<double, double>> clamped;  // name -> the farthest value, its limit
+  visit_limits(m, [&](const std::string& name, double& v, double lo, double hi) {
+    if (!(v < lo || v > hi)) return;  // in range, or NaN: the reader refuses it by name, the fit never writes one
+    const double limit = v < lo ? lo : hi;
+    auto& [worst, at] = clamped[name];
+    if (std::abs(v - limit) >= std::abs(worst - at)) worst = v, at = limit;
+    v = limit;
+  });
+  for (const auto& [name, value] : clamped) {
+    std::ostringstream s;
+    s << "facetfit:" << name << " was " << value.first << ", outside what a LUT stores: written as " << value.second;
+    m.warnings.push_back(s.str());
+  }
 }
 
 Lut in_colorspace(Lut lut, const std::string& space, const ColorMatrix& from_rec709) {
@@ -196,6 +257,7 @@ Lut in_colorspace(Lut lut, const std::string& space, const ColorMatrix& from_rec
     for (Rgb* c : {&lobe.f0, &lobe.f82, &lobe.f90}) convert(*c);
   m.colorspace = space;
   m.from_rec709 = from_rec709;
+  clamp_to_limits(m);  // a space narrower than Rec.709 takes some colours below 0
   return lut;
 }
 
@@ -331,44 +393,16 @@ namespace {
 
 // Every number of the metadata finite and in its range, or one line naming the attribute: a LUT edited by
 // hand or damaged must not render NaN or negative light.
-void validate(const std::string& path, const LutMetadata& m) {
-  const auto in_range = [&](const std::string& name, double v, double lo, double hi) {
-    if (!(v >= lo && v <= hi)) {
-      std::ostringstream s;
-      s << "facetfit:" << name << " is " << v << ": must be in [" << lo << ", " << hi << "]";
-      fail(path, s.str());
-    }
-  };
-  const auto colour = [&](const std::string& name, const Rgb& c, double hi) {
-    for (int k = 0; k < 3; ++k) in_range(name, c[k], 0.0, hi);
-  };
-  in_range("alpha_ggx", m.alpha_ggx, 0.0, 10.0);
-  in_range("anisotropic_ggx_alpha_x", m.anisotropic_ggx.alpha.alpha_x, 0.0, 10.0);
-  in_range("anisotropic_ggx_alpha_y", m.anisotropic_ggx.alpha.alpha_y, 0.0, 10.0);
-  in_range("anisotropic_ggx_angle", m.anisotropic_ggx.alpha.angle, -kPi, kPi);
-  colour("anisotropic_ggx_body", m.anisotropic_ggx.body, 1e3);
-  colour("anisotropic_ggx_f0", m.anisotropic_ggx.f0, 1e3);
-  colour("anisotropic_ggx_f82", m.anisotropic_ggx.f82, 1e3);
-  in_range("alpha_beckmann", m.alpha_beckmann, 0.0, 10.0);
-  colour("f0", m.f0, 1e3);  // an implausible measurement may give F > 1: baked with a warning, kept finite
-  colour("f82", m.f82, 1e3);
-  colour("body", m.body, 1e3);
-  in_range("coat_alpha", m.coat.alpha, 0.0, 10.0);
-  in_range("coat_f0", m.coat.f0, 0.0, 1.0);
-  for (const auto& [name, p] : {std::pair{"ggx", &m.ggx}, {"beckmann", &m.beckmann}, {"lsq", &m.lsq}}) {
-    const std::string n = name;
-    in_range(n + "_alpha", p->alpha, 0.0, 10.0);
-    colour(n + "_body", p->body, 1e3);
-    colour(n + "_f0", p->f0, 1e3);
-    colour(n + "_f82", p->f82, 1e3);
-    in_range(n + "_coat_alpha", p->coat.alpha, 0.0, 10.0);
-    in_range(n + "_coat_f0", p->coat.f0, 0.0, 1.0);
-  }
-  for (const auto& [name, v] : {std::pair{"tolerance", m.tolerance}, {"residual", m.residual}, {"error", m.error},
-                                {"error_ggx", m.error_ggx}, {"error_beckmann", m.error_beckmann}, {"error_lsq", m.error_lsq},
-                                {"error_extraction", m.error_extraction}, {"ndf_error_ggx", m.ndf_error_ggx},
-                                {"ndf_error_beckmann", m.ndf_error_beckmann}, {"anisotropic_ggx_error", m.anisotropic_ggx.error}})
-    in_range(name, v, 0.0, 1e30);
+void validate(const std::string& path, LutMetadata m) {
+  visit_limits(m, [&](const std::string& name, double& v, double lo, double hi) {
+    if (v >= lo && v <= hi) return;
+    std::ostringstream s;
+    s << "facetfit:" << name;
+    if (std::isnan(v)) s << " is missing or not a number";
+    else s << " is " << v;
+    s << ": must be in [" << lo << ", " << hi << "]";
+    fail(path, s.str());
+  });
 }
 
 // facetfit:colorspace and its matrix from lin_rec709; lin_rec709 when absent.

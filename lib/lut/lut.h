@@ -2,6 +2,7 @@
 // evaluate and sample the fitted material with plain texture lookups. Layout: docs/lut-format.md.
 #pragma once
 
+#include <functional>
 #include <optional>
 #include <string>
 
@@ -109,6 +110,13 @@ struct Lut {
  private:
   Closures recommended_fit_closures() const;  // the recommended family's fit as one lobe
 };
+
+// Every number a LUT's metadata stores, with the range its reader accepts (a colour per channel): the one
+// table the writer clamps to and the reader checks, so that a bake never writes what its reader refuses.
+void visit_limits(LutMetadata& m, const std::function<void(const std::string& name, double& value, double lo, double hi)>& visit);
+// Clamps every number of `m` into its range, one warning line per attribute clamped (its farthest value).
+// make_lut and in_colorspace end with it.
+void clamp_to_limits(LutMetadata& m);
 
 // Builds the LUT of a fit, its representation recommended under `tolerance` (fit/recommend.h).
 Lut make_lut(const FitResult& fit, const Quadrature& quadrature, const std::string& source, const std::string& source_sha256,
