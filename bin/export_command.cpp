@@ -1,7 +1,9 @@
 // facetfit export LUT... -o DIR: each LUT's closure representation as a MaterialX document, DIR/NAME.mtlx
-// (lib/lut/materialx.h). A batch goes on past a LUT it cannot read; the exit status is 1 if any failed.
+// (lib/lut/materialx.h). A batch goes on past a LUT it cannot read or whose name another took; the exit
+// status is 1 if any failed.
 #include <cstdio>
 #include <filesystem>
+#include <map>
 
 #include "commands.h"
 #include "core/error.h"
@@ -32,9 +34,17 @@ void add_export_command(CLI::App& app, Context& ctx) {
       return;
     }
     remove_stale_temporaries(*out_dir);
+    // A document's name is the material's name in every scene that binds it: two LUTs whose names clean to
+    // the same one are refused (the second), never written over each other or renamed behind the user.
+    std::map<std::string, fs::path> taken;
     for (const std::string& path : *luts) {
       try {
         const std::string name = materialx_name(fs::path(path).stem().string());
+        const fs::path source = fs::weakly_canonical(path, ec);
+        const auto [first, fresh] = taken.emplace(name, source);
+        if (!fresh && first->second != source)
+          fail(path, "its MaterialX name " + name + " is " + first->second.string() + "'s in this export: rename one of the two");
+        if (!fresh) continue;  // the same LUT given twice
         const std::string target = (fs::path(*out_dir) / (name + ".mtlx")).string();
         write_file_atomic(target, materialx_document(name, read_lut(path), *color82));
         if (!ctx.quiet()) std::printf("%s\n", target.c_str());

@@ -200,6 +200,25 @@ TEST(Cli, ExportWritesMaterialXDocumentsThatValidate) {
   EXPECT_EQ(valid.status, 0) << valid.out << valid.err;
 }
 
+// Names that clean to one MaterialX name (a/x and b/x; a-b and "a b"): the first is written, the second
+// refused with a line naming both; the same LUT given twice is written once.
+TEST(Cli, ExportRefusesTwoLutsOfOneName) {
+  TempDir dir;
+  ASSERT_EQ(facetfit("bake builtin:gold-ggx-0.15 -o " + dir.file("luts")).status, 0);
+  const std::string lut = dir.file("luts/gold-ggx-0.15.exr");
+  for (const char* copy : {"a/x.exr", "b/x.exr", "c/a-b.exr", "c/a b.exr"}) {
+    std::filesystem::create_directories(std::filesystem::path(dir.file(copy)).parent_path());
+    std::filesystem::copy_file(lut, dir.file(copy));
+  }
+  const RunResult r = facetfit("export " + dir.file("a/x.exr") + " " + dir.file("b/x.exr") + " " + dir.file("c/a-b.exr") + " '" +
+                               dir.file("c/a b.exr") + "' " + dir.file("a/x.exr") + " -o " + dir.file("mtlx"));
+  EXPECT_EQ(r.status, 1);
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 2) << r.err;
+  EXPECT_NE(r.err.find(dir.file("b/x.exr") + ": its MaterialX name x is " + dir.file("a/x.exr") + "'s in this export"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("its MaterialX name a_b is"), std::string::npos) << r.err;
+  EXPECT_EQ(std::count(r.out.begin(), r.out.end(), '\n'), 2) << r.out;  // x.mtlx and a_b.mtlx, once each
+}
+
 TEST(Cli, JsonHasExactlyTheDocumentedKeys) {
   const RunResult r = facetfit("fit builtin:copper-beckmann-0.30 --json");
   ASSERT_EQ(r.status, 0) << r.err;

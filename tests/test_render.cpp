@@ -1235,7 +1235,7 @@ TEST(Render, StretchedLutMaterials) {
   EXPECT_NE(test::error_of([&] {
               parse_scene_text(R"({"materials": {"m": {"type": "ggx", "alpha": 0.2, "stretch": [2, 1]}},
                                    "objects": [{"type": "sphere", "material": "m"}]})", "t.json", ".");
-            }).find("are for lut and closures materials"), std::string::npos);
+            }).find("are for lut, closures and material materials"), std::string::npos);
 }
 
 // A constant environment is lit by the BRDF sample alone, a map by a light sample and a BRDF sample

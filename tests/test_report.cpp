@@ -41,6 +41,23 @@ TEST(Report, AMaterialNameCannotWriteHtml) {
   const std::string html = test::read_bytes(dir.file("out/index.html"));
   EXPECT_EQ(html.find("onerror='"), std::string::npos);
   EXPECT_NE(html.find("x&#39; onerror=&#39;alert(1)"), std::string::npos);
+  EXPECT_NE(html.find("src='images/x%27%20onerror%3D%27alert%281%29/measured.png'"), std::string::npos);
+}
+
+// A name with '#' and '%' links to its own folder: the links are URL-encoded (issue 61).
+TEST(Report, ImageLinksAreUrlEncoded) {
+  TempDir dir;
+  const std::string name = "paint #5 100%";
+  HalfDiffTable::tabulate(LambertBrdf(Rgb(0.5))).write(dir.file(name + ".binary"));
+  ReportOptions o = small(dir.file("out"));
+  o.inputs = {dir.file(name + ".binary")};
+  ASSERT_EQ(run_report(o)["materials"].size(), 1u);
+  const std::string html = test::read_bytes(dir.file("out/index.html"));
+  const std::string link = "images/paint%20%235%20100%25/";
+  for (const char* file : {"measured.png", "ggx.png", "lobes_30.svg"}) {
+    EXPECT_NE(html.find("'" + link + file + "'"), std::string::npos) << file;
+    EXPECT_TRUE(std::filesystem::exists(dir.path() / "out" / "images" / name / file)) << file;
+  }
 }
 
 // Two inputs of one stem: the second is a failure naming the first, not a second row over its images and

@@ -1,6 +1,7 @@
 #include "report/report.h"
 
 #include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -102,6 +103,24 @@ void summarize(json& report) {
   report["worst"] = json::array();
   for (std::size_t k = 0; k < std::min<std::size_t>(5, worst.size()); ++k)
     report["worst"].push_back({{"name", std::get<1>(worst[k])}, {"delta_e", std::get<0>(worst[k])}, {"representation", std::get<2>(worst[k])}});
+}
+
+// A path segment as a URL: every byte but unreserved ones (RFC 3986) percent-encoded, so '#', '%', '?' or a
+// space in a material's name still links to its folder. Safe inside a quoted attribute as it is.
+std::string url_segment(const std::string& s) {
+  static const char* hex = "0123456789ABCDEF";
+  std::string out;
+  for (const char ch : s) {
+    const auto c = static_cast<unsigned char>(ch);
+    if (std::isalnum(c) || c == '-' || c == '_' || c == '.' || c == '~') {
+      out += ch;
+    } else {
+      out += '%';
+      out += hex[c >> 4];
+      out += hex[c & 15];
+    }
+  }
+  return out;
 }
 
 std::string html_escape(const std::string& s) {
@@ -233,22 +252,21 @@ std::string report_html(const json& report) {
   for (const std::string& r : report_representations()) h << "<th>" << r << "</th>";
   h << "</tr>";
   for (const json& m : report["materials"]) {
-    const std::string name = html_escape(m["name"].get<std::string>());
+    const std::string name = html_escape(m["name"].get<std::string>()), folder = "images/" + url_segment(m["name"].get<std::string>());
     h << "<tr><td>" << name << "</td><td>" << html_escape(m.value("representation", std::string("-"))) << "</td><td>"
-      << two_decimals(m["seconds"]["bake"].get<double>()) << "</td><td><img src='images/" << name << "/measured.png'></td>";
+      << two_decimals(m["seconds"]["bake"].get<double>()) << "</td><td><img src='" << folder << "/measured.png'></td>";
     for (const std::string& r : report_representations())
-      h << "<td>" << (m["delta_e"].contains(r) ? two_decimals(m["delta_e"][r].get<double>()) : std::string("-")) << "<img src='images/"
-        << name << "/" << r << ".png'><img src='images/" << name << "/" << r << "_delta_e.png'></td>";
+      h << "<td>" << (m["delta_e"].contains(r) ? two_decimals(m["delta_e"][r].get<double>()) : std::string("-")) << "<img src='"
+        << folder << "/" << r << ".png'><img src='" << folder << "/" << r << "_delta_e.png'></td>";
     h << "</tr>";
   }
   h << "</table>";
   // Per material: the BRDF in the plane of incidence (measured solid, fits dashed), NDF, Fresnel.
   h << "<h2>Lobes, NDF and Fresnel</h2>";
   for (const json& m : report["materials"]) {
-    const std::string name = html_escape(m["name"].get<std::string>());
-    h << "<h3>" << name << "</h3><p>";
+    h << "<h3>" << html_escape(m["name"].get<std::string>()) << "</h3><p>";
     for (const char* f : {"lobes_0", "lobes_30", "lobes_60", "ndf", "fresnel"})
-      h << "<img style='width:360px;image-rendering:auto' src='images/" << name << "/" << f << ".svg'>";
+      h << "<img style='width:360px;image-rendering:auto' src='images/" << url_segment(m["name"].get<std::string>()) << "/" << f << ".svg'>";
     h << "</p>";
   }
   // Implausible measurements and fits (fit/plausibility.h), per material.
