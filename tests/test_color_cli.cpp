@@ -1,5 +1,6 @@
 // facetfit deltae and facetfit diff as users run them.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <OpenImageIO/imageio.h>
 
@@ -478,11 +479,41 @@ TEST(WorkingSpace, BadConfigsAndSpacesAreOneLineErrors) {
   EXPECT_NE(unknown.err.find("the config has no colour space 'Nowhere'"), std::string::npos) << unknown.err;
   const RunResult log = facetfit("render --working-space ACEScct --ocio-config " + config + out);
   EXPECT_NE(log.err.find("'ACEScct' is not linear"), std::string::npos) << log.err;
-  for (const RunResult* r : {&unknown, &log}) {
+  const RunResult raw = facetfit("render --working-space Raw --ocio-config " + config + out);  // identity, but data
+  EXPECT_NE(raw.err.find("colour space 'Raw' is data, not colour"), std::string::npos) << raw.err;
+  for (const RunResult* r : {&unknown, &log, &raw}) {
     EXPECT_EQ(r->status, 1);
     EXPECT_EQ(std::count(r->err.begin(), r->err.end(), '\n'), 1) << r->err;
   }
   EXPECT_FALSE(std::filesystem::exists(dir.file("x.exr")));
+}
+
+// A config whose FileTransform reads a device or a FIFO is refused when it is loaded, by name: OCIO would
+// read /dev/zero until memory ran out, and wait on a FIFO for ever (issue 61). The control: the same config
+// reading a regular (empty) file loads, and a render through it runs.
+TEST(WorkingSpace, AConfigReadingADeviceOrAFifoIsRefused) {
+  TempDir dir;
+  ASSERT_EQ(::mkfifo(dir.file("fifo.cube").c_str(), 0600), 0);
+  test::write_bytes(dir.file("empty.spi1d"), "");
+  const auto config = [&](const std::string& src) {
+    const std::string path = dir.file("c.ocio");
+    test::write_bytes(path, "ocio_profile_version: 2.1\nsearch_path: .\nroles:\n  default: lin_rec709\n  scene_linear: lin_rec709\n"
+                            "file_rules:\n  - !<Rule> {name: Default, colorspace: default}\n"
+                            "displays:\n  sRGB:\n    - !<View> {name: Raw, colorspace: lin_rec709}\n"
+                            "colorspaces:\n  - !<ColorSpace>\n    name: lin_rec709\n"
+                            "  - !<ColorSpace>\n    name: looked\n    from_scene_reference: !<FileTransform> {src: " + src + "}\n");
+    return path;
+  };
+  const std::string out = " -o " + dir.file("x.exr") + " --spp 1 --width 8 --height 8";
+  for (const std::string& src : {std::string("/dev/zero"), dir.file("fifo.cube")}) {
+    const RunResult r = facetfit("render --ocio-config " + config(src) + out);
+    EXPECT_EQ(r.status, 1) << src;
+    EXPECT_NE(r.err.find("c.ocio: a FileTransform reads " + src + ", which is not a regular file"), std::string::npos) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir.file("x.exr")));
+  const RunResult control = facetfit("render --ocio-config " + config(dir.file("empty.spi1d")) + out);
+  EXPECT_EQ(control.status, 0) << control.err;
 }
 
 }  // namespace

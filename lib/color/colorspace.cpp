@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <cstdint>
 #include <filesystem>
 
 #include <glm/matrix.hpp>
@@ -10,6 +11,60 @@
 #include "core/error.h"
 
 namespace facetfit {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+// What a config's transforms may read: regular files up to this size (a 65^3 cube LUT as text is ~10 MB).
+constexpr std::uintmax_t kMaxTransformFileBytes = 256ull << 20;
+
+// Every file a transform (its groups' members included) reads, resolved as OCIO resolves it, is a regular
+// file within kMaxTransformFileBytes: OCIO reads a FileTransform's src whole when it builds a processor, so
+// a device (/dev/zero: gigabytes), a FIFO (a hang) or a huge file is refused before that, by name.
+void check_transform_files(const std::string& path, const OCIO::Config& config, const OCIO::ConstTransformRcPtr& t) {
+  if (!t) return;
+  if (const auto group = OCIO::DynamicPtrCast<const OCIO::GroupTransform>(t)) {
+    for (int k = 0; k < group->getNumTransforms(); ++k) check_transform_files(path, config, group->getTransform(k));
+    return;
+  }
+  const auto file = OCIO::DynamicPtrCast<const OCIO::FileTransform>(t);
+  if (!file || !file->getSrc()) return;
+  std::string resolved;
+  try {
+    resolved = config.getCurrentContext()->resolveFileLocation(file->getSrc());
+  } catch (const OCIO::Exception&) {
+    return;  // not found: OCIO says so by name when the transform is used
+  }
+  std::error_code ec;
+  if (!fs::is_regular_file(resolved, ec))
+    fail(path, "a FileTransform reads " + excerpt(resolved, 120) + ", which is not a regular file (a device, FIFO or folder)");
+  const std::uintmax_t size = fs::file_size(resolved, ec);
+  if (ec || size > kMaxTransformFileBytes)
+    fail(path, "a FileTransform reads " + excerpt(resolved, 120) + " of " + std::to_string(size) + " bytes: at most " +
+                   std::to_string(kMaxTransformFileBytes));
+}
+
+// check_transform_files over every transform the config holds: colour spaces, looks, view and named transforms.
+void check_config_files(const std::string& path, const OCIO::Config& config) {
+  const auto check = [&](const OCIO::ConstTransformRcPtr& t) { check_transform_files(path, config, t); };
+  for (int k = 0; k < config.getNumColorSpaces(OCIO::SEARCH_REFERENCE_SPACE_ALL, OCIO::COLORSPACE_ALL); ++k) {
+    const auto space = config.getColorSpace(config.getColorSpaceNameByIndex(OCIO::SEARCH_REFERENCE_SPACE_ALL, OCIO::COLORSPACE_ALL, k));
+    if (!space) continue;
+    check(space->getTransform(OCIO::COLORSPACE_DIR_TO_REFERENCE));
+    check(space->getTransform(OCIO::COLORSPACE_DIR_FROM_REFERENCE));
+  }
+  for (int k = 0; k < config.getNumLooks(); ++k)
+    if (const auto look = config.getLook(config.getLookNameByIndex(k))) check(look->getTransform()), check(look->getInverseTransform());
+  for (int k = 0; k < config.getNumViewTransforms(); ++k)
+    if (const auto view = config.getViewTransform(config.getViewTransformNameByIndex(k)))
+      check(view->getTransform(OCIO::VIEWTRANSFORM_DIR_TO_REFERENCE)), check(view->getTransform(OCIO::VIEWTRANSFORM_DIR_FROM_REFERENCE));
+  for (int k = 0; k < config.getNumNamedTransforms(OCIO::NAMEDTRANSFORM_ALL); ++k)
+    if (const auto named = config.getNamedTransform(config.getNamedTransformNameByIndex(OCIO::NAMEDTRANSFORM_ALL, k)))
+      check(named->getTransform(OCIO::TRANSFORM_DIR_FORWARD)), check(named->getTransform(OCIO::TRANSFORM_DIR_INVERSE));
+}
+
+}  // namespace
 
 ColorConfig::ColorConfig(const std::string& path) {
   path_ = path;
@@ -23,6 +78,7 @@ ColorConfig::ColorConfig(const std::string& path) {
     auto opaque = std::make_shared<Opaque>();
     opaque->config = OCIO::Config::CreateFromFile(path_.c_str());
     opaque->config->validate();
+    check_config_files(path_, *opaque->config);
     config_ = std::move(opaque);
   } catch (const OCIO::Exception& e) {
     fail(path_, std::string("not a valid OpenColorIO config: ") + excerpt(e.what(), 200));
@@ -37,6 +93,8 @@ ColorMatrix ColorConfig::from_rec709(const std::string& space) const {
   const OCIO::ConstConfigRcPtr& config = config_->config;
   for (const std::string& name : {std::string(kRec709Space), space})
     if (!config->getColorSpace(name.c_str())) fail(path_, "the config has no colour space '" + excerpt(name, 80) + "'");
+  if (config->getColorSpace(space.c_str())->isData())
+    fail(path_, "colour space '" + excerpt(space, 80) + "' is data, not colour (a working space must be an RGB colour space)");
   ColorMatrix m(0.0);
   try {
     const auto cpu = config->getProcessor(kRec709Space, space.c_str())->getDefaultCPUProcessor();
