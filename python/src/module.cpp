@@ -280,8 +280,19 @@ py::array_t<double> over_theta(const py::handle& theta, const std::function<doub
   const Array t = Array::ensure(theta);
   if (!t) throw py::value_error("theta: must be an array of angles in radians");
   py::array_t<double> out(std::vector<py::ssize_t>(t.shape(), t.shape() + t.ndim()));
-  for (py::ssize_t k = 0; k < t.size(); ++k) out.mutable_data()[k] = per_theta(t.data()[k]);
+  for (py::ssize_t k = 0; k < t.size(); ++k) {
+    const double x = t.data()[k];
+    if (!(x >= 0.0 && x <= 0.5 * kPi))  // a polar angle of the upper hemisphere; NaN is not one
+      throw py::value_error("theta: angles must be in [0, pi/2] radians; element " + std::to_string(k) + " is " + std::to_string(x));
+    out.mutable_data()[k] = per_theta(x);
+  }
   return out;
+}
+
+// The recommendation's tolerance, as `--tolerance` takes it (bin/app.cpp): finite, in [0, 1e30].
+double checked_tolerance(double tolerance) {
+  if (!(tolerance >= 0.0 && tolerance <= 1e30)) throw py::value_error("tolerance: must be a finite number in [0, 1e30], not " + std::to_string(tolerance));
+  return tolerance;
 }
 
 }  // namespace
@@ -371,6 +382,7 @@ PYBIND11_MODULE(_facetfit, m) {
           "recommended",
           [](const Fit& f, double tolerance) {
             if (!f.result.ok()) throw Error(f.source + ": " + f.result.problem);
+            checked_tolerance(tolerance);
             return to_python(recommended_json(parameters_of(f.result, recommend(f.result, tolerance)), tolerance));
           },
           py::arg("tolerance") = kDefaultTolerance,
@@ -399,7 +411,7 @@ PYBIND11_MODULE(_facetfit, m) {
             if (!f.result.ok()) throw Error(f.source + ": " + f.result.problem);
             const std::string path = fs_path(path_arg);
             py::gil_scoped_release release;
-            write_lut(path, make_lut(f.result, f.fitter->quadrature(), f.source, source_sha256(f.source), tolerance, sampling));
+            write_lut(path, make_lut(f.result, f.fitter->quadrature(), f.source, source_sha256(f.source), checked_tolerance(tolerance), sampling));
           },
           py::arg("path"), py::arg("tolerance") = kDefaultTolerance, py::arg("sampling") = true, "Bakes the LUT texture (docs/lut-format.md).")
       .def("__repr__", [](const Fit& f) {
@@ -471,7 +483,7 @@ PYBIND11_MODULE(_facetfit, m) {
         o.colorspace = working_space;
         o.from_rec709 = ColorConfig(ocio_config).from_rec709(working_space);
         o.force = force;
-        o.tolerance = tolerance;
+        o.tolerance = checked_tolerance(tolerance);
         o.with_sampling = sampling;
         prepare_output_folder(out_dir);  // as the command does
         const std::vector<std::string> sources = expand_inputs({source});

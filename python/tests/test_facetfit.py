@@ -369,3 +369,21 @@ def test_the_package_ships_the_shaders_of_its_lut_format(tmp_path):
     f = facetfit.fit("builtin:gold-ggx-0.15")
     f.write_lut(tmp_path / "gold.exr")
     assert 1 <= facetfit.read_lut(tmp_path / "gold.exr").format_version <= facetfit.lut_format_version
+
+
+def test_bad_angles_and_tolerances_raise_value_errors(tmp_path, gold_fit):
+    # An angle outside the hemisphere or NaN, and a tolerance a LUT cannot store, are the caller's mistakes:
+    # ValueError at once, never a value (D(nan) read as D(0)) or a LUT its reader refuses.
+    for theta in (np.nan, -1.0, 2.0, [0.1, np.nan]):
+        for curve in (gold_fit.D, gold_fit.slope_pdf):
+            with pytest.raises(ValueError, match="theta"):
+                curve(theta)
+    assert np.isfinite(gold_fit.D([0.0, math.pi / 2])).all()
+    for tolerance in (np.nan, -0.1, np.inf):
+        with pytest.raises(ValueError, match="tolerance"):
+            gold_fit.recommended(tolerance=tolerance)
+        with pytest.raises(ValueError, match="tolerance"):
+            gold_fit.write_lut(tmp_path / "g.exr", tolerance=tolerance)
+        with pytest.raises(ValueError, match="tolerance"):
+            facetfit.bake(GOLD, tmp_path / "out", tolerance=tolerance)
+    assert not (tmp_path / "g.exr").exists()
