@@ -485,11 +485,18 @@ int facetfit_sample(FacetfitLut lut, vector o, float u1_in, float u2, output vec
   return pdf > 0.0;
 }
 
-// The local frame of a shading point: z = N, x = T (any tangent for isotropic materials).
+// The local frame of a shading point: z = N, x = T, where no tangent is given: core/frame.h's Frame(n)
+// (Duff et al. 2017's branchless basis), computed on the normal written in facetfit's y-up world, so that a
+// stretched or anisotropic lobe without a tangent lies as in facetfit's renderer. The shader's world is
+// taken z-up (Blender's: its (x, y, z) is facetfit's (x, z, -y)); in a y-up renderer pass `tangent`.
 void facetfit_frame(normal Nn, output vector T, output vector B) {
-  vector a = abs(Nn[0]) > 0.9 ? vector(0, 1, 0) : vector(1, 0, 0);
-  T = normalize(cross(a, Nn));
-  B = cross(Nn, T);
+  vector n = vector(Nn[0], Nn[2], -Nn[1]);  // facetfit's world
+  float sign = n[2] >= 0.0 ? 1.0 : -1.0;  // copysign(1, n.z), as std::copysign (-0 aside)
+  float a = -1.0 / (sign + n[2]), c = n[0] * n[1] * a;
+  vector t = vector(1.0 + sign * n[0] * n[0] * a, sign * c, -sign * n[0]);
+  vector b = vector(c, sign + n[1] * n[1] * a, -n[1]);
+  T = vector(t[0], -t[2], t[1]);  // back to the shader's world
+  B = vector(b[0], -b[2], b[1]);
 }
 
 // The local frame with x along the surface projection of `along` (world space; an anisotropic or
