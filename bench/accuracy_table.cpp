@@ -195,8 +195,9 @@ void anisotropic_lobe_section(std::ostringstream& md, const std::string& scratch
 
 void resolution_section(std::ostringstream& md) {
   md << "## Run time against error: grid resolution\n\n"
-        "GGX, height-correlated, gold Fresnel. Fit time is extraction + Fresnel pass + both alphas on a "
-        "loaded table, median of 9 runs on this machine (2 cores); the quadrature of each resolution is "
+        "GGX, height-correlated, gold Fresnel. Fit time is the paper's fit (extraction + Fresnel pass + both "
+        "alphas) and the distances of its representations from the measurement (bins and directional albedo, "
+        "fit/measurement.h: most of the time) on a loaded table, median of 9 runs on this machine (2 cores); the quadrature of each resolution is "
         "built once per batch and not counted (see docs/benchmarks.md).\n\n"
         "| resolution | alpha 0.02: alpha error | D error | alpha 0.7: alpha error | D error | fit ms |\n"
         "|---|---|---|---|---|---|\n";
