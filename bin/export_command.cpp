@@ -1,6 +1,6 @@
-// facetfit export LUT... -o DIR: each LUT's closure representation as a MaterialX document, DIR/NAME.mtlx
-// (lib/lut/materialx.h). A batch goes on past a LUT it cannot read or whose name another took; the exit
-// status is 1 if any failed.
+// facetfit export LUT... -o DIR: each LUT's production closures as a MaterialX document, DIR/NAME.mtlx, and
+// with --usd a UsdShade material referencing it, DIR/NAME.usda (lib/lut/materialx.h). A batch goes on past a
+// LUT it cannot read or whose name another took; the exit status is 1 if any failed.
 #include <cstdio>
 #include <filesystem>
 #include <map>
@@ -16,7 +16,7 @@ namespace facetfit::cli {
 void add_export_command(CLI::App& app, Context& ctx) {
   auto luts = std::make_shared<std::vector<std::string>>();
   auto out_dir = std::make_shared<std::string>();
-  auto color82 = std::make_shared<bool>(false);
+  auto color82 = std::make_shared<bool>(false), usd = std::make_shared<bool>(false);
   CLI::App* cmd = app.add_subcommand("export", "Write each LUT's closures as a MaterialX document (pbrlib nodes), OUT/NAME.mtlx");
   cmd->add_option("luts", *luts, "LUT files (.exr, from bake)")->required();
   cmd->add_option("-o,--output", *out_dir, "Output folder (created if missing)")->required();
@@ -24,7 +24,9 @@ void add_export_command(CLI::App& app, Context& ctx) {
                 "Write F82-tint lobes exactly (color82), for a MaterialX implementation that honours it; by default "
                 "each is the nearest generalized Schlick lobe, which every implementation renders alike (a LUT "
                 "baked with --closure-fresnel schlick has no F82-tint lobe: its document is exact everywhere)");
-  cmd->callback([luts, out_dir, color82, &ctx] {
+  cmd->add_flag("--usd", *usd,
+                "Also write OUT/NAME.usda: a UsdShade material referencing NAME.mtlx, with a UsdPreviewSurface fallback");
+  cmd->callback([luts, out_dir, color82, usd, &ctx] {
     namespace fs = std::filesystem;
     std::error_code ec;
     fs::create_directories(*out_dir, ec);
@@ -46,8 +48,13 @@ void add_export_command(CLI::App& app, Context& ctx) {
           fail(path, "its MaterialX name " + name + " is " + first->second.string() + "'s in this export: rename one of the two");
         if (!fresh) continue;  // the same LUT given twice
         const std::string target = (fs::path(*out_dir) / (name + ".mtlx")).string();
-        write_file_atomic(target, materialx_document(name, read_lut(path), *color82));
+        const Lut lut = read_lut(path);
+        write_file_atomic(target, materialx_document(name, lut, *color82));
         if (!ctx.quiet()) std::printf("%s\n", target.c_str());
+        if (!*usd) continue;
+        const std::string usda = (fs::path(*out_dir) / (name + ".usda")).string();
+        write_file_atomic(usda, usd_document(name, "./" + name + ".mtlx", lut));
+        if (!ctx.quiet()) std::printf("%s\n", usda.c_str());
       } catch (const Error& e) {
         report_error(e.what());
         ctx.status = 1;

@@ -5,8 +5,8 @@
 set -euo pipefail
 here="$(cd "$(dirname "$0")" && pwd)"
 venv=${1:-build/py-venv}
-python=$("$here/setup-venv.sh" "$venv" "scikit_build_core, pybind11, numpy, pytest, matplotlib, MaterialX, hypothesis, PyOpenColorIO, h5py" \
-  "scikit-build-core>=0.10" "pybind11>=2.12" "numpy" "pytest" "matplotlib" "materialx" "hypothesis" "opencolorio" "h5py")
+python=$("$here/setup-venv.sh" "$venv" "scikit_build_core, pybind11, numpy, pytest, matplotlib, MaterialX, hypothesis, PyOpenColorIO, h5py, pxr.UsdValidation" \
+  "scikit-build-core>=0.10" "pybind11>=2.12" "numpy" "pytest" "matplotlib" "materialx" "hypothesis" "opencolorio" "h5py" "usd-core")
 # No build isolation: the build tools are the venv's, so nothing is fetched again on each run.
 "$python" -m pip install --quiet --no-build-isolation "$here/.."
 echo "$python"

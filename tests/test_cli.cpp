@@ -177,11 +177,11 @@ TEST(Cli, ExportWritesMaterialXDocumentsThatValidate) {
   test::write_bytes(dir.file("luts/broken.exr"), "not a LUT");
   const std::string luts = dir.file("luts/gold-ggx-0.15.exr") + " " + dir.file("luts/broken.exr") + " " + dir.file("luts/blue-clearcoat-paint.exr") +
                            " " + dir.file("luts/red-plastic.exr") + " " + dir.file("luts/aniso.exr");
-  const RunResult r = facetfit("export " + luts + " -o " + dir.file("mtlx/out"));
+  const RunResult r = facetfit("export --usd " + luts + " -o " + dir.file("mtlx/out"));
   EXPECT_EQ(r.status, 1);
   EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
   EXPECT_NE(r.err.find("broken.exr"), std::string::npos) << r.err;
-  std::string documents;
+  std::string documents, stages;
   for (const char* name : {"gold_ggx_0_15", "blue_clearcoat_paint", "red_plastic", "aniso"}) {
     const std::string path = dir.file(std::string("mtlx/out/") + name + ".mtlx");
     ASSERT_TRUE(std::filesystem::exists(path)) << path;
@@ -190,7 +190,9 @@ TEST(Cli, ExportWritesMaterialXDocumentsThatValidate) {
     EXPECT_NE(text.find("<surfacematerial name=\"" + std::string(name) + "\""), std::string::npos) << text;
     EXPECT_NE(text.find("generalized_schlick_bsdf"), std::string::npos);
     documents += " " + path;
+    stages += " " + dir.file(std::string("mtlx/out/") + name + ".usda");
   }
+  EXPECT_FALSE(std::filesystem::exists(dir.file("mtlx/out/broken.usda")));
   std::ifstream aniso(dir.file("mtlx/out/aniso.mtlx"));
   EXPECT_NE(std::string((std::istreambuf_iterator<char>(aniso)), std::istreambuf_iterator<char>()).find("rotate3d"), std::string::npos);
   const std::string python = FACETFIT_PY_PYTHON;
@@ -198,6 +200,16 @@ TEST(Cli, ExportWritesMaterialXDocumentsThatValidate) {
     GTEST_SKIP() << "no MaterialX in " << python << " (run: make python): documents written, not validated";
   const RunResult valid = run_command("'" + python + "' " + std::string(FACETFIT_SOURCE_DIR) + "/tests/materialx/validate.py" + documents);
   EXPECT_EQ(valid.status, 0) << valid.out << valid.err;
+  // The USD stages (export --usd) through usd-core: open, bind, reference resolved, validators.
+  if (run_command("'" + python + "' -c 'import pxr.UsdValidation' 2>/dev/null").status != 0)
+    GTEST_SKIP() << "no usd-core in " << python << " (run: make python): USD files written, not validated";
+  const std::string usd_check = "'" + python + "' " + std::string(FACETFIT_SOURCE_DIR) + "/tests/usd/validate.py";
+  const RunResult usd = run_command(usd_check + stages + " 2>&1");
+  EXPECT_EQ(usd.status, 0) << usd.out << usd.err;
+  std::cout << usd.out;
+  // The control: a stage whose MaterialX document is gone fails.
+  std::filesystem::remove(dir.file("mtlx/out/red_plastic.mtlx"));
+  EXPECT_NE(run_command(usd_check + " " + dir.file("mtlx/out/red_plastic.usda") + " 2>&1").status, 0);
 }
 
 // Names that clean to one MaterialX name (a/x and b/x; a-b and "a b"): the first is written, the second

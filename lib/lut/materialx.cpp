@@ -1,7 +1,9 @@
 #include "lut/materialx.h"
 
+#include <algorithm>
 #include <array>
 #include <cctype>
+#include <cmath>
 #include <cstdio>
 #include <sstream>
 #include <vector>
@@ -106,6 +108,35 @@ std::string materialx_colorspace(const std::string& space) {
   for (const char* standard : kStandard)
     if (key(standard) == key(space)) return standard;
   return space;  // another (the studio config's name): kept as the LUT names it
+}
+
+std::string usd_document(const std::string& name, const std::string& mtlx_file, const Lut& lut) {
+  const Closures c = lut.production_closures();
+  Rgb specular(0.0);
+  for (const ClosureLobe& l : c.lobes) specular += l.weight * l.fresnel_at(1.0);
+  specular = glm::clamp(specular, Rgb(0.0), Rgb(1.0));
+  const ClosureLobe& first = c.lobes.front();
+  const double roughness = std::sqrt(std::sqrt(first.alpha_x * first.alpha_y));
+  const std::string space = materialx_colorspace(lut.meta.colorspace);
+  const auto colour = [&](const Rgb& v) {
+    std::ostringstream s;
+    s << "(" << float(v.r) << ", " << float(v.g) << ", " << float(v.b) << ") (\n            colorSpace = \"" << space << "\"\n        )";
+    return s.str();
+  };
+  std::ostringstream out;
+  out << "#usda 1.0\n(\n    defaultPrim = \"" << name << "\"\n    metersPerUnit = 1\n    upAxis = \"Y\"\n)\n\n"
+      << "def Material \"" << name << "\" (\n    prepend references = @" << mtlx_file << "@</MaterialX/Materials/" << name << ">\n)\n{\n"
+      << "    token outputs:surface.connect = </" << name << "/PreviewSurface.outputs:surface>\n\n"
+      << "    def Shader \"PreviewSurface\"\n    {\n"
+      << "        uniform token info:id = \"UsdPreviewSurface\"\n"
+      << "        color3f inputs:diffuseColor = " << colour(glm::clamp(c.body, Rgb(0.0), Rgb(1.0))) << "\n"
+      << "        color3f inputs:specularColor = " << colour(specular) << "\n"
+      << "        float inputs:roughness = " << float(std::min(roughness, 1.0)) << "\n"
+      << "        int inputs:useSpecularWorkflow = 1\n"
+      << "        float inputs:clearcoat = " << (c.coat.present() ? 1 : 0) << "\n"
+      << "        float inputs:clearcoatRoughness = " << float(std::min(std::sqrt(c.coat.alpha), 1.0)) << "\n"
+      << "        token outputs:surface\n    }\n}\n";
+  return out.str();
 }
 
 std::string materialx_name(const std::string& stem) {

@@ -27,6 +27,14 @@ std::string materialx_document(const std::string& name, const Lut& lut, bool col
 // `stem` as a MaterialX element name: other characters become underscores, a leading digit gets one before it.
 std::string materialx_name(const std::string& stem);
 
+// A UsdShade material (USD ASCII) named `name` that references the MaterialX document `mtlx_file` (a path
+// relative to the USD file) at </MaterialX/Materials/NAME>, where USD's MaterialX file format (usdMtlx) puts
+// its material, and carries a UsdPreviewSurface fallback for renderers without MaterialX: the production
+// closures' body as diffuse colour, their lobes' summed F(0) as specular colour (specular workflow), the
+// first lobe's roughness (sqrt of its alpha: the preview surface squares it) and the coat. Colours carry
+// the LUT's working space as their colorSpace (materialx_colorspace).
+std::string usd_document(const std::string& name, const std::string& mtlx_file, const Lut& lut);
+
 // A working space's name as a MaterialX document names it: MaterialX's standard name where the space is one of
 // them (matched without case and punctuation: "ACEScg" is "acescg"), else as given.
 std::string materialx_colorspace(const std::string& space);

@@ -458,6 +458,15 @@ PYBIND11_MODULE(_facetfit, m) {
           "The closures as a MaterialX document's text (as `facetfit export` writes it, `color82` as its --color82; the "
           "name made a valid MaterialX name).")
       .def(
+          "usd",
+          [](const Lut& l, const std::string& name) {
+            const std::string n = materialx_name(name);
+            return usd_document(n, "./" + n + ".mtlx", l);
+          },
+          py::arg("name"),
+          "The UsdShade material `facetfit export --usd` writes (USD ASCII): it references ./NAME.mtlx (write materialx(name) "
+          "there) and carries a UsdPreviewSurface fallback.")
+      .def(
           "parametric",
           [](const Lut& l, const std::string& family) {
             if (!l.meta.fit(family)) throw py::value_error("family: must be ggx, beckmann or lsq, not '" + family + "'");

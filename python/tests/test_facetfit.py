@@ -387,3 +387,15 @@ def test_bad_angles_and_tolerances_raise_value_errors(tmp_path, gold_fit):
         with pytest.raises(ValueError, match="tolerance"):
             facetfit.bake(GOLD, tmp_path / "out", tolerance=tolerance)
     assert not (tmp_path / "g.exr").exists()
+
+
+def test_usd_is_what_export_writes(tmp_path):
+    # Lut.usd is the command's NAME.usda; Lut.materialx its NAME.mtlx.
+    facetfit.bake("builtin:red-plastic", str(tmp_path / "luts"), refine="none")
+    lut_path = tmp_path / "luts" / "red-plastic.exr"
+    lut = facetfit.read_lut(lut_path)
+    command = os.path.join(os.path.dirname(sys.executable), "facetfit")
+    subprocess.run([command, "export", "--usd", str(lut_path), "-o", str(tmp_path / "out")], check=True, capture_output=True)
+    assert (tmp_path / "out" / "red_plastic.usda").read_text() == lut.usd("red-plastic")
+    assert (tmp_path / "out" / "red_plastic.mtlx").read_text() == lut.materialx("red-plastic")
+    assert "@./red_plastic.mtlx@</MaterialX/Materials/red_plastic>" in lut.usd("red-plastic")
