@@ -393,6 +393,15 @@ TEST(Cli, UsageErrors) {
   EXPECT_NE(unknown.err.find("no such built-in material"), std::string::npos);
 }
 
+// An output named with a '?' (OpenImageIO reads "name?query" as options) is written, not refused as a full disk.
+TEST(Cli, AQuestionMarkInAnOutputNameIsWritten) {
+  TempDir dir;
+  const RunResult r = facetfit("render -o '" + dir.file("a?b.exr") + "' --png '" + dir.file("c?d.png") + "' --spp 1 --width 8 --height 8");
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(std::filesystem::exists(dir.file("a?b.exr")));
+  EXPECT_TRUE(std::filesystem::exists(dir.file("c?d.png")));
+}
+
 TEST(Cli, ConvertIntoReadOnlyFolderFailsCleanly) {
   // Root writes through permission bits, but nobody creates files in /proc.
   TempDir dir;

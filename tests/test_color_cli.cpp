@@ -468,6 +468,9 @@ TEST(WorkingSpace, BadConfigsAndSpacesAreOneLineErrors) {
   const RunResult env = run_command("OCIO=/nonexistent.ocio " + std::string(FACETFIT_CLI) + " render" + out);
   EXPECT_EQ(env.status, 1);
   EXPECT_NE(env.err.find("/nonexistent.ocio: no such OpenColorIO config"), std::string::npos) << env.err;
+  const RunResult folder = facetfit("render --ocio-config " + dir.path().string() + out);  // a folder is not "no such config"
+  EXPECT_EQ(folder.status, 1);
+  EXPECT_NE(folder.err.find(dir.path().string() + ": is a folder, not an OpenColorIO config"), std::string::npos) << folder.err;
   const RunResult none = facetfit("render --working-space ACEScg" + out);
   EXPECT_EQ(none.status, 1);
   EXPECT_NE(none.err.find("ACEScg: a colour space other than lin_rec709 needs an OpenColorIO config"), std::string::npos) << none.err;

@@ -242,6 +242,9 @@ TEST(Lut, AWorkingSpaceWithoutAUsableMatrixIsRefused) {
         << (bad ? bad : "(absent)") << ": " << e;
     EXPECT_EQ(e.find('\n'), std::string::npos) << e;
   }
+  // Invertible but not between RGB spaces: -I takes white to a negative colour (issue 61: negative pixels).
+  EXPECT_NE(error_of([&] { read_lut(with_matrix("bad.exr", "-1 0 0 0 -1 0 0 0 -1")); }).find("takes white to a colour that is not positive"),
+            std::string::npos);
 }
 
 TEST(Lut, ToleranceChoosesTheRepresentation) {
@@ -290,6 +293,25 @@ TEST(Lut, EveryMeasurementThatFitsBakesWhatItsReaderAccepts) {
   }
   EXPECT_GE(baked, 6);
   EXPECT_TRUE(clamped_alpha) << "the GGX of alpha 10 did not clamp its moment alpha";
+}
+
+// A format version this facetfit does not read is named as such, a missing one as missing (issue 61: -1 was
+// reported as "no format_version attribute").
+TEST(Lut, AFormatVersionIsNamedAsWritten) {
+  const Baked b = fit_of(MicrofacetBrdf(Ndf::isotropic(NdfType::ggx, 0.2), Smith::correlated, Fresnel::schlick(Rgb(0.9))));
+  TempDir dir;
+  const RewritableLut original(dir.file("g.exr"), b);
+  for (const int version : {-1, 0, 99}) {
+    OIIO::ImageSpec spec = original.spec;
+    spec.attribute("facetfit:format_version", version);
+    original.write(dir.file("bad.exr"), spec);
+    EXPECT_NE(error_of([&] { read_lut(dir.file("bad.exr")); }).find("LUT format version " + std::to_string(version) + "; this facetfit reads versions 1 to"),
+              std::string::npos) << version;
+  }
+  OIIO::ImageSpec spec = original.spec;
+  spec.erase_attribute("facetfit:format_version");
+  original.write(dir.file("bad.exr"), spec);
+  EXPECT_NE(error_of([&] { read_lut(dir.file("bad.exr")); }).find("no facetfit:format_version attribute"), std::string::npos);
 }
 
 TEST(Lut, ADarkChannelOfNegativeNoiseBakesAndReadsBack) {
@@ -576,19 +598,23 @@ TEST(Lut, BadFilesGetOneClearLine) {
     const std::string e = error_of([&] { read_lut(file); });
     EXPECT_NE(e.find(falls ? "row 8, column 11: the sampling CDF falls" : "row 8: the sampling CDF must run from 0 to 1"), std::string::npos) << e;
   }
-  // A negative Fresnel reflectance (issue 47: accepted, it rendered negative pixels).
-  {
-    auto in = OIIO::ImageInput::open(dir.file("good.exr"));
-    OIIO::ImageSpec spec = in->spec();
-    std::vector<float> px(std::size_t(spec.width) * std::size_t(spec.height) * std::size_t(spec.nchannels));
-    ASSERT_TRUE(in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, px.data()));
-    px[(std::size_t(LutLayout::kFresnelRow) * std::size_t(spec.width) + 7) * std::size_t(spec.nchannels) + 1] = -0.25f;
-    auto out = OIIO::ImageOutput::create(dir.file("negative-fresnel.exr"));
-    ASSERT_TRUE(out->open(dir.file("negative-fresnel.exr"), spec) && out->write_image(OIIO::TypeDesc::FLOAT, px.data()) && out->close());
+  // A negative Fresnel reflectance (issue 47: accepted, it rendered negative pixels), and one of 3e38 (issue 61:
+  // pixels of 2.5e38).
+  for (const float bad : {-0.25f, 3e38f}) {
+    {
+      auto in = OIIO::ImageInput::open(dir.file("good.exr"));
+      OIIO::ImageSpec spec = in->spec();
+      std::vector<float> px(std::size_t(spec.width) * std::size_t(spec.height) * std::size_t(spec.nchannels));
+      ASSERT_TRUE(in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, px.data()));
+      px[(std::size_t(LutLayout::kFresnelRow) * std::size_t(spec.width) + 7) * std::size_t(spec.nchannels) + 1] = bad;
+      auto out = OIIO::ImageOutput::create(dir.file("bad-fresnel.exr"));
+      ASSERT_TRUE(out->open(dir.file("bad-fresnel.exr"), spec) && out->write_image(OIIO::TypeDesc::FLOAT, px.data()) && out->close());
+    }
+    const std::string fresnel = error_of([&] { read_lut(dir.file("bad-fresnel.exr")); });
+    EXPECT_NE(fresnel.find("row " + std::to_string(LutLayout::kFresnelRow) + ", column 7: the Fresnel reflectance must be in [0, 1000]"),
+              std::string::npos)
+        << bad << ": " << fresnel;
   }
-  const std::string fresnel = error_of([&] { read_lut(dir.file("negative-fresnel.exr")); });
-  EXPECT_NE(fresnel.find("row " + std::to_string(LutLayout::kFresnelRow) + ", column 7: the Fresnel reflectance must be >= 0"), std::string::npos)
-      << fresnel;
 }
 
 }  // namespace

@@ -71,7 +71,11 @@ ColorConfig::ColorConfig(const std::string& path) {
   if (path_.empty())
     if (const char* env = std::getenv("OCIO"); env && *env) path_ = env;
   if (path_.empty()) return;
-  if (!std::filesystem::is_regular_file(path_)) fail(path_, "no such OpenColorIO config (from --ocio-config or $OCIO)");
+  std::error_code ec;
+  if (std::filesystem::is_directory(path_, ec)) fail(path_, "is a folder, not an OpenColorIO config (from --ocio-config or $OCIO)");
+  if (std::filesystem::exists(path_, ec) && !std::filesystem::is_regular_file(path_, ec))
+    fail(path_, "is not a regular file, so not an OpenColorIO config (from --ocio-config or $OCIO)");
+  if (!std::filesystem::is_regular_file(path_, ec)) fail(path_, "no such OpenColorIO config (from --ocio-config or $OCIO)");
   try {
     // Studio configs list inactive spaces they do not define; OCIO warns of each on stderr.
     OCIO::SetLoggingLevel(OCIO::LOGGING_LEVEL_NONE);

@@ -4,6 +4,7 @@
 #include <signal.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cctype>
 #include <cerrno>
 #include <cstdio>
@@ -28,7 +29,11 @@ AtomicFile::AtomicFile(std::string path) : path_(std::move(path)) {
   const unsigned tag = rd();
   char suffix[64];
   std::snprintf(suffix, sizeof suffix, ".tmp-%ld-%08x", static_cast<long>(::getpid()), tag);
-  temp_ = (dir / ("." + target.stem().string() + suffix + target.extension().string())).string();
+  // The temporary's stem without '?': OpenImageIO reads "name?query" as a file name with options and refuses
+  // it as malformed, so a target named "a?b.png" would fail its read-back check.
+  std::string stem = target.stem().string();
+  std::replace(stem.begin(), stem.end(), '?', '_');
+  temp_ = (dir / ("." + stem + suffix + target.extension().string())).string();
 }
 
 AtomicFile::~AtomicFile() {

@@ -168,12 +168,12 @@ Lut make_lut(const FitResult& fit, const Quadrature& quadrature, const std::stri
     if (l.view_aligned()) m.format_version = kLutViewLobesVersion;
   // A reader of version 5 knows no closures representation.
   if (m.representation == Representation::closures) m.format_version = kLutViewLobesVersion;
-  clamp_to_limits(m);
+  clamp_to_limits(lut);
   return lut;
 }
 
 void visit_limits(LutMetadata& m, const std::function<void(const std::string& name, double& value, double lo, double hi)>& visit) {
-  constexpr double kAlpha = 10.0, kColour = 1e3, kDistance = 1e30;
+  constexpr double kAlpha = 10.0, kColour = kLutMaxColour, kDistance = 1e30;
   const auto colour = [&](const std::string& name, Rgb& c, double hi) {
     for (int k = 0; k < 3; ++k) visit(name, c[k], 0.0, hi);  // an implausible measurement may give F > 1: kept finite
   };
@@ -224,18 +224,25 @@ void visit_limits(LutMetadata& m, const std::function<void(const std::string& na
   }
 }
 
-void clamp_to_limits(LutMetadata& m) {
+void clamp_to_limits(Lut& lut) {
+  LutMetadata& m = lut.meta;
   std::map<std::string, std::pair<double, double>> clamped;  // name -> the farthest value, its limit
-  visit_limits(m, [&](const std::string& name, double& v, double lo, double hi) {
+  const auto clamp = [&](const std::string& name, double& v, double lo, double hi) {
     if (!(v < lo || v > hi)) return;  // in range, or NaN: the reader refuses it by name, the fit never writes one
     const double limit = v < lo ? lo : hi;
     auto& [worst, at] = clamped[name];
     if (std::abs(v - limit) >= std::abs(worst - at)) worst = v, at = limit;
     v = limit;
-  });
+  };
+  visit_limits(m, [&](const std::string& name, double& v, double lo, double hi) { clamp("facetfit:" + name, v, lo, hi); });
+  // The Fresnel rows, as the reader checks them (LutPixels::reflectance).
+  for (FresnelCurve* curve : {&lut.tables.fresnel, lut.anisotropic ? &lut.anisotropic->fresnel : nullptr})
+    if (curve)
+      for (Rgb& f : curve->value)
+        for (int c = 0; c < 3; ++c) clamp("the Fresnel curve", f[c], 0.0, kLutMaxColour);
   for (const auto& [name, value] : clamped) {
     std::ostringstream s;
-    s << "facetfit:" << name << " was " << value.first << ", outside what a LUT stores: written as " << value.second;
+    s << name << " was " << value.first << ", outside what a LUT stores: written as " << value.second;
     m.warnings.push_back(s.str());
   }
 }
@@ -257,7 +264,7 @@ Lut in_colorspace(Lut lut, const std::string& space, const ColorMatrix& from_rec
     for (Rgb* c : {&lobe.f0, &lobe.f82, &lobe.f90}) convert(*c);
   m.colorspace = space;
   m.from_rec709 = from_rec709;
-  clamp_to_limits(m);  // a space narrower than Rec.709 takes some colours below 0
+  clamp_to_limits(lut);  // a space narrower than Rec.709 takes some colours below 0
   return lut;
 }
 
@@ -413,14 +420,18 @@ void read_colorspace(const std::string& path, const ImageSpec& spec, LutMetadata
   if (!from_rec709)
     fail(path, "facetfit:colorspace_matrix is missing or not nine numbers of an invertible matrix (from lin_rec709 to " +
                    excerpt(name, 40) + ")");
+  // Every RGB colour space holds white as a positive colour; a matrix that does not (-I) would render negative light.
+  const Rgb white = *from_rec709 * Rgb(1.0);
+  if (!(white.r > 0.0 && white.g > 0.0 && white.b > 0.0))
+    fail(path, "facetfit:colorspace_matrix takes white to a colour that is not positive: not a matrix between RGB spaces");
   m.colorspace = name;
   m.from_rec709 = *from_rec709;
 }
 
 // The format version, one this facetfit reads.
 int read_format_version(const std::string& path, const ImageSpec& spec) {
+  if (!spec.attributes.count(key("format_version"))) fail(path, "not a facetfit LUT (no facetfit:format_version attribute)");
   const int version = spec.get_int(key("format_version"), -1);
-  if (version < 0) fail(path, "not a facetfit LUT (no facetfit:format_version attribute)");
   if (version < 1 || version > kLutViewLobesVersion)
     fail(path, "LUT format version " + std::to_string(version) + "; this facetfit reads versions 1 to " +
                    std::to_string(kLutViewLobesVersion));
@@ -577,8 +588,9 @@ struct LutPixels {
   // A Fresnel row's reflectance: a negative one (an edited file) would render negative pixels.
   Rgb reflectance(int row, int x) const {
     const Rgb f(get(row, x, 0), get(row, x, 1), get(row, x, 2));
-    if (!(f.r >= 0.0 && f.g >= 0.0 && f.b >= 0.0))
-      fail(path, "row " + std::to_string(row) + ", column " + std::to_string(x) + ": the Fresnel reflectance must be >= 0");
+    for (int c = 0; c < 3; ++c)
+      if (!(f[c] >= 0.0 && f[c] <= kLutMaxColour))
+        fail(path, "row " + std::to_string(row) + ", column " + std::to_string(x) + ": the Fresnel reflectance must be in [0, 1000]");
     return f;
   }
 };

@@ -114,9 +114,12 @@ struct Lut {
 // Every number a LUT's metadata stores, with the range its reader accepts (a colour per channel): the one
 // table the writer clamps to and the reader checks, so that a bake never writes what its reader refuses.
 void visit_limits(LutMetadata& m, const std::function<void(const std::string& name, double& value, double lo, double hi)>& visit);
-// Clamps every number of `m` into its range, one warning line per attribute clamped (its farthest value).
-// make_lut and in_colorspace end with it.
-void clamp_to_limits(LutMetadata& m);
+// The largest colour a LUT stores (a reflectance or body, per channel): an implausible measurement may give
+// F > 1, baked with a warning; past this it is damage or an attack.
+constexpr double kLutMaxColour = 1e3;
+// Clamps every number of the metadata and the Fresnel rows into its range, one warning line per attribute
+// clamped (its farthest value). make_lut and in_colorspace end with it.
+void clamp_to_limits(Lut& lut);
 
 // Builds the LUT of a fit, its representation recommended under `tolerance` (fit/recommend.h).
 Lut make_lut(const FitResult& fit, const Quadrature& quadrature, const std::string& source, const std::string& source_sha256,
