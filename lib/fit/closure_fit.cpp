@@ -328,7 +328,10 @@ Solved solve(const MeasuredBins& bins, const AlbedoTarget* albedo, const Closure
 }
 
 // `fit` with one more GGX lobe of Fresnel `form`, `scale` times the alpha of its strongest lobe (by weight
-// times the luminance of F at 60 degrees), of its colour, taking a quarter of every lobe's weight.
+// times the luminance of F at 60 degrees), of its colour, taking a quarter of every lobe's weight. At the
+// same alpha (scale 1) a Schlick lobe's F falls to 0 at grazing: beside a rising lobe it makes a colour that
+// dips and rises again with theta_d, as a thin film's does (cc_nothern_aurora's red falls from 0.10 to 0.06 at
+// 24 degrees and rises to 0.28 at 64), which no one Schlick lobe follows.
 Closures with_lobe(const Closures& fit, ClosureLobe::Fresnel form, double scale) {
   Closures c = fit;
   const auto strength = [](const ClosureLobe& l) { return l.weight * luminance(l.fresnel_at(0.5)); };
@@ -342,10 +345,14 @@ Closures with_lobe(const Closures& fit, ClosureLobe::Fresnel form, double scale)
   if (form == ClosureLobe::Fresnel::f82_tint) {
     lobe.weight = 0.25;
     lobe.f82 = strongest.f82;
-  } else {  // a quarter of the strongest's F at normal incidence, rising as (1 - mu)^2 to a quarter of it at 82 degrees
+  } else if (scale != 1.0) {  // a quarter of the strongest's F at normal incidence, rising as (1 - mu)^2 to a quarter of it at 82 degrees
     lobe.f0 = 0.25 * strongest.fresnel_at(1.0);
     lobe.f90 = 0.25 * strongest.fresnel_at(1.0 / 7.0);
     lobe.exponent = 2.0;
+  } else {  // at the strongest's alpha, a quarter of its F at normal incidence falling to 0 at grazing
+    lobe.f0 = 0.25 * strongest.fresnel_at(1.0);
+    lobe.f90 = Rgb(0.0);
+    lobe.exponent = 1.0;
   }
   c.lobes.push_back(lobe);
   return c;
@@ -407,10 +414,11 @@ ClosureFit fit_closures(const MeasuredBins& bins, const AlbedoTarget* albedo, co
     for (ClosureLobe& l : first.lobes) l = without_f82(l);
   Solved current = solve(screen, albedo, first, options.max_iterations);
   while (int(current.closures.lobes.size()) < options.max_lobes) {
-    // A sharper and a broader generalized-Schlick lobe, solved concurrently. (On the six RGL materials the
-    // Schlick candidates were taken over F82-tint ones of the same alpha, or within 0.1% of them: their
-    // exponent bends the colour over the middle angles, where the first lobe's F82-tint is flat.)
-    constexpr std::array<double, 2> kScales{0.5, 2.0};
+    // A sharper and a broader generalized-Schlick lobe and one of the same alpha (with_lobe), solved
+    // concurrently. (On the six RGL materials the Schlick candidates were taken over F82-tint ones of the
+    // same alpha, or within 0.1% of them: their exponent bends the colour over the middle angles, where the
+    // first lobe's F82-tint is flat.)
+    constexpr std::array<double, 3> kScales{0.5, 2.0, 1.0};
     std::array<Solved, kScales.size()> tried;
     tbb::parallel_for(std::size_t(0), kScales.size(), [&](std::size_t t) {
       tried[t] = solve(screen, albedo, with_lobe(current.closures, ClosureLobe::Fresnel::schlick, kScales[t]), options.max_iterations);

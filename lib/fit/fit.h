@@ -30,8 +30,9 @@ namespace facetfit {
 // 6: the grazing pairs' soft L1 loss (fit/measurement.h); 7: the tabulated body's Minnaert exponent (model/body.h);
 // 8: the closure representation (fit/closure_fit.h); 9: the paper's representations measured too
 // (their distances choose the recommended one, fit/recommend.h); 10: closure lobes that follow the view, the
-// tabulated lobe matching the albedo, distances judged with the albedo's (fit/measurement.h judged_distance).
-constexpr int kFitRevision = 10;
+// tabulated lobe matching the albedo, distances judged with the albedo's (fit/measurement.h judged_distance);
+// 11: a closure lobe candidate at the strongest lobe's alpha with a falling Fresnel (fit/closure_fit.cpp).
+constexpr int kFitRevision = 11;
 
 // The range of FitOptions::resolution. Below 16 intervals the grid misses narrow lobes: the built-in
 // aluminium (GGX 0.05) is extracted at alpha 0.030 with 8 and with a negative E|x| with 5 or 6, and
