@@ -29,16 +29,20 @@ ReportOptions small(const std::string& out) {
   return o;
 }
 
+// The report page (DIR/out/index.html) of one Lambert material written as DIR/NAME.binary.
+std::string page_of_material_named(const TempDir& dir, const std::string& name) {
+  HalfDiffTable::tabulate(LambertBrdf(Rgb(0.5))).write(dir.file(name + ".binary"));
+  ReportOptions o = small(dir.file("out"));
+  o.inputs = {dir.file(name + ".binary")};
+  EXPECT_EQ(run_report(o)["materials"].size(), 1u);
+  return test::read_bytes(dir.file("out/index.html"));
+}
+
 // A material file named to break out of a single-quoted attribute: its name is escaped in every HTML
 // context, so the page holds no attribute the name wrote (issue 47).
 TEST(Report, AMaterialNameCannotWriteHtml) {
   TempDir dir;
-  const std::string name = "x' onerror='alert(1)";
-  HalfDiffTable::tabulate(LambertBrdf(Rgb(0.5))).write(dir.file(name + ".binary"));
-  ReportOptions o = small(dir.file("out"));
-  o.inputs = {dir.file(name + ".binary")};
-  run_report(o);
-  const std::string html = test::read_bytes(dir.file("out/index.html"));
+  const std::string html = page_of_material_named(dir, "x' onerror='alert(1)");
   EXPECT_EQ(html.find("onerror='"), std::string::npos);
   EXPECT_NE(html.find("x&#39; onerror=&#39;alert(1)"), std::string::npos);
   EXPECT_NE(html.find("src='images/x%27%20onerror%3D%27alert%281%29/measured.png'"), std::string::npos);
@@ -48,11 +52,7 @@ TEST(Report, AMaterialNameCannotWriteHtml) {
 TEST(Report, ImageLinksAreUrlEncoded) {
   TempDir dir;
   const std::string name = "paint #5 100%";
-  HalfDiffTable::tabulate(LambertBrdf(Rgb(0.5))).write(dir.file(name + ".binary"));
-  ReportOptions o = small(dir.file("out"));
-  o.inputs = {dir.file(name + ".binary")};
-  ASSERT_EQ(run_report(o)["materials"].size(), 1u);
-  const std::string html = test::read_bytes(dir.file("out/index.html"));
+  const std::string html = page_of_material_named(dir, name);
   const std::string link = "images/paint%20%235%20100%25/";
   for (const char* file : {"measured.png", "ggx.png", "lobes_30.svg"}) {
     EXPECT_NE(html.find("'" + link + file + "'"), std::string::npos) << file;

@@ -70,7 +70,7 @@ Integrator::Integrator(const SceneDesc& desc, const RenderSettings& settings)
   }
   const std::map<std::string, int> material_index = LoadMaterials(memory_left);
   LoadEnvironment(memory_left);
-  referenced_by(desc_, "a mesh object", [&] { return &tracer_.emplace(desc_); });
+  referenced_by(desc_, "a mesh object", [&] { return &tracer_.emplace(desc_, memory_left); });
   PlanObjects(material_index);
   PlanLanes();
   SetCamera();

@@ -21,8 +21,9 @@ struct RenderSettings {
   // (render/wavefront.h); false: one ray and one evaluation at a time (the same image, the reference the
   // stream path is tested against).
   bool ray_streams = true;
-  // Bytes the image buffers and the environment map may take together (core/memory_budget.h); 0: half of
-  // the machine's memory. A scene over it is refused before anything is allocated.
+  // Bytes the image buffers, textures, environment map and meshes may take together (core/memory_budget.h);
+  // 0: half of the machine's memory. A scene over it is refused before the images are allocated, a mesh as
+  // its file is read.
   std::uint64_t max_memory = 0;
   std::function<void(int done_passes, int passes)> progress;  // optional
 };
