@@ -42,13 +42,13 @@ void add_export_command(CLI::App& app, Context& ctx) {
     for (const std::string& path : *luts) {
       try {
         const std::string name = materialx_name(fs::path(path).stem().string());
-        const fs::path source = fs::weakly_canonical(path, ec);
+        const Lut lut = read_lut(path);  // a LUT that cannot be read takes no name
+        const fs::path source = fs::weakly_canonical(path);
         const auto [first, fresh] = taken.emplace(name, source);
         if (!fresh && first->second != source)
           fail(path, "its MaterialX name " + name + " is " + first->second.string() + "'s in this export: rename one of the two");
         if (!fresh) continue;  // the same LUT given twice
         const std::string target = (fs::path(*out_dir) / (name + ".mtlx")).string();
-        const Lut lut = read_lut(path);
         write_file_atomic(target, materialx_document(name, lut, *color82));
         if (!ctx.quiet()) std::printf("%s\n", target.c_str());
         if (!*usd) continue;
@@ -57,6 +57,9 @@ void add_export_command(CLI::App& app, Context& ctx) {
         if (!ctx.quiet()) std::printf("%s\n", usda.c_str());
       } catch (const Error& e) {
         report_error(e.what());
+        ctx.status = 1;
+      } catch (const fs::filesystem_error& e) {
+        report_error(path + ": " + e.code().message());
         ctx.status = 1;
       }
     }

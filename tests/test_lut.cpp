@@ -254,6 +254,11 @@ TEST(Lut, ToleranceChoosesTheRepresentation) {
   EXPECT_EQ(make_lut(two_lobes.fit, two_lobes.fitter.quadrature(), "x", "", 10.0, true).meta.representation, Representation::ggx);
   const Baked ggx = fit_of(MicrofacetBrdf(Ndf::isotropic(NdfType::ggx, 0.2), Smith::correlated, Fresnel::one()));
   EXPECT_EQ(make_lut(ggx.fit, ggx.fitter.quadrature(), "x", "", 0.02, true).meta.representation, Representation::ggx);
+  // The largest tolerance --tolerance takes, 1e30, is written as the float nearest it (just above 1e30) and read
+  // back: the reader's limits are the floats the writer stores.
+  TempDir dir;
+  write_lut(dir.file("t.exr"), make_lut(ggx.fit, ggx.fitter.quadrature(), "x", "", 1e30, true));
+  EXPECT_FLOAT_EQ(float(read_lut(dir.file("t.exr")).meta.tolerance), 1e30f);
 }
 
 TEST(Lut, EveryMeasurementThatFitsBakesWhatItsReaderAccepts) {

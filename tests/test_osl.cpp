@@ -378,7 +378,7 @@ TEST_P(OslModel, MetadataEqualsLibrary) {
   cases.second.assign(kGrid * kGrid, Vec3(0.0, 0.0, 1.0));
   const Image img = probe(5, cases);
   const int smith = table.meta.smith == Smith::masking ? 0 : (table.meta.smith == Smith::correlated ? 1 : 2);
-  const int representation = static_cast<int>(table.meta.representation);  // Representation's order is the code's
+  const int representation = representation_code(table.meta.representation);
   EXPECT_EQ(img.at(0, 0)[0], float(smith));
   EXPECT_EQ(img.at(0, 0)[1], float(representation));
   EXPECT_EQ(img.at(0, 0)[2], float(table.meta.resolution));

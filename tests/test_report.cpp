@@ -114,6 +114,9 @@ TEST(Report, ASecondReportIntoTheSameFolderIsRefused) {
     EXPECT_FALSE(std::filesystem::exists(dir.path() / "out" / "report.json"));
   }
   EXPECT_EQ(run_report(o)["materials"].size(), 1u);
+  // Its LUTs in its own images/ would wait on its own lock: refused, not a hang.
+  o.luts_dir = dir.file("out/images");
+  EXPECT_NE(test::error_of([&] { run_report(o); }).find("is the report's images folder"), std::string::npos);
 }
 
 json read_json(const std::string& path) {

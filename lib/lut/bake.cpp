@@ -124,6 +124,7 @@ BakeOutcome bake_material(const std::string& source, const std::string& name, co
     r = fit_record(source, fit, out.seconds, options.tolerance);
     r["lut"] = lut_path.filename().string();
     r["lut_sha256"] = sha256_file(lut_path.string());
+    r["warnings"] = lut.meta.warnings;  // the fit's, and what the LUT clamped to its limits (clamp_to_limits)
     r["representation"] = to_string(lut.meta.representation);
     r["ndf_error_ggx"] = lut.meta.ndf_error_ggx;
     r["ndf_error_beckmann"] = lut.meta.ndf_error_beckmann;

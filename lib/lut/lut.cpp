@@ -40,15 +40,6 @@ int smith_code(Smith s) {
   return -1;
 }
 
-int representation_code(Representation r) {
-  switch (r) {
-    case Representation::tabulated: return 0;
-    case Representation::ggx: return 1;
-    case Representation::beckmann: return 2;
-    case Representation::closures: return 3;
-  }
-  return -1;
-}
 
 // A closure lobe's family as an integer (Cycles' OSL reads no string attribute): 1 GGX, 2 Beckmann, as
 // representation_code.
@@ -111,6 +102,16 @@ void read_closures(const std::string& path, const ImageSpec& spec, LutMetadata& 
 }
 
 }  // namespace
+
+int representation_code(Representation r) {
+  switch (r) {
+    case Representation::tabulated: return 0;
+    case Representation::ggx: return 1;
+    case Representation::beckmann: return 2;
+    case Representation::closures: return 3;
+  }
+  return -1;
+}
 
 LutLayout LutLayout::of(int resolution, bool sampling, int anisotropic_resolution, int anisotropic_phi_count) {
   const int rows = kSamplingRow + (sampling ? resolution + 1 : 0);
@@ -402,7 +403,9 @@ namespace {
 // hand or damaged must not render NaN or negative light.
 void validate(const std::string& path, LutMetadata m) {
   visit_limits(m, [&](const std::string& name, double& v, double lo, double hi) {
-    if (v >= lo && v <= hi) return;
+    // Against the limits as floats, as the attributes are stored: a value the writer clamped to 1e30, 1e-4 or
+    // pi is written as the float nearest it, which lies just outside the double limit.
+    if (v >= double(float(lo)) && v <= double(float(hi))) return;
     std::ostringstream s;
     s << "facetfit:" << name;
     if (std::isnan(v)) s << " is missing or not a number";

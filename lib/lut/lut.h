@@ -21,8 +21,8 @@ namespace facetfit {
 // without the anisotropic rows; it is written only when k is not 1, so a Lambertian body's LUT stays
 // version 2 or 3 and earlier readers, which would render the body Lambertian, refuse the others.
 // Version 5 is version 4 with the closure representation (facetfit:closures_*, model/closures.h): what
-// the production shader renders. Every LUT of this facetfit is version 5; versions 1 to 4 still read,
-// without closures.
+// the production shader renders. Version 6 is 5 with closure lobes that follow the view or with `closures`
+// recommended. A bake writes 5 or 6 (a fit with closures); versions 1 to 4 still read, without closures.
 constexpr int kLutFormatVersion = 2;
 constexpr int kLutAnisotropicVersion = 3;
 constexpr int kLutBodyExponentVersion = 4;
@@ -120,6 +120,9 @@ constexpr double kLutMaxColour = 1e3;
 // Clamps every number of the metadata and the Fresnel rows into its range, one warning line per attribute
 // clamped (its farthest value). make_lut and in_colorspace end with it.
 void clamp_to_limits(Lut& lut);
+
+// facetfit:representation_code of a representation: 0 tabulated, 1 ggx, 2 beckmann, 3 closures (the shaders read it).
+int representation_code(Representation r);
 
 // Builds the LUT of a fit, its representation recommended under `tolerance` (fit/recommend.h).
 Lut make_lut(const FitResult& fit, const Quadrature& quadrature, const std::string& source, const std::string& source_sha256,

@@ -110,6 +110,46 @@ std::string materialx_colorspace(const std::string& space) {
   return space;  // another (the studio config's name): kept as the LUT names it
 }
 
+namespace {
+
+// A working space's name as USD names it (GfColorSpaceNames: lin_rec709_scene, lin_ap1_scene, ...) where it is
+// one of USD's, else MaterialX's name for it.
+std::string usd_colorspace(const std::string& space) {
+  static const std::pair<const char*, const char*> kUsd[] = {
+      {"lin_rec709", "lin_rec709_scene"}, {"acescg", "lin_ap1_scene"},       {"lin_ap1", "lin_ap1_scene"},
+      {"lin_adobergb", "lin_adobergb_scene"}, {"lin_displayp3", "lin_p3d65_scene"}};
+  const std::string mx = materialx_colorspace(space);
+  for (const auto& [materialx, usd] : kUsd)
+    if (mx == materialx) return usd;
+  return mx;
+}
+
+// `text` as an XML attribute's value: the five special characters as entities, control characters dropped.
+std::string xml_attribute(const std::string& text) {
+  std::string out;
+  for (const char c : text) {
+    if (c == '&') out += "&amp;";
+    else if (c == '<') out += "&lt;";
+    else if (c == '>') out += "&gt;";
+    else if (c == '"') out += "&quot;";
+    else if (c == '\'') out += "&apos;";
+    else if (static_cast<unsigned char>(c) >= 0x20 && c != 0x7f) out += c;
+  }
+  return out;
+}
+
+// `text` as a USD string literal's content: quotes and backslashes escaped, control characters dropped.
+std::string usd_string(const std::string& text) {
+  std::string out;
+  for (const char c : text) {
+    if (c == '"' || c == '\\') out += '\\';
+    if (static_cast<unsigned char>(c) >= 0x20 && c != 0x7f) out += c;
+  }
+  return out;
+}
+
+}  // namespace
+
 std::string usd_document(const std::string& name, const std::string& mtlx_file, const Lut& lut) {
   const Closures c = lut.production_closures();
   Rgb specular(0.0);
@@ -117,7 +157,7 @@ std::string usd_document(const std::string& name, const std::string& mtlx_file, 
   specular = glm::clamp(specular, Rgb(0.0), Rgb(1.0));
   const ClosureLobe& first = c.lobes.front();
   const double roughness = std::sqrt(std::sqrt(first.alpha_x * first.alpha_y));
-  const std::string space = materialx_colorspace(lut.meta.colorspace);
+  const std::string space = usd_string(usd_colorspace(lut.meta.colorspace));
   const auto colour = [&](const Rgb& v) {
     std::ostringstream s;
     s << "(" << float(v.r) << ", " << float(v.g) << ", " << float(v.b) << ") (\n            colorSpace = \"" << space << "\"\n        )";
@@ -180,7 +220,7 @@ std::string materialx_document(const std::string& name, const Lut& lut, bool col
   nodes.push_back({"surfacematerial", name, "material", {{"surfaceshader", "surfaceshader", "@" + name + "_surface"}}});
   std::ostringstream out;
   // The colours' space, as the LUT was baked (MaterialX's own name where the space is one of its standard ones).
-  out << "<?xml version=\"1.0\"?>\n<materialx version=\"1.39\" colorspace=\"" << materialx_colorspace(lut.meta.colorspace) << "\">\n";
+  out << "<?xml version=\"1.0\"?>\n<materialx version=\"1.39\" colorspace=\"" << xml_attribute(materialx_colorspace(lut.meta.colorspace)) << "\">\n";
   for (const Node& n : nodes) n.write(out);
   out << "</materialx>\n";
   return out.str();

@@ -1,5 +1,6 @@
-// A LUT's closure representation as a MaterialX document (MaterialX 1.39, pbrlib nodes only): what a
-// renderer that takes MaterialX or USD shades with (docs/osl.md).
+// A LUT's production closures (Lut::production_closures: what osl/facetfit_material.osl emits) as a
+// MaterialX document (MaterialX 1.39, pbrlib nodes only): what a renderer that takes MaterialX or USD shades
+// with (docs/osl.md).
 //
 // The body is `oren_nayar_diffuse_bsdf` at roughness 0 (Lambert); each lobe a `generalized_schlick_bsdf`
 // with the lobe's alphas as its roughness and its weight: a generalized Schlick lobe with color0 = f0,
@@ -32,7 +33,8 @@ std::string materialx_name(const std::string& stem);
 // its material, and carries a UsdPreviewSurface fallback for renderers without MaterialX: the production
 // closures' body as diffuse colour, their lobes' summed F(0) as specular colour (specular workflow), the
 // first lobe's roughness (sqrt of its alpha: the preview surface squares it) and the coat. Colours carry
-// the LUT's working space as their colorSpace (materialx_colorspace).
+// the LUT's working space as their colorSpace, USD's name for it where USD has one (lin_rec709_scene,
+// lin_ap1_scene for ACEScg, ...), else MaterialX's (materialx_colorspace).
 std::string usd_document(const std::string& name, const std::string& mtlx_file, const Lut& lut);
 
 // A working space's name as a MaterialX document names it: MaterialX's standard name where the space is one of

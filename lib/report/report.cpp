@@ -375,6 +375,9 @@ void judge_against_baseline(const json& previous, json& report, bool accept) {
   json base = baseline_of(previous);
   std::set<std::string> regressed, present;
   for (const json& g : report["regressions"]) regressed.insert(g["name"].get<std::string>());
+  // A material that failed this run is not removed: its baseline stays, and the failure says what happened.
+  for (const json& f : report.value("failures", json::array()))
+    if (f.contains("source")) present.insert(source_name(f["source"].get<std::string>()));
   for (const json& m : report["materials"]) {
     const std::string name = m["name"].get<std::string>();
     present.insert(name);
@@ -429,6 +432,9 @@ json run_report(const ReportOptions& o) {
   if (!fs::is_directory(o.out_dir) || !fs::is_directory(luts))
     fail(fs::is_directory(o.out_dir) ? luts.string() : o.out_dir, "cannot create folder" + (ec ? ": " + ec.message() : std::string()));
   const FolderLock lock = lock_report(o.out_dir);
+  // Each bake locks the LUTs' folder: in the report's images/ it would wait on the report's own lock.
+  if (fs::equivalent(luts, fs::path(o.out_dir) / "images", ec))
+    fail(luts.string(), "is the report's images folder: give --luts another folder");
   remove_stale_temporaries(o.out_dir);
   remove_stale_temporaries(luts.string());
   for (const auto& entry : fs::directory_iterator(fs::path(o.out_dir) / "images", ec))
