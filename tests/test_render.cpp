@@ -20,6 +20,7 @@
 #include "model/parametric.h"
 #include "model/proposal.h"
 #include "core/frame.h"
+#include "render/mis.h"
 #include "render/renderer.h"
 #include "render/camera_batch.h"
 #include "render/environment.h"
@@ -1535,6 +1536,19 @@ TEST(Render, MeshesCountAgainstTheMemoryBudget) {
   settings.max_memory = std::uint64_t(2) << 20;
   EXPECT_NO_THROW(render(scene(mesh("a.obj")), settings));
   EXPECT_NE(test::error_of([&] { render(scene(mesh("a.obj") + ", " + mesh("b.obj")), settings); }).find("b.obj: a mesh of"), std::string::npos);
+}
+
+// The integrator's MIS factor (render/mis.h): cos w(p, q) / p by the power heuristic, as the two-sample sum
+// needs it, and finite where p^2 + q^2 underflows (the one-ray path gave 0 / 0 there; the lanes did not).
+TEST(Mis, PowerHeuristicFactorStaysFiniteWhereTheSquaresUnderflow) {
+  const auto reference = [](double cos, double p, double q) { return cos * (p * p / (p * p + q * q)) / p; };
+  for (const auto& [p, q] : {std::pair{1.0, 1.0}, {0.3, 2.0}, {5.0, 1e-3}, {1e-100, 1e-100}, {2.0, 0.0}})
+    EXPECT_NEAR(power_heuristic_factor(0.7, p, q), reference(0.7, p, q), 1e-14 * reference(0.7, p, q)) << p << " " << q;
+  EXPECT_TRUE(std::isnan(reference(0.7, 1e-170, 1e-170)));  // the heuristic as written
+  EXPECT_NEAR(power_heuristic_factor(0.7, 1e-170, 1e-170), 0.7 / 2e-170, 1e-12 * (0.7 / 2e-170));
+  EXPECT_NEAR(power_heuristic_factor(0.7, 1e-170, 3e-170), 0.7 / (1e-170 + 9e-170), 1e-12 * (0.7 / 1e-169));
+  EXPECT_EQ(power_heuristic_factor(0.7, 0.0, 1.0), 0.0);
+  EXPECT_EQ(power_heuristic_factor(0.7, 0.0, 0.0), 0.0);
 }
 
 TEST(PiecewiseConstant2D, DrawsCellsInProportionToTheirWeightsAndReportsTheirDensity) {

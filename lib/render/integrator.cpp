@@ -10,14 +10,13 @@
 #include "core/error.h"
 #include "core/memory_budget.h"
 #include "io/input.h"
+#include "render/mis.h"
 
 namespace facetfit {
 
 namespace {
 
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
-
-double power_heuristic(double a, double b) { return a * a / (a * a + b * b); }
 
 // Texture coordinates of point p on a sphere (render/texture.h) or a plane (its square's axes, as the
 // tracer builds its geometry: 0 to 1 across it). Meshes carry none (the scene refuses textures on them).
@@ -240,13 +239,13 @@ void Integrator::EnvironmentSlots(const ShadingModel& model, const Planned& plan
     const Vec3 il = planned.frame.to_local(ls.d);
     if (il.z > 0.0 && ls.pdf > 0.0) {
       const ShadingModel::Evaluation e = model.eval(o, il, true);
-      cast(ls.d, e.f * ls.radiance * (il.z * power_heuristic(ls.pdf, e.pdf) / ls.pdf));
+      cast(ls.d, e.f * ls.radiance * power_heuristic_factor(il.z, ls.pdf, e.pdf));
     }
   }
   if (const auto i = model.sample_direction(o, u[2], u[3], u[4])) {
     const Environment::Sample at = env_->lookup(planned.frame.to_world(*i));  // its d: the world direction
     const ShadingModel::Evaluation e = model.eval(o, *i, true);
-    if (e.pdf > 0.0) cast(at.d, e.f * (i->z / e.pdf) * at.radiance * (light_sampled_ ? power_heuristic(e.pdf, at.pdf) : 1.0));
+    if (e.pdf > 0.0) cast(at.d, e.f * at.radiance * (light_sampled_ ? power_heuristic_factor(i->z, e.pdf, at.pdf) : i->z / e.pdf));
   }
 }
 

@@ -323,11 +323,9 @@ void ShadowValues(ShadowBatch& batch, const SlotRanges& ranges) {
     const M brdf = index >= hn::Set(d, double(ranges.brdf_begin));
     const V pdf = load(d, batch.pdf, k), cos_i = load(d, batch.iz, k);
     // value = f x arriving x factor. A light: factor cos. The environment's light sample and the BRDF's,
-    // each weighted against the other by the power heuristic w(p, q) = p^2 / (p^2 + q^2), p its own
-    // density and q the other's: factor = cos w(p, q) / p = cos p / (p^2 + q^2), one division (a BRDF
-    // sample against q = 0, a constant environment's, weighs 1: cos / p). Where p^2 + q^2 underflows
-    // (densities below 1e-154) and p > 0, cos / (p + q (q / p)), the same without the squares; where p is
-    // 0, nothing.
+    // each weighted against the other: factor = power_heuristic_factor(cos, p, q) (render/mis.h), p its own
+    // density and q the other's, in lanes (a BRDF sample against q = 0, a constant environment's, weighs 1:
+    // cos / p).
     V factor = cos_i;
     const M weighted = hn::Or(env_light, brdf);
     if (!hn::AllFalse(d, weighted)) {
