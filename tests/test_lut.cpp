@@ -302,6 +302,46 @@ TEST(Lut, EveryMeasurementThatFitsBakesWhatItsReaderAccepts) {
 
 // A format version this facetfit does not read is named as such, a missing one as missing (issue 61: -1 was
 // reported as "no format_version attribute").
+// The property behind the test above, on random valid measurements (seeded, so that CI draws the same): a
+// GGX or Beckmann lobe of alpha log-uniform in [0.002, 10] with a random RGB Schlick Fresnel over a random
+// Lambert body of albedo log-uniform in [1e-3, 2e4] (very bright tables included), some with only the pairs at
+// theta_h past a random angle in [60, 89] degrees kept. Each either fails in the fit with its problem or bakes
+// a LUT that its reader reads back.
+TEST(Lut, RandomValidMeasurementsBakeOrFailInTheFit) {
+  std::mt19937_64 rng(61);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const auto log_uniform = [&](double lo, double hi) { return lo * std::pow(hi / lo, u(rng)); };
+  TempDir dir;
+  int baked = 0, failed = 0;
+  for (int draw = 0; draw < 8; ++draw) {
+    const NdfType type = u(rng) < 0.5 ? NdfType::ggx : NdfType::beckmann;
+    const double alpha = log_uniform(0.002, 10.0);
+    const auto lobe = std::make_shared<MicrofacetBrdf>(Ndf::isotropic(type, alpha), Smith::correlated, Fresnel::schlick(Rgb(u(rng), u(rng), u(rng))));
+    const Rgb albedo = log_uniform(1e-3, 2e4) * Rgb(u(rng), u(rng), u(rng));
+    HalfDiffTable table = HalfDiffTable::tabulate(SumBrdf({std::make_shared<LambertBrdf>(albedo), lobe}));
+    if (draw % 3 == 2) {  // only theta_h past a random angle: bins below it missing
+      const int first = int(HalfDiffTable::kThetaH * std::sqrt(log_uniform(60.0, 89.0) / 90.0));
+      for (int i = 0; i < first; ++i)
+        for (int j = 0; j < HalfDiffTable::kThetaD; ++j)
+          for (int k = 0; k < HalfDiffTable::kPhiD; ++k) table.set_missing(i, j, k);
+    }
+    const std::string what = std::string(to_string(type)) + " alpha " + std::to_string(alpha) + ", albedo " + std::to_string(albedo.r);
+    const Fitter fitter{FitOptions{}};
+    const FitResult fit = fitter.fit(table);
+    if (!fit.ok()) {
+      EXPECT_FALSE(fit.problem.empty()) << what;
+      ++failed;
+      continue;
+    }
+    const std::string path = dir.file("r" + std::to_string(draw) + ".exr");
+    ASSERT_NO_THROW(write_lut(path, make_lut(fit, fitter.quadrature(), "x", "", 0.02, true))) << what;
+    EXPECT_NO_THROW(read_lut(path)) << what;
+    ++baked;
+  }
+  std::printf("[ random ] %d baked, %d failed in the fit\n", baked, failed);
+  EXPECT_GE(baked, 4);
+}
+
 TEST(Lut, AFormatVersionIsNamedAsWritten) {
   const Baked b = fit_of(MicrofacetBrdf(Ndf::isotropic(NdfType::ggx, 0.2), Smith::correlated, Fresnel::schlick(Rgb(0.9))));
   TempDir dir;
