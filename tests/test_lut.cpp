@@ -197,7 +197,8 @@ TEST(Lut, ClosuresAreValidatedAndOlderLutsGetOneLobe) {
   damaged("facetfit:closures_lobes", kAbsent, "closures_lobes is -1");
   damaged("facetfit:closures_lobe0_alpha_x", std::nanf(""), "closures_lobe0_alpha_x is missing or not a number: must be in [0.0001, 10]");
   damaged("facetfit:closures_lobe0_alpha_y", 0.0f, "closures_lobe0_alpha_y is 0: must be in [0.0001, 10]");
-  damaged("facetfit:closures_lobe0_weight", -1.0f, "closures_lobe0_weight is -1: must be in [0, 1000]");
+  damaged("facetfit:closures_lobe0_weight", -1.0f, "closures_lobe0_weight is -1: must be in [0, 1]");
+  damaged("facetfit:closures_lobe0_weight", 900.0f, "closures_lobe0_weight is 900: must be in [0, 1]");  // pixels of 3.4e6
   damaged("facetfit:closures_lobe0_family_code", 3, "closures_lobe0_family_code is missing");
   damaged("facetfit:closures_lobe0_fresnel_code", 0, "closures_lobe0_fresnel_code is missing");
   damaged("facetfit:closures_lobe0_exponent", kAbsent, "closures_lobe0_exponent is missing");

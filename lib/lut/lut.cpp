@@ -216,7 +216,7 @@ void visit_limits(LutMetadata& m, const std::function<void(const std::string& na
     visit(lobe_key(k, "alpha_x"), l.alpha_x, 1e-4, kAlpha);
     visit(lobe_key(k, "alpha_y"), l.alpha_y, 1e-4, kAlpha);
     visit(lobe_key(k, "angle"), l.angle, -kPi, kPi);
-    visit(lobe_key(k, "weight"), l.weight, 0.0, kColour);
+    visit(lobe_key(k, "weight"), l.weight, 0.0, 1.0);  // as the closure fit bounds it: the colours carry the rest
     colour(lobe_key(k, "f0"), l.f0, kColour);
     colour(lobe_key(k, "f82"), l.f82, kColour);
     colour(lobe_key(k, "f90"), l.f90, kColour);
