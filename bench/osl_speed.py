@@ -9,59 +9,24 @@ The realref scene (a unit sphere, a constant environment of 0.3 and a sun of irr
 three. Each material renders once to compile, then RUNS times; the median of those is its time. Prints a
 Markdown table and writes OUT_DIR/NAME.exr of each material's last render.
 """
-import glob
-import math
 import os
 import statistics
 import sys
 import time
 
-
-# oslquery, which script nodes need, ships inside bpy's own tree.
-sys.path += glob.glob(os.path.join(sys.prefix, "lib", "python3*", "site-packages", "bpy", "*", "python", "lib",
-                                   "python3*", "site-packages"))
+# The tests' Cycles scene (tests/osl/cycles_render.py, which also puts bpy's own oslquery on the path): one
+# realref scene for the tests and this benchmark.
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tests", "osl"))
+import cycles_render  # noqa: E402
 import bpy  # noqa: E402  Blender as a Python module (bpy wheel)
-from mathutils import Vector  # noqa: E402
 
 SIZE, SPP = 256, 64
 
 
 def scene_setup():
-    bpy.ops.wm.read_factory_settings(use_empty=True)
-    scene = bpy.context.scene
-    scene.render.engine = "CYCLES"
-    scene.cycles.device = "CPU"
-    scene.cycles.shading_system = True  # OSL, for all three
-    scene.cycles.samples = SPP
-    scene.cycles.use_adaptive_sampling = False
-    scene.cycles.use_denoising = False
-    scene.cycles.max_bounces = 1
-    scene.cycles.pixel_filter_type = "BOX"
-    scene.render.resolution_x = scene.render.resolution_y = SIZE
-    scene.render.resolution_percentage = 100
-    scene.render.film_transparent = True
-    scene.view_settings.view_transform = "Standard"
-    scene.render.image_settings.file_format = "OPEN_EXR"
-    scene.render.image_settings.color_depth = "32"
-    bpy.ops.mesh.primitive_uv_sphere_add(segments=256, ring_count=128, radius=1.0)
-    bpy.ops.object.shade_smooth()
-    sphere = bpy.context.active_object
-    bpy.ops.object.camera_add(location=(0, -4, 0.6))
-    camera = bpy.context.active_object
-    camera.rotation_euler = (-camera.location).to_track_quat("-Z", "Y").to_euler()
-    camera.data.sensor_fit = "VERTICAL"
-    camera.data.angle_y = math.radians(30)
-    scene.camera = camera
-    world = bpy.data.worlds.new("w")
-    world.use_nodes = True
-    world.node_tree.nodes["Background"].inputs["Color"].default_value = (0.3, 0.3, 0.3, 1)
-    scene.world = world
-    sun = bpy.data.lights.new("sun", "SUN")
-    sun.energy = 3.0
-    sun.angle = 0.0
-    sun_object = bpy.data.objects.new("sun", sun)
-    sun_object.rotation_euler = Vector((0.3, -0.5, 1.0)).normalized().to_track_quat("Z", "Y").to_euler()
-    scene.collection.objects.link(sun_object)
+    scene = cycles_render.new_scene(SIZE, SPP)  # OSL for all three, direct lighting, box filter
+    sphere = cycles_render.sphere_and_camera(scene)
+    cycles_render.realref_lighting(scene)
     return scene, sphere
 
 

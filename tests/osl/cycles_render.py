@@ -118,16 +118,11 @@ def probe(shader, out, size, params):
     render(scene, out)
 
 
-def shaded_sphere(shader, size, spp, params):
-    """A new scene of the unit sphere shaded by SHADER, seen from the reference renderer's default camera."""
-    scene = new_scene(size, spp)
+def sphere_and_camera(scene):
+    """The unit sphere and the reference renderer's default camera, added to SCENE; returns the sphere."""
     bpy.ops.mesh.primitive_uv_sphere_add(segments=256, ring_count=128, radius=1.0)
     bpy.ops.object.shade_smooth()
-    stretch_texture = params.pop("stretch_texture", None)
-    material = script_material(shader, params)
-    if stretch_texture:
-        connect_stretch_texture(material, stretch_texture)
-    bpy.context.active_object.data.materials.append(material)
+    sphere = bpy.context.active_object
     # Blender is z-up: facetfit's (x, y, z) is Blender's (x, z, -y) read backwards, i.e. Blender (x, y, z)
     # = facetfit (x, -z, y). The camera at facetfit (0, 0.6, 4) looking at the origin.
     bpy.ops.object.camera_add(location=(0, -4, 0.6))
@@ -136,6 +131,35 @@ def shaded_sphere(shader, size, spp, params):
     camera.data.sensor_fit = "VERTICAL"
     camera.data.angle_y = math.radians(30)
     scene.camera = camera
+    return sphere
+
+
+def realref_lighting(scene):
+    """The lights of ../shared/data/realref in SCENE: a constant world of 0.3 and a sun lamp of strength 3
+    toward facetfit's (0.3, 1, 0.5)."""
+    from mathutils import Vector
+    world = bpy.data.worlds.new("constant")
+    world.use_nodes = True
+    world.node_tree.nodes["Background"].inputs["Color"].default_value = (0.3, 0.3, 0.3, 1)
+    scene.world = world
+    lamp = bpy.data.lights.new("sun", "SUN")
+    lamp.energy = 3.0
+    lamp.angle = 0.0
+    lamp_object = bpy.data.objects.new("sun", lamp)
+    toward = Vector((0.3, -0.5, 1.0)).normalized()  # facetfit's (0.3, 1, 0.5) in Blender's frame
+    lamp_object.rotation_euler = toward.to_track_quat("Z", "Y").to_euler()  # the lamp shines along its -Z
+    scene.collection.objects.link(lamp_object)
+
+
+def shaded_sphere(shader, size, spp, params):
+    """A new scene of the unit sphere shaded by SHADER, seen from the reference renderer's default camera."""
+    scene = new_scene(size, spp)
+    sphere = sphere_and_camera(scene)
+    stretch_texture = params.pop("stretch_texture", None)
+    material = script_material(shader, params)
+    if stretch_texture:
+        connect_stretch_texture(material, stretch_texture)
+    sphere.data.materials.append(material)
     return scene
 
 
@@ -162,19 +186,8 @@ def sphere(shader, out, size, spp, environment, params):
 
 
 def sun(shader, out, size, spp, params):
-    from mathutils import Vector
     scene = shaded_sphere(shader, size, spp, params)
-    world = bpy.data.worlds.new("constant")
-    world.use_nodes = True
-    world.node_tree.nodes["Background"].inputs["Color"].default_value = (0.3, 0.3, 0.3, 1)
-    scene.world = world
-    lamp = bpy.data.lights.new("sun", "SUN")
-    lamp.energy = 3.0
-    lamp.angle = 0.0
-    lamp_object = bpy.data.objects.new("sun", lamp)
-    toward = Vector((0.3, -0.5, 1.0)).normalized()  # facetfit's (0.3, 1, 0.5) in Blender's frame
-    lamp_object.rotation_euler = toward.to_track_quat("Z", "Y").to_euler()  # the lamp shines along its -Z
-    scene.collection.objects.link(lamp_object)
+    realref_lighting(scene)
     render(scene, out)
 
 
