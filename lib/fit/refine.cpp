@@ -245,6 +245,154 @@ PassTerms pass_terms(const MeasuredBins& bins, Smith smith, const LobeFit& lobe)
   return t;
 }
 
+// The Fresnel unknowns: the entries the bins' theta_d reach (the knots). The entries between them are
+// linear in between, those past the last knot equal it. The entries no bin sees carry no information of
+// their own, and fewer unknowns make a faster solve.
+struct FresnelKnots {
+  std::vector<int> entry;  // sorted
+
+  explicit FresnelKnots(const std::vector<NodeWeights>& row_entries) {
+    for (const NodeWeights& e : row_entries) entry.insert(entry.end(), e.node.begin(), e.node.end());
+    std::sort(entry.begin(), entry.end());
+    entry.erase(std::unique(entry.begin(), entry.end()), entry.end());
+  }
+  std::size_t size() const { return entry.size(); }
+  // The position of knot entry e among the knots.
+  std::size_t index(int e) const { return std::size_t(std::lower_bound(entry.begin(), entry.end(), e) - entry.begin()); }
+
+  // The two knots bracketing entry position x and their weights.
+  void bracket(double x, int e[2], double w[2]) const {
+    const auto above = std::upper_bound(entry.begin(), entry.end(), x);
+    if (above == entry.begin() || above == entry.end()) {
+      e[0] = e[1] = above == entry.begin() ? entry.front() : entry.back();
+      w[0] = 1.0, w[1] = 0.0;
+      return;
+    }
+    e[0] = *(above - 1), e[1] = *above;
+    w[1] = (x - e[0]) / double(e[1] - e[0]), w[0] = 1.0 - w[1];
+  }
+};
+
+// What the refinement solves for, in the layout of its parameter blocks.
+struct LobeUnknowns {
+  std::vector<double> d, body;
+  double exponent;
+  std::vector<std::array<double, 3>> fresnel;
+
+  explicit LobeUnknowns(const LobeFit& fit)
+      : d(fit.ndf.ndf), body{fit.body.r, fit.body.g, fit.body.b}, exponent(clamp(fit.body_exponent, 1.0, kMaxBodyExponent)),
+        fresnel(FresnelCurve::kSize) {
+    for (int j = 0; j < FresnelCurve::kSize; ++j)
+      for (int c = 0; c < 3; ++c) fresnel[std::size_t(j)][std::size_t(c)] = clamp(fit.fresnel.value[std::size_t(j)][c], 0.0, 1.0);
+  }
+  std::vector<double*> node_blocks() {
+    std::vector<double*> all;
+    for (double& v : d) all.push_back(&v);
+    return all;
+  }
+};
+
+// The albedo's coefficients B[n][m] of one view (AlbedoRefineCost): the lobe's visible normals drawn on a
+// jittered 32 x 32 grid, each direction's spline weights on the nodes times its linear weights on the
+// knots (through the Fresnel entries between them).
+AlbedoRefineCost::View albedo_view(double cos_o, std::uint64_t seed, const LobeFit& lobe, Smith smith, const ThetaGrid& grid,
+                                   const VisibleSlopeProposal& proposal, const G1Table& g1, const FresnelKnots& knots) {
+  constexpr int kGrid = 32;
+  const double step = FresnelCurve::theta_d(1);
+  AlbedoRefineCost::View v;
+  v.cos_o = cos_o;
+  v.b.assign(lobe.ndf.ndf.size() * knots.size(), 0.0);
+  const Vec3 o(std::sqrt(std::max(0.0, 1.0 - v.cos_o * v.cos_o)), 0.0, v.cos_o);
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> jitter(0.0, 1.0);
+  for (int a = 0; a < kGrid; ++a)
+    for (int c = 0; c < kGrid; ++c) {
+      const auto i = proposal.sample_direction(o, (a + jitter(rng)) / kGrid, (c + jitter(rng)) / kGrid);
+      const double pdf = i ? proposal.pdf(o, *i) : 0.0;
+      if (!(pdf > 0.0)) continue;
+      const Vec3 h = glm::normalize(*i + o);
+      const double g = smith_g2_from_g1(smith, g1(o.z), g1(i->z)) / (4.0 * o.z * pdf * kGrid * kGrid);
+      const NodeWeights nodes = ndf_nodes(grid, std::acos(clamp(h.z, -1.0, 1.0)));
+      // F at theta_d: linear between entries x0 and x0 + 1, each linear between its bracketing knots.
+      const double x = clamp(std::acos(clamp(glm::dot(*i, h), 0.0, 1.0)) / step, 0.0, double(FresnelCurve::kSize - 1));
+      const int x0 = std::min(int(x), FresnelCurve::kSize - 2);
+      for (int side = 0; side < 2; ++side) {
+        const double along = side == 0 ? x0 + 1 - x : x - x0;
+        int e[2];
+        double w[2];
+        knots.bracket(x0 + side, e, w);
+        for (int q = 0; q < 2; ++q) {
+          const std::size_t m = knots.index(e[q]);
+          for (std::size_t t = 0; t < nodes.node.size(); ++t)
+            v.b[std::size_t(nodes.node[t]) * knots.size() + m] += g * along * w[q] * nodes.weight[t];
+        }
+      }
+    }
+  const Coat& coat = lobe.coat;
+  if (coat.present())
+    VisibleMoments::for_each_visible_normal(v.cos_o, coat.alpha, coat.alpha,
+                                            [&](double mu, double ratio) { v.coat += fresnel_schlick(Rgb(coat.f0), mu).r * ratio; });
+  return v;
+}
+
+// The albedo views of the current lobe, one per view of the target (seeded by its index).
+std::vector<AlbedoRefineCost::View> albedo_views(const AlbedoTarget& target, const LobeFit& lobe, Smith smith, const ThetaGrid& grid,
+                                                 const FresnelKnots& knots) {
+  std::vector<AlbedoRefineCost::View> views(target.cos_o.size());
+  const VisibleSlopeProposal proposal(lobe.tables(smith));
+  const G1Table g1(lobe.ndf);
+  tbb::parallel_for(std::size_t(0), views.size(),
+                    [&](std::size_t j) { views[j] = albedo_view(target.cos_o[j], j + 1, lobe, smith, grid, proposal, g1, knots); });
+  return views;
+}
+
+// The smoothness penalties: second differences of the Fresnel knots and of the NDF nodes.
+void add_smoothness(SmallProblem& problem, const FresnelKnots& knots, LobeUnknowns& x, const RefineOptions& options) {
+  const std::vector<int>& k = knots.entry;
+  for (std::size_t j = 1; j + 1 < k.size(); ++j)
+    problem.AddResidualBlock(new ceres::AutoDiffCostFunction<SecondDifference<3>, 3, 3, 3, 3>(
+                                 new SecondDifference<3>(fresnel_smoothness(options.fresnel_smoothness, k[j - 1], k[j], k[j + 1]))),
+                             nullptr, x.fresnel[std::size_t(k[j - 1])].data(), x.fresnel[std::size_t(k[j])].data(),
+                             x.fresnel[std::size_t(k[j + 1])].data());
+  std::vector<double>& d = x.d;
+  for (std::size_t j = 1; j + 1 < d.size(); ++j) {
+    const double scale = std::max(d[j], 1e-3 * d[0] + 1e-6);
+    problem.AddResidualBlock(new ceres::AutoDiffCostFunction<SecondDifference<1>, 1, 1, 1, 1>(
+                                 new SecondDifference<1>{options.ndf_smoothness / scale, -2.0 * options.ndf_smoothness / scale,
+                                                         options.ndf_smoothness / scale}),
+                             nullptr, &d[j - 1], &d[j], &d[j + 1]);
+  }
+}
+
+// Bounds, not a clamp afterwards: left free, the solve trades negative nodes against each other. A
+// Fresnel factor is a reflectance: in [0, 1] (above 1 the fit would trade the NDF's scale for it).
+void set_bounds(SmallProblem& problem, const FresnelKnots& knots, LobeUnknowns& x) {
+  for (int c = 0; c < 3; ++c) problem.SetParameterLowerBound(x.body.data(), c, 0.0);
+  problem.SetParameterLowerBound(&x.exponent, 0, 1.0), problem.SetParameterUpperBound(&x.exponent, 0, kMaxBodyExponent);
+  for (int j : knots.entry)
+    for (int c = 0; c < 3; ++c)
+      problem.SetParameterLowerBound(x.fresnel[std::size_t(j)].data(), c, 0.0),
+          problem.SetParameterUpperBound(x.fresnel[std::size_t(j)].data(), c, 1.0);
+  for (double& v : x.d) problem.SetParameterLowerBound(&v, 0, 0.0);
+}
+
+// The fit the unknowns stand for: the body, its exponent (Lambert's where it does nothing visible: within
+// 1e-3 of 1, f_body moves by under 0.5% even where both cosines are 0.01, or over a body too faint to see;
+// the LUT then stays version 2 or 3), the Fresnel entries from the knots.
+void store(const LobeUnknowns& x, const FresnelKnots& knots, LobeFit& fit) {
+  const std::vector<double>& body = x.body;
+  fit.body = Rgb(body[0], body[1], body[2]);
+  fit.body_exponent = std::abs(x.exponent - 1.0) < 1e-3 || std::max({body[0], body[1], body[2]}) < 1e-3 ? 1.0 : x.exponent;
+  for (int j = 0; j < FresnelCurve::kSize; ++j) {
+    int e[2];
+    double w[2];
+    knots.bracket(j, e, w);
+    for (int c = 0; c < 3; ++c)
+      fit.fresnel.value[std::size_t(j)][c] =
+          w[0] * x.fresnel[std::size_t(e[0])][std::size_t(c)] + w[1] * x.fresnel[std::size_t(e[1])][std::size_t(c)];
+  }
+}
+
 }  // namespace
 
 double normalize_ndf(TabulatedNdf& ndf, const Quadrature& quad) {
@@ -267,145 +415,44 @@ LobeFit refine_lobe(const MeasuredBins& bins, const Quadrature& quad, Smith smit
                     const RefineOptions& options) {
   LobeFit fit = start;
   if (bins.size() == 0) return fit;
-  const ThetaGrid& grid = quad.grid();
   normalize_ndf(fit.ndf, quad);
-  std::vector<double> d = fit.ndf.ndf;
-  std::vector<double> body = {fit.body.r, fit.body.g, fit.body.b};
-  double exponent = clamp(fit.body_exponent, 1.0, kMaxBodyExponent);
-  std::vector<std::array<double, 3>> fresnel(FresnelCurve::kSize);
-  for (int j = 0; j < FresnelCurve::kSize; ++j)
-    for (int c = 0; c < 3; ++c) fresnel[std::size_t(j)][std::size_t(c)] = clamp(fit.fresnel.value[std::size_t(j)][c], 0.0, 1.0);
-  PassTerms terms;
+  LobeUnknowns x(fit);
   std::vector<NodeWeights> row_nodes, row_entries;
-  row_nodes.reserve(bins.rows.size());
-  row_entries.reserve(bins.rows.size());
   for (const MeasuredBins::Row& row : bins.rows)
-    row_nodes.push_back(ndf_nodes(grid, row.theta_h)), row_entries.push_back(fresnel_entries(row.theta_d));
-  // The Fresnel unknowns are the entries the bins' theta_d reach (the knots); the entries between
-  // them are linear in between, those past the last knot equal it. The entries no bin sees carry no
-  // information of their own, and fewer unknowns make a faster solve.
-  std::vector<int> knots;
-  for (const NodeWeights& e : row_entries) knots.insert(knots.end(), e.node.begin(), e.node.end());
-  std::sort(knots.begin(), knots.end());
-  knots.erase(std::unique(knots.begin(), knots.end()), knots.end());
-  // The two knots bracketing entry position x and their weights.
-  const auto bracket = [&knots](double x, int e[2], double w[2]) {
-    const auto above = std::upper_bound(knots.begin(), knots.end(), x);
-    if (above == knots.begin() || above == knots.end()) {
-      e[0] = e[1] = above == knots.begin() ? knots.front() : knots.back();
-      w[0] = 1.0, w[1] = 0.0;
-      return;
-    }
-    e[0] = *(above - 1), e[1] = *above;
-    w[1] = (x - e[0]) / double(e[1] - e[0]), w[0] = 1.0 - w[1];
-  };
-
-  // The albedo's coefficients of the current lobe (AlbedoRefineCost): its visible normals drawn from each view
-  // on a jittered 32 x 32 grid, each direction's spline weights on the nodes times its linear weights on
-  // the knots (through the Fresnel entries between them).
-  const auto albedo_views = [&](const LobeFit& lobe) {
-    std::vector<AlbedoRefineCost::View> views(options.albedo->cos_o.size());
-    const MicrofacetTables tables = lobe.tables(smith);
-    const VisibleSlopeProposal proposal(tables);
-    const G1Table g1(lobe.ndf);
-    const double step = FresnelCurve::theta_d(1);
-    tbb::parallel_for(std::size_t(0), views.size(), [&](std::size_t j) {
-      constexpr int kGrid = 32;
-      AlbedoRefineCost::View& v = views[j];
-      v.cos_o = options.albedo->cos_o[j];
-      v.b.assign(lobe.ndf.ndf.size() * knots.size(), 0.0);
-      const Vec3 o(std::sqrt(std::max(0.0, 1.0 - v.cos_o * v.cos_o)), 0.0, v.cos_o);
-      std::mt19937_64 rng(j + 1);
-      std::uniform_real_distribution<double> jitter(0.0, 1.0);
-      for (int a = 0; a < kGrid; ++a)
-        for (int c = 0; c < kGrid; ++c) {
-          const auto i = proposal.sample_direction(o, (a + jitter(rng)) / kGrid, (c + jitter(rng)) / kGrid);
-          const double pdf = i ? proposal.pdf(o, *i) : 0.0;
-          if (!(pdf > 0.0)) continue;
-          const Vec3 h = glm::normalize(*i + o);
-          const double g = smith_g2_from_g1(smith, g1(o.z), g1(i->z)) / (4.0 * o.z * pdf * kGrid * kGrid);
-          const NodeWeights nodes = ndf_nodes(grid, std::acos(clamp(h.z, -1.0, 1.0)));
-          // F at theta_d: linear between entries x0 and x0 + 1, each linear between its bracketing knots.
-          const double x = clamp(std::acos(clamp(glm::dot(*i, h), 0.0, 1.0)) / step, 0.0, double(FresnelCurve::kSize - 1));
-          const int x0 = std::min(int(x), FresnelCurve::kSize - 2);
-          for (int side = 0; side < 2; ++side) {
-            const double along = side == 0 ? x0 + 1 - x : x - x0;
-            int e[2];
-            double w[2];
-            bracket(x0 + side, e, w);
-            for (int q = 0; q < 2; ++q) {
-              const std::size_t m = std::size_t(std::lower_bound(knots.begin(), knots.end(), e[q]) - knots.begin());
-              for (std::size_t t = 0; t < nodes.node.size(); ++t)
-                v.b[std::size_t(nodes.node[t]) * knots.size() + m] += g * along * w[q] * nodes.weight[t];
-            }
-          }
-        }
-      const Coat& coat = lobe.coat;
-      if (coat.present())
-        VisibleMoments::for_each_visible_normal(v.cos_o, coat.alpha, coat.alpha,
-                                                [&](double mu, double ratio) { v.coat += fresnel_schlick(Rgb(coat.f0), mu).r * ratio; });
-    });
-    return views;
-  };
+    row_nodes.push_back(ndf_nodes(quad.grid(), row.theta_h)), row_entries.push_back(fresnel_entries(row.theta_d));
+  const FresnelKnots knots(row_entries);
+  const bool albedo = options.albedo && !options.albedo->cos_o.empty();
 
   for (int pass = 0; pass < options.passes; ++pass) {
-    terms = pass_terms(bins, smith, fit);  // G2 of the current NDF (the coat is held: the same every pass)
+    const PassTerms terms = pass_terms(bins, smith, fit);  // G2 of the current NDF (the coat is held: the same every pass)
     SmallProblem problem;
     for (std::size_t r = 0; r < bins.rows.size(); ++r) {
-      std::vector<double*> blocks{body.data(), &exponent};
-      for (int e : row_entries[r].node) blocks.push_back(fresnel[std::size_t(e)].data());
-      for (int n : row_nodes[r].node) blocks.push_back(&d[std::size_t(n)]);
+      std::vector<double*> blocks{x.body.data(), &x.exponent};
+      for (int e : row_entries[r].node) blocks.push_back(x.fresnel[std::size_t(e)].data());
+      for (int n : row_nodes[r].node) blocks.push_back(&x.d[std::size_t(n)]);
       problem.AddResidualBlock(new LobeRowCost(bins, bins.rows[r], terms, row_entries[r], row_nodes[r]), nullptr, blocks);
     }
-    std::vector<double*> all_nodes;
-    for (double& v : d) all_nodes.push_back(&v);
+    const std::vector<double*> all_nodes = x.node_blocks();
     problem.AddResidualBlock(new NormalizationCost(quad.projected_area(), 10.0), nullptr, all_nodes);
-    if (options.albedo && !options.albedo->cos_o.empty()) {
-      std::vector<double*> blocks{body.data(), &exponent};
-      for (int e : knots) blocks.push_back(fresnel[std::size_t(e)].data());
+    if (albedo) {
+      std::vector<double*> blocks{x.body.data(), &x.exponent};
+      for (int e : knots.entry) blocks.push_back(x.fresnel[std::size_t(e)].data());
       blocks.insert(blocks.end(), all_nodes.begin(), all_nodes.end());
-      problem.AddResidualBlock(new AlbedoRefineCost(*options.albedo, albedo_views(fit), knots.size(), d.size()), nullptr, blocks);
+      problem.AddResidualBlock(new AlbedoRefineCost(*options.albedo, albedo_views(*options.albedo, fit, smith, quad.grid(), knots),
+                                                    knots.size(), x.d.size()),
+                               nullptr, blocks);
     }
-    for (std::size_t k = 1; k + 1 < knots.size(); ++k)
-      problem.AddResidualBlock(
-          new ceres::AutoDiffCostFunction<SecondDifference<3>, 3, 3, 3, 3>(
-              new SecondDifference<3>(fresnel_smoothness(options.fresnel_smoothness, knots[k - 1], knots[k], knots[k + 1]))),
-          nullptr, fresnel[std::size_t(knots[k - 1])].data(), fresnel[std::size_t(knots[k])].data(), fresnel[std::size_t(knots[k + 1])].data());
-    for (std::size_t j = 1; j + 1 < d.size(); ++j) {
-      const double scale = std::max(d[j], 1e-3 * d[0] + 1e-6);
-      problem.AddResidualBlock(new ceres::AutoDiffCostFunction<SecondDifference<1>, 1, 1, 1, 1>(
-                                   new SecondDifference<1>{options.ndf_smoothness / scale, -2.0 * options.ndf_smoothness / scale,
-                                                           options.ndf_smoothness / scale}),
-                               nullptr, &d[j - 1], &d[j], &d[j + 1]);
-    }
-    // Bounds, not a clamp afterwards: left free, the solve trades negative nodes against each other.
-    for (int c = 0; c < 3; ++c) problem.SetParameterLowerBound(body.data(), c, 0.0);
-    problem.SetParameterLowerBound(&exponent, 0, 1.0), problem.SetParameterUpperBound(&exponent, 0, kMaxBodyExponent);
-    // A Fresnel factor is a reflectance: in [0, 1] (above 1 the fit would trade the NDF's scale for it).
-    for (int j : knots)
-      for (int c = 0; c < 3; ++c)
-        problem.SetParameterLowerBound(fresnel[std::size_t(j)].data(), c, 0.0), problem.SetParameterUpperBound(fresnel[std::size_t(j)].data(), c, 1.0);
-    for (double& v : d) problem.SetParameterLowerBound(&v, 0, 0.0);
-
+    add_smoothness(problem, knots, x, options);
+    set_bounds(problem, knots, x);
     problem.Solve(options.max_iterations, options.function_tolerance);
 
-    fit.ndf.ndf = d;
+    fit.ndf.ndf = x.d;
     const double area = normalize_ndf(fit.ndf, quad);  // F D stays what the solve found
-    d = fit.ndf.ndf;
-    for (auto& f : fresnel)
+    x.d = fit.ndf.ndf;
+    for (auto& f : x.fresnel)
       for (double& v : f) v = std::min(v * area, 1.0);
   }
-  fit.body = Rgb(body[0], body[1], body[2]);
-  // An exponent that does nothing visible is Lambert's: within 1e-3 of 1 (f_body moves by under 0.5% even
-  // where both cosines are 0.01), or over a body too faint to see; the LUT then stays version 2 or 3.
-  fit.body_exponent = std::abs(exponent - 1.0) < 1e-3 || std::max({body[0], body[1], body[2]}) < 1e-3 ? 1.0 : exponent;
-  for (int j = 0; j < FresnelCurve::kSize; ++j) {
-    int e[2];
-    double w[2];
-    bracket(j, e, w);
-    for (int c = 0; c < 3; ++c)
-      fit.fresnel.value[std::size_t(j)][c] = w[0] * fresnel[std::size_t(e[0])][std::size_t(c)] + w[1] * fresnel[std::size_t(e[1])][std::size_t(c)];
-  }
+  store(x, knots, fit);
   return fit;
 }
 
