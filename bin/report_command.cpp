@@ -179,9 +179,9 @@ void run_report_command(const ReportArgs& args, Context& ctx) {
   }
   report_settings(ctx, "report", o.bake.fit);
   std::shared_ptr<Progress> progress;
-  o.progress = [&progress, &ctx](const std::string& name, std::size_t done, std::size_t total) {
+  o.progress = [&progress, &ctx](const std::string& name, const std::string& what, std::size_t done, std::size_t total) {
     if (!progress) progress = std::make_shared<Progress>(total, ctx.verbosity);
-    progress->step(name, "report: " + std::to_string(done) + "/" + std::to_string(total) + " " + name);
+    progress->step(name, "report: " + std::to_string(done) + "/" + std::to_string(total) + " " + name + " (" + what + ")");
   };
   try {
     finish(run_report(o), o.out_dir, args.fail_on_regression, ctx);

@@ -420,18 +420,20 @@ FolderLock lock_report(const fs::path& out_dir) {
   return FolderLock(images.string(), FolderLock::Wait::no);
 }
 
-}  // namespace
-
-json run_report(const ReportOptions& o) {
+// The report's folders, made: OUT and its LUTs' folder (OUT/luts unless --luts), never through a link.
+void make_report_folders(const ReportOptions& o, const fs::path& luts) {
   std::error_code ec;
-  const fs::path luts = o.luts_dir.empty() ? fs::path(o.out_dir) / "luts" : fs::path(o.luts_dir);
   refuse_link(fs::path(o.out_dir) / "images");
   if (o.luts_dir.empty()) refuse_link(luts);  // a --luts folder is the user's to place
   fs::create_directories(fs::path(o.out_dir), ec);
   fs::create_directories(luts, ec);
   if (!fs::is_directory(o.out_dir) || !fs::is_directory(luts))
     fail(fs::is_directory(o.out_dir) ? luts.string() : o.out_dir, "cannot create folder" + (ec ? ": " + ec.message() : std::string()));
-  const FolderLock lock = lock_report(o.out_dir);
+}
+
+// Under the report's lock: the LUTs' folder checked, stale temporaries of a killed run removed.
+void clean_report_folders(const ReportOptions& o, const fs::path& luts) {
+  std::error_code ec;
   // Each bake locks the LUTs' folder: in the report's images/ it would wait on the report's own lock.
   if (fs::equivalent(luts, fs::path(o.out_dir) / "images", ec))
     fail(luts.string(), "is the report's images folder: give --luts another folder");
@@ -439,21 +441,18 @@ json run_report(const ReportOptions& o) {
   remove_stale_temporaries(luts.string());
   for (const auto& entry : fs::directory_iterator(fs::path(o.out_dir) / "images", ec))
     if (!entry.is_symlink(ec) && entry.is_directory(ec)) remove_stale_temporaries(entry.path().string());
-  const json previous = read_json_file((fs::path(o.out_dir) / "report.json").string());
+}
+
+// The previous run's entries by name: reused where their key is unchanged.
+std::map<std::string, json> reusable_entries(const json& previous) {
   std::map<std::string, json> reusable;
   if (previous.is_object() && previous.contains("materials"))
     for (const json& m : previous["materials"]) reusable[m["name"].get<std::string>()] = m;
+  return reusable;
+}
 
-  std::vector<std::string> inputs = expand_inputs(o.inputs.empty() ? std::vector<std::string>{kBuiltinPrefix} : o.inputs);
-  std::sort(inputs.begin(), inputs.end());
-  std::vector<std::string> mine;  // this shard's, a deterministic subset
-  for (std::size_t k = 0; k < inputs.size(); ++k)
-    if (int(k % std::size_t(o.shards)) == o.shard - 1) mine.push_back(inputs[k]);
-  // Names must be unique over all the inputs (every shard sees the same owner): a second input of the same
-  // stem is a failure, not a second row over the first one's images and LUT.
-  std::map<std::string, std::string> owner;
-  for (const std::string& source : inputs) owner.emplace(source_name(source), source);
-
+// A new report's head: version, settings, shard, empty lists.
+json report_head(const ReportOptions& o) {
   json report;
   report["facetfit_version"] = FACETFIT_VERSION;
   report["settings"] = {{"size", o.size}, {"spp", o.spp}, {"smith", to_string(o.bake.fit.smith)}, {"resolution", o.bake.fit.resolution},
@@ -462,73 +461,122 @@ json run_report(const ReportOptions& o) {
   report["shard"] = std::to_string(o.shard) + "/" + std::to_string(o.shards);
   report["materials"] = json::array();
   report["failures"] = json::array();
-  const Fitter fitter(o.bake.fit);
+  return report;
+}
+
+// One material's renders: the measurement and each representation of its LUT, their pictures, Delta E and
+// heat maps, and the paper's figures, into `images`; the entry's figures added to `entry`.
+void render_material(const ReportOptions& o, const std::string& source, const std::string& lut, const fs::path& images,
+                     const std::string& key, json& entry) {
+  const auto render_as = [&](const std::string& type, const std::string& file) {
+    MaterialDesc m;
+    m.type = type;
+    m.file = file;
+    if (type == "measured") m.proposal = lut;  // the bake's fit, not a second one
+    RenderSettings settings;
+    settings.max_memory = o.max_memory;
+    return render(report_scene(m, o), settings);
+  };
   const DisplayTransform display;
   const DisplayTransform& pictures = o.pictures ? *o.pictures : display;
+  std::vector<std::string> written;  // the entry's files, for its stamp
+  const auto image = [&](const std::string& file) { return (images / written.emplace_back(file)).string(); };
+  const RenderedImage measured = render_as("measured", source);
+  entry["seconds"]["render"]["measured"] = measured.seconds;
+  write_display_png(image("measured.png"), measured.rgba.data(), measured.width, measured.height, 4, pictures);
+  std::vector<bool> mask(std::size_t(measured.width) * measured.height);
+  for (std::size_t p = 0; p < mask.size(); ++p) mask[p] = measured.rgba[p * 4 + 3] >= 1.0f;  // the sphere
+  for (const std::string& r : report_representations()) {
+    const RenderedImage img = render_as(r == "tabulated" ? "lut" : r, lut);
+    entry["seconds"]["render"][r] = img.seconds;
+    write_display_png(image(r + ".png"), img.rgba.data(), img.width, img.height, 4, pictures);
+    const ImageDiff diff = image_delta_e(measured.rgb(), false, img.rgb(), false, mask, display);
+    entry["delta_e"][r] = diff.mean;
+    entry["max_delta_e"][r] = diff.max;
+    write_heatmap_png(image(r + "_delta_e.png"), img.width, img.height, diff.delta_e, mask);
+  }
+  // The figures the paper validates fits with: lobes in the plane of incidence, NDF, Fresnel.
+  const HalfDiffTable table = load_table(source, o.bake.fit.merl_bins);
+  for (const auto& [file, svg] : material_figures(table, read_lut(lut))) write_file_atomic(image(file), svg);
+  stamp_complete(images, key, written);
+}
+
+// What happened to one material in a run, for the progress line.
+enum class MaterialRun { rendered, reused };
+
+// One material of the report: baked (or found baked), then its previous entry reused where its key (the bake,
+// the render settings and facetfit) is unchanged and its images complete, else rendered again.
+MaterialRun report_material(const ReportOptions& o, const std::string& source, const fs::path& luts, const Fitter& fitter,
+                            const std::map<std::string, json>& reusable, json& report) {
+  const std::string name = source_name(source);
+  const fs::path images = fs::path(o.out_dir) / "images" / name;
+  const auto bake_start = std::chrono::steady_clock::now();
+  const BakeOutcome baked = bake_material(source, name, luts.string(), o.bake, fitter);
+  if (baked.status == BakeOutcome::Status::failed) throw Error(baked.error);
+  const double bake_seconds = seconds_since(bake_start);
+  const std::string key_text = baked.record["cache_key"].get<std::string>() + "|" + json_text(report["settings"]) + "|" + FACETFIT_VERSION;
+  const std::string key = sha256_hex(key_text.data(), key_text.size());
+  const auto old = reusable.find(name);
+  if (!o.force && old != reusable.end() && old->second.value("key", "") == key && images_complete(images, key)) {
+    report["materials"].push_back(old->second);
+    return MaterialRun::reused;
+  }
+  refuse_link(images);
+  std::error_code ec;
+  fs::create_directories(images, ec);
+  fs::remove(images / kCompleteStamp, ec);
+  json entry;
+  entry["name"] = name;
+  entry["source"] = source;
+  entry["key"] = key;
+  entry["source_sha256"] = baked.record.value("source_sha256", "");
+  entry["representation"] = baked.record["representation"];
+  entry["warnings"] = baked.record.value("warnings", json::array());
+  entry["seconds"]["bake"] = bake_seconds;
+  render_material(o, source, (luts / (name + ".exr")).string(), images, key, entry);
+  report["materials"].push_back(entry);
+  return MaterialRun::rendered;
+}
+
+// This shard's inputs: a deterministic subset of all the inputs, sorted.
+std::vector<std::string> shard_inputs(const std::vector<std::string>& inputs, const ReportOptions& o) {
+  std::vector<std::string> mine;
+  for (std::size_t k = 0; k < inputs.size(); ++k)
+    if (int(k % std::size_t(o.shards)) == o.shard - 1) mine.push_back(inputs[k]);
+  return mine;
+}
+
+}  // namespace
+
+json run_report(const ReportOptions& o) {
+  const fs::path luts = o.luts_dir.empty() ? fs::path(o.out_dir) / "luts" : fs::path(o.luts_dir);
+  make_report_folders(o, luts);
+  const FolderLock lock = lock_report(o.out_dir);
+  clean_report_folders(o, luts);
+  const json previous = read_json_file((fs::path(o.out_dir) / "report.json").string());
+  const std::map<std::string, json> reusable = reusable_entries(previous);
+  std::vector<std::string> inputs = expand_inputs(o.inputs.empty() ? std::vector<std::string>{kBuiltinPrefix} : o.inputs);
+  std::sort(inputs.begin(), inputs.end());
+  const std::vector<std::string> mine = shard_inputs(inputs, o);
+  // Names must be unique over all the inputs (every shard sees the same owner): a second input of the same
+  // stem is a failure, not a second row over the first one's images and LUT.
+  std::map<std::string, std::string> owner;
+  for (const std::string& source : inputs) owner.emplace(source_name(source), source);
+
+  json report = report_head(o);
+  const Fitter fitter(o.bake.fit);
   std::size_t done = 0;
   for (const std::string& source : mine) {
     const std::string name = source_name(source);
-    const fs::path images = fs::path(o.out_dir) / "images" / name;
+    std::string what;
     try {
       if (owner.at(name) != source) fail(source, "output name " + name + " is already taken by " + owner.at(name));
-      const auto bake_start = std::chrono::steady_clock::now();
-      const BakeOutcome baked = bake_material(source, name, luts.string(), o.bake, fitter);
-      if (baked.status == BakeOutcome::Status::failed) throw Error(baked.error);
-      const double bake_seconds = seconds_since(bake_start);
-      // An entry is reused when its bake, the render settings and facetfit are unchanged.
-      const std::string key_text = baked.record["cache_key"].get<std::string>() + "|" + json_text(report["settings"]) + "|" + FACETFIT_VERSION;
-      const std::string key = sha256_hex(key_text.data(), key_text.size());
-      const auto old = reusable.find(name);
-      if (!o.force && old != reusable.end() && old->second.value("key", "") == key && images_complete(images, key)) {
-        report["materials"].push_back(old->second);
-      } else {
-        refuse_link(images);
-        fs::create_directories(images, ec);
-        fs::remove(images / kCompleteStamp, ec);
-        const std::string lut = (luts / (name + ".exr")).string();
-        json entry;
-        entry["name"] = name;
-        entry["source"] = source;
-        entry["key"] = key;
-        entry["source_sha256"] = baked.record.value("source_sha256", "");
-        entry["representation"] = baked.record["representation"];
-        entry["warnings"] = baked.record.value("warnings", json::array());
-        entry["seconds"]["bake"] = bake_seconds;
-        const auto render_as = [&](const std::string& type, const std::string& file) {
-          MaterialDesc m;
-          m.type = type;
-          m.file = file;
-          if (type == "measured") m.proposal = lut;  // the bake's fit, not a second one
-          RenderSettings settings;
-          settings.max_memory = o.max_memory;
-          return render(report_scene(m, o), settings);
-        };
-        std::vector<std::string> written;  // the entry's files, for its stamp
-        const auto image = [&](const std::string& file) { return (images / written.emplace_back(file)).string(); };
-        const RenderedImage measured = render_as("measured", source);
-        entry["seconds"]["render"]["measured"] = measured.seconds;
-        write_display_png(image("measured.png"), measured.rgba.data(), measured.width, measured.height, 4, pictures);
-        std::vector<bool> mask(std::size_t(measured.width) * measured.height);
-        for (std::size_t p = 0; p < mask.size(); ++p) mask[p] = measured.rgba[p * 4 + 3] >= 1.0f;  // the sphere
-        for (const std::string& r : report_representations()) {
-          const RenderedImage img = render_as(r == "tabulated" ? "lut" : r, lut);
-          entry["seconds"]["render"][r] = img.seconds;
-          write_display_png(image(r + ".png"), img.rgba.data(), img.width, img.height, 4, pictures);
-          const ImageDiff diff = image_delta_e(measured.rgb(), false, img.rgb(), false, mask, display);
-          entry["delta_e"][r] = diff.mean;
-          entry["max_delta_e"][r] = diff.max;
-          write_heatmap_png(image(r + "_delta_e.png"), img.width, img.height, diff.delta_e, mask);
-        }
-        // The figures the paper validates fits with: lobes in the plane of incidence, NDF, Fresnel.
-        const HalfDiffTable table = load_table(source, o.bake.fit.merl_bins);
-        for (const auto& [file, svg] : material_figures(table, read_lut(lut))) write_file_atomic(image(file), svg);
-        stamp_complete(images, key, written);
-        report["materials"].push_back(entry);
-      }
+      what = report_material(o, source, luts, fitter, reusable, report) == MaterialRun::reused ? "reused" : "rendered";
     } catch (const Error& e) {
       report["failures"].push_back({{"source", source}, {"error", e.what()}});
+      what = "failed";
     }
-    if (o.progress) o.progress(name, ++done, mine.size());
+    if (o.progress) o.progress(name, what, ++done, mine.size());
   }
   summarize(report);
   judge_against_baseline(previous, report, o.accept);
@@ -536,10 +584,12 @@ json run_report(const ReportOptions& o) {
   return report;
 }
 
-json merge_reports(const std::vector<std::string>& parts, const std::string& out_dir, bool accept) {
-  // Every part is read and checked before anything is written: a refused merge leaves no output. No
-  // material may come from two parts (a shard given twice), and the shards of a K/N split must all be
-  // there; a farm's parts are whole reports of disjoint lists (1/1) and cannot be checked for that.
+namespace {
+
+// Every part of a merge, read and checked before anything is written: a refused merge leaves no output. No
+// material may come from two parts (a shard given twice), and the shards of a K/N split must all be there; a
+// farm's parts are whole reports of disjoint lists (1/1) and cannot be checked for that.
+std::vector<json> read_parts(const std::vector<std::string>& parts) {
   std::vector<json> reports;
   std::map<std::string, std::string> from_part;  // material name -> the part holding it
   std::map<int, std::vector<int>> shards_of;      // N -> the K given
@@ -572,14 +622,12 @@ json merge_reports(const std::vector<std::string>& parts, const std::string& out
       if (!std::binary_search(ks.begin(), ks.end(), k))
         fail(parts.front(), "shard " + std::to_string(k) + "/" + std::to_string(n) + " of its split is not among the parts");
   }
+  return reports;
+}
 
-  prepare_output_folder(out_dir);
-  const FolderLock lock = lock_report(out_dir);
-  const fs::path images = fs::path(out_dir) / "images";
-  for (const json& r : reports)
-    for (const json& m : r["materials"]) refuse_link(images / m["name"].get<std::string>());
+// The parts' entries and failures in one report, sorted by name, their images copied into `images`.
+json join_parts(const std::vector<json>& reports, const std::vector<std::string>& parts, const fs::path& images) {
   std::error_code ec;
-  const json previous = read_json_file((fs::path(out_dir) / "report.json").string());
   json merged;
   merged["materials"] = json::array();
   merged["failures"] = json::array();
@@ -598,6 +646,20 @@ json merge_reports(const std::vector<std::string>& parts, const std::string& out
   std::sort(merged["materials"].begin(), merged["materials"].end(),
             [](const json& a, const json& b) { return a["name"].get<std::string>() < b["name"].get<std::string>(); });
   merged["shard"] = "merged";
+  return merged;
+}
+
+}  // namespace
+
+json merge_reports(const std::vector<std::string>& parts, const std::string& out_dir, bool accept) {
+  const std::vector<json> reports = read_parts(parts);
+  prepare_output_folder(out_dir);
+  const FolderLock lock = lock_report(out_dir);
+  const fs::path images = fs::path(out_dir) / "images";
+  for (const json& r : reports)
+    for (const json& m : r["materials"]) refuse_link(images / m["name"].get<std::string>());
+  const json previous = read_json_file((fs::path(out_dir) / "report.json").string());
+  json merged = join_parts(reports, parts, images);
   summarize(merged);
   judge_against_baseline(previous, merged, accept);
   write_outputs(merged, out_dir);

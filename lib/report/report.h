@@ -31,7 +31,8 @@ struct ReportOptions {
   // through which Delta E is measured whatever the pictures show.
   std::shared_ptr<const DisplayTransform> pictures;
   std::string pictures_name;
-  std::function<void(const std::string& name, std::size_t done, std::size_t total)> progress;
+  // Called after each material: its name, what was done ("rendered", "reused" from the previous run, "failed").
+  std::function<void(const std::string& name, const std::string& what, std::size_t done, std::size_t total)> progress;
 };
 
 // The representations compared with the measurement, in report order.
