@@ -204,8 +204,10 @@ std::string time_error_plot(const json& report) {
   return svg.str();
 }
 
-std::string report_html(const json& report) {
-  std::ostringstream h;
+namespace {
+
+// The page's head and the run's settings.
+void html_head(std::ostream& h, const json& report) {
   h << "<!doctype html><html><head><meta charset='utf-8'><title>facetfit accuracy report</title><style>"
        "body{font-family:sans-serif;margin:2em}table{border-collapse:collapse}td,th{border:1px solid #ccc;padding:4px 8px}"
        "th{cursor:pointer;background:#eee}img{image-rendering:pixelated;width:96px;display:block}.bad{color:#b00}"
@@ -214,7 +216,12 @@ std::string report_html(const json& report) {
     << report["materials"].size() << " materials, " << report["settings"]["size"] << "&sup2; pixels, "
     << report["settings"]["spp"] << " spp. Mean CIE Delta E 2000 over the sphere between the render of the measurement "
     << "and of each representation, on the sRGB display of their Rec.709 colour (docs/colour.md). Pictures: "
-    << html_escape(report["settings"].value("pictures", std::string("the same sRGB display"))) << ".</p><h2>Database mean</h2><table><tr>";
+    << html_escape(report["settings"].value("pictures", std::string("the same sRGB display"))) << ".</p>";
+}
+
+// The database's mean Delta E and render time per representation.
+void html_database_mean(std::ostream& h, const json& report) {
+  h << "<h2>Database mean</h2><table><tr>";
   for (const std::string& r : report_representations()) h << "<th>" << r << "</th>";
   h << "<th></th></tr>";
   for (const auto& [key, label] : {std::pair{"database_mean_delta_e", "mean &Delta;E"}, {"database_mean_render_seconds", "mean render s"}}) {
@@ -226,6 +233,10 @@ std::string report_html(const json& report) {
     h << "<td>" << label << "</td></tr>";
   }
   h << "</table>";
+}
+
+// The judgement against the baseline (regressions, removed materials) and the worst materials.
+void html_judgement(std::ostream& h, const json& report) {
   const bool accepted = report.value("accepted", false);
   if (!report["regressions"].empty()) {
     h << "<h2 class='bad'>Regressions against the baseline" << (accepted ? " (accepted: the new baseline)" : "") << "</h2><ul>";
@@ -244,9 +255,12 @@ std::string report_html(const json& report) {
   for (const json& w : report["worst"])
     h << "<li>" << html_escape(w["name"].get<std::string>()) << ": " << two_decimals(w["delta_e"].get<double>()) << " ("
       << html_escape(w.value("representation", std::string())) << ")</li>";
-  h << "</ol><h2>Run time against error</h2>" << time_error_plot(report);
-  // One cell per representation: its Delta E (what a click on the header sorts by), its render and its
-  // Delta E map, so that the table fits a 1400-pixel window (tests/report/layout.sh).
+  h << "</ol>";
+}
+
+// One row per material. One cell per representation: its Delta E (what a click on the header sorts by), its
+// render and its Delta E map, so that the table fits a 1400-pixel window (tests/report/layout.sh).
+void html_material_table(std::ostream& h, const json& report) {
   h << "<h2>Materials</h2><p>Click a column header to sort. Each representation: mean &Delta;E, render, &Delta;E map "
     << heatmap_scale() << "</p><table id='t'><tr><th>material</th><th>recommended</th><th>bake s</th><th>measured</th>";
   for (const std::string& r : report_representations()) h << "<th>" << r << "</th>";
@@ -261,7 +275,10 @@ std::string report_html(const json& report) {
     h << "</tr>";
   }
   h << "</table>";
-  // Per material: the BRDF in the plane of incidence (measured solid, fits dashed), NDF, Fresnel.
+}
+
+// Per material: the BRDF in the plane of incidence (measured solid, fits dashed), NDF, Fresnel.
+void html_figures(std::ostream& h, const json& report) {
   h << "<h2>Lobes, NDF and Fresnel</h2>";
   for (const json& m : report["materials"]) {
     h << "<h3>" << html_escape(m["name"].get<std::string>()) << "</h3><p>";
@@ -269,7 +286,10 @@ std::string report_html(const json& report) {
       h << "<img style='width:360px;image-rendering:auto' src='images/" << url_segment(m["name"].get<std::string>()) << "/" << f << ".svg'>";
     h << "</p>";
   }
-  // Implausible measurements and fits (fit/plausibility.h), per material.
+}
+
+// Implausible measurements and fits (fit/plausibility.h) per material, and the materials that failed.
+void html_warnings_and_failures(std::ostream& h, const json& report) {
   bool any_warning = false;
   for (const json& m : report["materials"])
     for (const json& w : m.value("warnings", json::array())) {
@@ -283,11 +303,29 @@ std::string report_html(const json& report) {
     for (const json& f : report["failures"]) h << "<li>" << html_escape(f["error"].get<std::string>()) << "</li>";
     h << "</ul>";
   }
+}
+
+// The heat maps' legend and the script sorting the material table by a clicked column.
+void html_tail(std::ostream& h) {
   h << "<p>Heatmaps: Delta E 2000 from 0 (dark) to 10 (bright), see docs/colour.md.</p>"
        "<script>document.querySelectorAll('#t th').forEach((th,c)=>th.onclick=()=>{const t=th.closest('table');"
        "const rows=[...t.rows].slice(1);const num=v=>{const x=parseFloat(v);return isNaN(x)?v:x};"
        "const dir=th.dataset.dir=th.dataset.dir==='1'?'-1':'1';rows.sort((a,b)=>{const x=num(a.cells[c].innerText),"
        "y=num(b.cells[c].innerText);return (x>y?1:x<y?-1:0)*dir});rows.forEach(r=>t.appendChild(r))});</script></body></html>";
+}
+
+}  // namespace
+
+std::string report_html(const json& report) {
+  std::ostringstream h;
+  html_head(h, report);
+  html_database_mean(h, report);
+  html_judgement(h, report);
+  h << "<h2>Run time against error</h2>" << time_error_plot(report);
+  html_material_table(h, report);
+  html_figures(h, report);
+  html_warnings_and_failures(h, report);
+  html_tail(h);
   return h.str();
 }
 
