@@ -252,38 +252,11 @@ void Fitter::fit_anisotropic_lobes(const HalfDiffTable& table, const FresnelCurv
   a.refined = true;
 }
 
-FitResult Fitter::fit(const HalfDiffTable& table) const {
-  FitResult result;
-  result.smith = options_.smith;
-  result.extraction = extract_ndf(backscatter_of(table), quadrature_,
-                                  {options_.smith, options_.tolerance, options_.max_iterations});
-  result.lobe.ndf = result.extraction.ndf;
-  if (!result.extraction.problem.empty()) {
-    result.problem = result.extraction.problem;
-    return result;
-  }
-  const auto fresnel = fit_fresnel(table, result.ndf(), options_.smith);
-  if (!fresnel) {
-    result.problem = "no measurement where the microfacet model is nonzero (all missing?)";
-    return result;
-  }
-  result.lobe.fresnel = *fresnel;
-  const FresnelCurve paper_fresnel = *fresnel;  // the anisotropic lobe's: the refinement is isotropic
+namespace {
 
-  const bool refine = options_.refine == FitOptions::Refine::full;
-  result.refined = refine;
-  result.alpha_ggx = alpha_ggx_from_moments(result.ndf(), quadrature_);
-  result.alpha_beckmann = alpha_beckmann_from_moments(result.ndf(), quadrature_);
-  if (!(result.alpha_ggx > 0.0) || !(result.alpha_beckmann > 0.0)) {
-    // E|x| and E[x^2] of a distribution of slopes are positive; on a grid too coarse for a narrow lobe
-    // the quadrature's are not (the built-in aluminium's E|x| was negative with 5 or 6 intervals).
-    result.problem = "the extracted NDF's slope moments are not positive (alpha_ggx " + std::to_string(result.alpha_ggx) +
-                     ", alpha_beckmann " + std::to_string(result.alpha_beckmann) + ") at resolution " +
-                     std::to_string(options_.resolution) + ": raise --resolution";
-    return result;
-  }
-  // The parametric representations of the paper's method: the moment alphas with the extraction's
-  // Fresnel at 0 and 82 degrees (Schlick's for lsq), no body.
+// The parametric representations of the paper's method: the moment alphas with the extraction's Fresnel at
+// 0 and 82 degrees (Schlick's for lsq), no body; and the closures of the GGX one.
+void moment_fits(FitResult& result) {
   const std::pair<Rgb, Rgb> reflectance = f0_f82_of(result.fresnel());
   const Rgb &f0 = reflectance.first, &f82 = reflectance.second;
   const auto moments = [&](NdfType type, double alpha, ParametricFit::FresnelForm form) {
@@ -299,49 +272,90 @@ FitResult Fitter::fit(const HalfDiffTable& table) const {
   result.beckmann = moments(NdfType::beckmann, result.alpha_beckmann, ParametricFit::FresnelForm::f82);
   result.lsq = moments(NdfType::ggx, result.alpha_ggx, ParametricFit::FresnelForm::schlick);
   result.closures.closures = closures_of(result.ggx);
-  if (refine)
+}
+
+// Why the moment alphas cannot be used, or empty. E|x| and E[x^2] of a distribution of slopes are positive;
+// on a grid too coarse for a narrow lobe the quadrature's are not (the built-in aluminium's E|x| was negative
+// with 5 or 6 intervals).
+std::string moments_problem(const FitResult& result, int resolution) {
+  if (result.alpha_ggx > 0.0 && result.alpha_beckmann > 0.0) return {};
+  return "the extracted NDF's slope moments are not positive (alpha_ggx " + std::to_string(result.alpha_ggx) + ", alpha_beckmann " +
+         std::to_string(result.alpha_beckmann) + ") at resolution " + std::to_string(resolution) + ": raise --resolution";
+}
+
+bool finite(const Rgb& c) { return std::isfinite(c.r) && std::isfinite(c.g) && std::isfinite(c.b); }
+
+}  // namespace
+
+FitResult Fitter::fit(const HalfDiffTable& table) const {
+  // The paper's method: the NDF by power iteration on the back-scattering, then the Fresnel curve.
+  FitResult result;
+  result.smith = options_.smith;
+  result.extraction = extract_ndf(backscatter_of(table), quadrature_, {options_.smith, options_.tolerance, options_.max_iterations});
+  result.lobe.ndf = result.extraction.ndf;
+  if (!result.extraction.problem.empty()) {
+    result.problem = result.extraction.problem;
+    return result;
+  }
+  const auto fresnel = fit_fresnel(table, result.ndf(), options_.smith);
+  if (!fresnel) {
+    result.problem = "no measurement where the microfacet model is nonzero (all missing?)";
+    return result;
+  }
+  result.lobe.fresnel = *fresnel;
+
+  // The parametric fits from the NDF's moments, then refined on the whole measurement (or measured as they are).
+  result.refined = options_.refine == FitOptions::Refine::full;
+  result.alpha_ggx = alpha_ggx_from_moments(result.ndf(), quadrature_);
+  result.alpha_beckmann = alpha_beckmann_from_moments(result.ndf(), quadrature_);
+  result.problem = moments_problem(result, options_.resolution);
+  if (!result.ok()) return result;
+  moment_fits(result);
+  if (result.refined)
     refine_on_measurement(table, result);
   else
     measure_paper_fits(table, result);
   result.f0 = result.fresnel().value[0];
   result.f82 = result.fresnel().eval(f82_theta());
 
-  const auto finite = [](const Rgb& c) { return std::isfinite(c.r) && std::isfinite(c.g) && std::isfinite(c.b); };
-  if (!std::isfinite(result.alpha_ggx) || !std::isfinite(result.alpha_beckmann) || !finite(result.f0) ||
-      !finite(result.f82) || !finite(result.body()))
+  if (!std::isfinite(result.alpha_ggx) || !std::isfinite(result.alpha_beckmann) || !finite(result.f0) || !finite(result.f82) ||
+      !finite(result.body()))
     result.problem = "the fit produced non-finite parameters";
   if (result.ok()) result.warnings = plausibility_warnings(table, result);
-  if (result.ok() && table.source_backscatter().azimuths > 1) {
-    // The same power iteration with the azimuth kept, on the source's own azimuths (6 ms at 90 x 48). Its
-    // back-scattering has six polar angles: 90 intervals are plenty (the UTIA bar holds there), and a
-    // finer isotropic --resolution would cost the 2D quadrature (J^2 M doubles) gigabytes.
-    const BackscatterLattice& lattice = table.source_backscatter();
-    const Quadrature2D quadrature(std::min(options_.resolution, 90), lattice.azimuths);
-    const Extraction2D e = extract_ndf_2d(backscatter_2d(lattice, quadrature), quadrature,
-                                          {options_.smith, options_.tolerance, options_.max_iterations});
-    if (e.problem.empty()) {
-      AnisotropicFit a;
-      a.alpha_ggx = alpha_ggx_2d(e.ndf, quadrature);
-      a.alpha_beckmann = alpha_beckmann_2d(e.ndf, quadrature);
-      a.iterations = e.iterations;
-      a.residual = e.residual;
-      a.tables = AnisotropicTables{quadrature.grid(), quadrature.phi_count(), e.ndf, e.sigma, options_.smith, paper_fresnel};
-      fit_anisotropic_lobes(table, paper_fresnel, result, a);
-      a.tables.axis = a.ggx.alpha.angle;
-      result.closures = {closures_of(a.ggx), a.ggx.error};
-      result.anisotropic = a;
-      // Anisotropic beyond what the 15-degree grid resolves (a 10% ratio): say what an isotropic LUT loses.
-      if (a.alpha_ggx.alpha_x > 1.1 * a.alpha_ggx.alpha_y) {
-        char text[200];
-        std::snprintf(text, sizeof text, "anisotropic (GGX %.3f x %.3f, x axis at %.0f degrees): the isotropic fits are of its azimuthal mean",
-                      a.alpha_ggx.alpha_x, a.alpha_ggx.alpha_y, a.alpha_ggx.angle * 180.0 / kPi);
-        result.warnings.push_back(text);
-      }
-    } else {
-      result.warnings.push_back("no anisotropic fit: " + e.problem);
-    }
-  }
+  if (result.ok() && table.source_backscatter().azimuths > 1) fit_anisotropic(table, *fresnel, result);
   return result;
+}
+
+void Fitter::fit_anisotropic(const HalfDiffTable& table, const FresnelCurve& paper_fresnel, FitResult& result) const {
+  // The same power iteration with the azimuth kept, on the source's own azimuths (6 ms at 90 x 48). Its
+  // back-scattering has six polar angles: 90 intervals are plenty (the UTIA bar holds there), and a finer
+  // isotropic --resolution would cost the 2D quadrature (J^2 M doubles) gigabytes. The lobe's Fresnel is the
+  // paper's: the refinement is isotropic.
+  const BackscatterLattice& lattice = table.source_backscatter();
+  const Quadrature2D quadrature(std::min(options_.resolution, 90), lattice.azimuths);
+  const Extraction2D e = extract_ndf_2d(backscatter_2d(lattice, quadrature), quadrature,
+                                        {options_.smith, options_.tolerance, options_.max_iterations});
+  if (!e.problem.empty()) {
+    result.warnings.push_back("no anisotropic fit: " + e.problem);
+    return;
+  }
+  AnisotropicFit a;
+  a.alpha_ggx = alpha_ggx_2d(e.ndf, quadrature);
+  a.alpha_beckmann = alpha_beckmann_2d(e.ndf, quadrature);
+  a.iterations = e.iterations;
+  a.residual = e.residual;
+  a.tables = AnisotropicTables{quadrature.grid(), quadrature.phi_count(), e.ndf, e.sigma, options_.smith, paper_fresnel};
+  fit_anisotropic_lobes(table, paper_fresnel, result, a);
+  a.tables.axis = a.ggx.alpha.angle;
+  result.closures = {closures_of(a.ggx), a.ggx.error};
+  result.anisotropic = a;
+  // Anisotropic beyond what the 15-degree grid resolves (a 10% ratio): say what an isotropic LUT loses.
+  if (a.alpha_ggx.alpha_x > 1.1 * a.alpha_ggx.alpha_y) {
+    char text[200];
+    std::snprintf(text, sizeof text, "anisotropic (GGX %.3f x %.3f, x axis at %.0f degrees): the isotropic fits are of its azimuthal mean",
+                  a.alpha_ggx.alpha_x, a.alpha_ggx.alpha_y, a.alpha_ggx.angle * 180.0 / kPi);
+    result.warnings.push_back(text);
+  }
 }
 
 }  // namespace facetfit

@@ -131,6 +131,8 @@ class Fitter {
   void refine_on_measurement(const HalfDiffTable& table, FitResult& result) const;
   // --refine none: the distances of the paper's representations from the measurement.
   void measure_paper_fits(const HalfDiffTable& table, FitResult& result) const;
+  // Sources with azimuths (UTIA): the 2D extraction, its lobes and closures, into result.anisotropic.
+  void fit_anisotropic(const HalfDiffTable& table, const FresnelCurve& paper_fresnel, FitResult& result) const;
   // The anisotropic GGX and Beckmann lobes of `a` (AnisotropicFit::ggx, beckmann) from its moment alphas.
   void fit_anisotropic_lobes(const HalfDiffTable& table, const FresnelCurve& paper_fresnel, const FitResult& result, AnisotropicFit& a) const;
 
