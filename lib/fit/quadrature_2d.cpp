@@ -37,6 +37,24 @@ double clipped_antiderivative(double a, double b, double phi_max, double sin_max
   return x < phi_max ? a * sin_x + b * x : a * sin_max + b * phi_max;
 }
 
+// The azimuthal bins' integrals of max(0, k.h) (cp) and of k.h (cl), k.h = a cos(delta phi) + b, over bins
+// d = 0..M/2 with upper edges `edge` (and their sines); the bin centred on pi counts twice (the kernel is even).
+void bin_integrals(double a, double b, const std::vector<double>& edge, const std::vector<double>& edge_sin, int m,
+                   std::vector<double>& cp, std::vector<double>& cl) {
+  const double phi_max = a <= b ? kPi : std::acos(-b / a);
+  const double sin_max = a <= b ? 0.0 : std::sqrt(std::max(0.0, 1.0 - (b / a) * (b / a)));
+  double g_lo = 0.0, lin_lo = 0.0;  // both antiderivatives at the lower edge of bin d
+  for (std::size_t d = 0; d < edge.size(); ++d) {
+    const double g = clipped_antiderivative(a, b, phi_max, sin_max, edge[d], edge_sin[d]);
+    const double l = a * edge_sin[d] + b * edge[d];
+    if (d == 0) g_lo = -g, lin_lo = -l;
+    const double twice = 2 * int(d) == m ? 2.0 : 1.0;
+    cp[d] = twice * (g - g_lo);
+    cl[d] = twice * (l - lin_lo);
+    g_lo = g, lin_lo = l;
+  }
+}
+
 // Integral of |cos(t)| dt from -pi/2 to x: 2 per half period, 1 - cos within one.
 double abs_cos_antiderivative(double x) {
   const double y = x + 0.5 * kPi, n = std::floor(y / kPi);
@@ -55,6 +73,18 @@ struct Quadrature2D::Plans {
   }
 };
 
+// FFTW's plans of the n transforms of length m (f frequencies each), forward and back; planning is not
+// thread-safe.
+std::unique_ptr<Quadrature2D::Plans> Quadrature2D::plan_transforms(int n, int m, int f) {
+  std::lock_guard<std::mutex> lock(planner_mutex());
+  auto plans = std::make_unique<Plans>();
+  FftwBuffer real(sizeof(double) * std::size_t(n) * m), spectrum(sizeof(fftw_complex) * std::size_t(n) * f);
+  plans->forward = fftw_plan_many_dft_r2c(1, &m, n, real.real(), nullptr, 1, m, spectrum.complex(), nullptr, 1, f, FFTW_ESTIMATE);
+  plans->backward = fftw_plan_many_dft_c2r(1, &m, n, spectrum.complex(), nullptr, 1, f, real.real(), nullptr, 1, m, FFTW_ESTIMATE);
+  if (!plans->forward || !plans->backward) throw Error("fftw: cannot plan a transform of " + std::to_string(m));
+  return plans;
+}
+
 double Quadrature2D::phi(int m) const { return 2.0 * kPi * m / phi_count_; }
 
 Quadrature2D::Quadrature2D(int resolution, int phi_count) : base_(resolution), phi_count_(phi_count) {
@@ -64,16 +94,7 @@ Quadrature2D::Quadrature2D(int resolution, int phi_count) : base_(resolution), p
   const double bin = 2.0 * kPi / m;
   const std::vector<Quadrature::Node>& nodes = base_.nodes();
 
-  {
-    std::lock_guard<std::mutex> lock(planner_mutex());
-    plans_ = std::make_unique<Plans>();
-    FftwBuffer real(sizeof(double) * std::size_t(n) * m), spectrum(sizeof(fftw_complex) * std::size_t(n) * f);
-    plans_->forward = fftw_plan_many_dft_r2c(1, &phi_count_, n, real.real(), nullptr, 1, m, spectrum.complex(), nullptr, 1, f,
-                                             FFTW_ESTIMATE);
-    plans_->backward = fftw_plan_many_dft_c2r(1, &phi_count_, n, spectrum.complex(), nullptr, 1, f, real.real(), nullptr, 1, m,
-                                              FFTW_ESTIMATE);
-    if (!plans_->forward || !plans_->backward) throw Error("fftw: cannot plan a transform of " + std::to_string(m));
-  }
+  plans_ = plan_transforms(n, m, f);
 
   // K_kj(delta) for delta = 0..M/2 (even in delta), from the theta nodes' azimuthal bin integrals of the
   // kernel, spread onto the grid nodes like the isotropic weights; then each K_kj's spectrum.
@@ -91,19 +112,7 @@ Quadrature2D::Quadrature2D(int resolution, int phi_count) : base_(resolution), p
     std::vector<double> pos(std::size_t(n) * m, 0.0), lin(std::size_t(n) * m, 0.0), cp(edge.size()), cl(edge.size());
     for (const Quadrature::Node& node : nodes) {
       const double s = std::sin(node.theta), c = std::cos(node.theta);
-      const double a = sk * s, b = ck * c;  // k.h = a cos(delta phi) + b
-      const double phi_max = a <= b ? kPi : std::acos(-b / a);
-      const double sin_max = a <= b ? 0.0 : std::sqrt(std::max(0.0, 1.0 - (b / a) * (b / a)));
-      double g_lo = 0.0, lin_lo = 0.0;  // both antiderivatives at the lower edge of bin d
-      for (std::size_t d = 0; d < edge.size(); ++d) {
-        const double g = clipped_antiderivative(a, b, phi_max, sin_max, edge[d], edge_sin[d]);
-        const double l = a * edge_sin[d] + b * edge[d];
-        if (d == 0) g_lo = -g, lin_lo = -l;
-        const double twice = 2 * int(d) == m ? 2.0 : 1.0;
-        cp[d] = twice * (g - g_lo);
-        cl[d] = twice * (l - lin_lo);
-        g_lo = g, lin_lo = l;
-      }
+      bin_integrals(sk * s, ck * c, edge, edge_sin, m, cp, cl);  // k.h = a cos(delta phi) + b
       const ThetaGrid::Stencil st = grid().stencil(node.interval, node.t);
       for (int q = 0; q < 4; ++q) {
         const double w = st.weight[q] * s * node.weight;

@@ -56,6 +56,7 @@ class Quadrature2D {
   int phi_count_;
   std::vector<double> positive_, absolute_;
   struct Plans;
+  static std::unique_ptr<Plans> plan_transforms(int n, int m, int f);
   std::unique_ptr<Plans> plans_;
 };
 
