@@ -88,6 +88,61 @@ void check_outputs_spare_inputs(const std::vector<std::pair<std::string, std::st
       if (!path.empty() && file_key(path) == file_key(input)) fail(path, flag + " would overwrite an input of the scene");
 }
 
+// The removal of a temporary folder when it goes out of scope.
+using TemporaryFolder = std::unique_ptr<fs::path, void (*)(fs::path*)>;
+
+TemporaryFolder no_temporary_folder() {
+  return TemporaryFolder(nullptr, [](fs::path* p) {
+    std::error_code ec;
+    fs::remove_all(*p, ec);
+    delete p;
+  });
+}
+
+// The scene: the given file, or the embedded default around --material. A measurement rendered as one of the
+// LUT's representations is baked first, into a temporary folder (`baked_dir`, removed by its owner).
+SceneDesc render_scene(const RenderArgs& args, TemporaryFolder& baked_dir) {
+  if (!args.scene.empty()) return parse_scene(args.scene);
+  MaterialDesc subject;
+  subject.type = args.material_type;
+  subject.file = args.material;
+  if (find_material_type(subject.type)->reads_lut && fs::path(subject.file).extension() != ".exr") {
+    baked_dir.reset(new fs::path(fs::temp_directory_path() / ("facetfit-render-" + std::to_string(::getpid()))));
+    fs::create_directories(*baked_dir);
+    const BakeOptions bake_options;
+    const BakeOutcome baked = bake_material(subject.file, "subject", baked_dir->string(), bake_options, Fitter(bake_options.fit));
+    if (baked.status == BakeOutcome::Status::failed) throw Error(baked.error);
+    subject.file = (*baked_dir / "subject.exr").string();
+  }
+  return default_scene(subject);
+}
+
+// The built-in sky as a lat-long EXR, for other renderers.
+void save_sky(const std::string& path) {
+  const Environment sky = Environment::sky();
+  RenderedImage img;
+  img.width = sky.width();
+  img.height = sky.height();
+  for (std::size_t p = 0; p < sky.pixels().size() / 3; ++p)
+    img.rgba.insert(img.rgba.end(), {sky.pixels()[3 * p], sky.pixels()[3 * p + 1], sky.pixels()[3 * p + 2], 1.0f});
+  write_exr(path, img, {{"environment", "builtin sky"}});
+}
+
+// Samples, seed and memory from the command line; progress as a line redrawn on a terminal, with -v one line
+// per pass anywhere, nothing with -q.
+RenderSettings render_settings(const RenderArgs& args, const Context& ctx) {
+  RenderSettings settings;
+  settings.spp = args.spp;
+  settings.seed = args.seed;
+  settings.max_memory = args.max_memory;
+  const bool tty = ::isatty(STDERR_FILENO) == 1 && !ctx.quiet(), lines = ctx.verbose();
+  settings.progress = [tty, lines](int done, int total) {
+    if (lines) std::fprintf(stderr, "facetfit: render: pass %d/%d\n", done, total);
+    else if (tty) std::fprintf(stderr, "\rrendering: pass %d/%d%s", done, total, done == total ? "\n" : "");
+  };
+  return settings;
+}
+
 void run_render(const RenderArgs& args, Context& ctx) {
   int& status = ctx.status;
   try {
@@ -100,53 +155,15 @@ void run_render(const RenderArgs& args, Context& ctx) {
     std::optional<DisplayTransform> pictures;
     if (!args.png.empty() || !args.color.display.empty() || !args.color.view.empty())
       pictures.emplace(args.color.pictures(config, args.color.working_space, from_rec709));
-    SceneDesc scene;
-    // A measurement rendered as one of the LUT's representations is baked first, into a temporary folder.
-    std::unique_ptr<fs::path, void (*)(fs::path*)> baked_dir(nullptr, [](fs::path* p) {
-      std::error_code ec;
-      fs::remove_all(*p, ec);
-      delete p;
-    });
-    if (args.scene.empty()) {
-      MaterialDesc subject;
-      subject.type = args.material_type;
-      subject.file = args.material;
-      if (find_material_type(subject.type)->reads_lut && fs::path(subject.file).extension() != ".exr") {
-        baked_dir.reset(new fs::path(fs::temp_directory_path() / ("facetfit-render-" + std::to_string(::getpid()))));
-        fs::create_directories(*baked_dir);
-        const BakeOptions bake_options;
-        const BakeOutcome baked = bake_material(subject.file, "subject", baked_dir->string(), bake_options, Fitter(bake_options.fit));
-        if (baked.status == BakeOutcome::Status::failed) throw Error(baked.error);
-        subject.file = (*baked_dir / "subject.exr").string();
-      }
-      scene = default_scene(subject);
-    } else {
-      scene = parse_scene(args.scene);
-    }
+    TemporaryFolder baked_dir = no_temporary_folder();
+    SceneDesc scene = render_scene(args, baked_dir);
     check_outputs_spare_inputs(outputs, scene, args.scene);
-    if (!args.save_sky.empty()) {  // the built-in sky as a lat-long EXR, for other renderers
-      const Environment sky = Environment::sky();
-      RenderedImage img;
-      img.width = sky.width();
-      img.height = sky.height();
-      for (std::size_t p = 0; p < sky.pixels().size() / 3; ++p)
-        img.rgba.insert(img.rgba.end(), {sky.pixels()[3 * p], sky.pixels()[3 * p + 1], sky.pixels()[3 * p + 2], 1.0f});
-      write_exr(args.save_sky, img, {{"environment", "builtin sky"}});
-    }
+    if (!args.save_sky.empty()) save_sky(args.save_sky);
     scene.working_space = args.color.working_space;
     scene.from_rec709 = from_rec709;
     if (args.width > 0) scene.camera.width = args.width;
     if (args.height > 0) scene.camera.height = args.height;
-    RenderSettings settings;
-    settings.spp = args.spp;
-    settings.seed = args.seed;
-    settings.max_memory = args.max_memory;
-    // A line redrawn on a terminal; with -v one line per pass anywhere; nothing with -q.
-    const bool tty = ::isatty(STDERR_FILENO) == 1 && !ctx.quiet(), lines = ctx.verbose();
-    settings.progress = [tty, lines](int done, int total) {
-      if (lines) std::fprintf(stderr, "facetfit: render: pass %d/%d\n", done, total);
-      else if (tty) std::fprintf(stderr, "\rrendering: pass %d/%d%s", done, total, done == total ? "\n" : "");
-    };
+    const RenderSettings settings = render_settings(args, ctx);
     if (ctx.verbose())
       std::fprintf(stderr, "facetfit: render: %dx%d, %zu objects, %zu lights, threads %zu\n", scene.camera.width, scene.camera.height,
                    scene.objects.size(), scene.lights.size(),
