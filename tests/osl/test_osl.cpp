@@ -728,7 +728,7 @@ TEST_F(OslSphere, StretchedPreviewMatchesReference) {
                    "lut=" + lut + " environment_map=" + work_->file("sky.exr") + " samples=" + std::to_string(kSamples) +
                        " roughness_scale_x=3.0 roughness_scale_y=0.5 rotation=30.0 tangent=0,0,1"});
   // The material shader's closure with its alphas scaled: for a GGX material the stretched tabulated lobe
-  // is the anisotropic GGX (tests/test_stretch.cpp), so the same reference holds, F82-tint against the curve.
+  // is the anisotropic GGX (tests/model/test_stretch.cpp), so the same reference holds, F82-tint against the curve.
   cases.push_back({"gold-ggx-0.15-stretched", "material stretched (3, 0.5) at 30 degrees", reference, 4096, "facetfit_material", 512,
                    "lut=" + lut + " roughness_scale_x=3.0 roughness_scale_y=0.5 rotation=30.0 tangent=0,0,1"});
   check_spheres(cases, "stretched");

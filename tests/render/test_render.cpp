@@ -1214,7 +1214,7 @@ TEST(Render, MeasuredMaterialSampledByAGivenLutRendersTheSameImage) {
 }
 
 TEST(Render, StretchedLutMaterials) {
-  // The scene's stretch reaches the model (tests/test_stretch.cpp checks the model against the analytic
+  // The scene's stretch reaches the model (tests/model/test_stretch.cpp checks the model against the analytic
   // anisotropic GGX): the identity renders the LUT as it is, a stretch changes the image, and bad values
   // get one line.
   test::TempDir dir;
@@ -1386,7 +1386,7 @@ TEST(Render, AnisotropicLutRendersNearerItsMeasurementThanTheIsotropicLobe) {
   EXPECT_LT(anisotropic, 0.5 * turned);
   EXPECT_LT(ggx, 0.5 * ggx_isotropic);
   // The artist's stretch reshapes the anisotropic lobe too (the lobe's own test: model/tabulated_anisotropic.h,
-  // tests/test_anisotropic.cpp), uniformly or from a texture: a uniform texture (2, 0.5) times (1.5, 1) is
+  // tests/model/test_anisotropic.cpp), uniformly or from a texture: a uniform texture (2, 0.5) times (1.5, 1) is
   // (3, 0.5) everywhere, sample for sample.
   write_texture(dir.file("uniform.exr"), 4, 2, [](int, int) { return Rgb(2.0, 0.5, 7.0); });
   const auto quick = [&](const std::string& material) { return sphere_under_sky(dir, material, 24, 8); };
