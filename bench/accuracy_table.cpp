@@ -46,7 +46,7 @@ void ground_truth_section(std::ostringstream& md) {
   md << "## Ground truth: analytic materials through the MERL writer\n\n"
         "Each material is GGX or Beckmann with gold's conductor Fresnel, made with the Smith model in the "
         "first column, written as a MERL `.binary`, read back and fitted with the matching `--smith` at "
-        "resolution 90. Bars (tests/test_accuracy.cpp): alpha within 0.5% (1.5% at 0.02), D within 1% "
+        "resolution 90. Bars (tests/fit/test_accuracy.cpp): alpha within 0.5% (1.5% at 0.02), D within 1% "
         "relative L1 weighted by projected area, Fresnel within 0.005 for theta_d <= 80 degrees.\n\n"
         "| NDF | smith | alpha | fitted alpha | alpha error | D L1 error | max Fresnel error | iterations |\n"
         "|---|---|---|---|---|---|---|---|\n";
@@ -103,11 +103,11 @@ void anisotropic_section(std::ostringstream& md, const std::string& scratch) {
         "Analytic NDFs with F = 1 and their axes turned (fit/extract_2d.h, tests/support/ground_truth.h): principal "
         "alphas, angle and D (projected-area weighted relative L1 at the grid's nodes) from the back-scattering. Dense: "
         "the analytic back-scattering at MERL's 90 theta_h bins on a 90 x 64 grid, bars 1% and 0.5 degree "
-        "(tests/test_extract_2d.cpp). UTIA: written by facetfit's UTIA writer and read back, six polar angles 15 degrees "
-        "apart, masking form, 90 x 48 grid, bar 3% for alpha >= 0.2 (tests/test_utia.cpp). RGL: the dense cases written "
+        "(tests/fit/test_extract_2d.cpp). UTIA: written by facetfit's UTIA writer and read back, six polar angles 15 degrees "
+        "apart, masking form, 90 x 48 grid, bar 3% for alpha >= 0.2 (tests/io/test_utia.cpp). RGL: the dense cases written "
         "as an anisotropic RGL tensor file by the tests' writer (tests/support/tensor_file.h: 25 x 48 slices, 64 x 64 RGB "
         "nodes warped toward grazing half vectors) and read back through the file's evaluation at 90 polar angles x 64 "
-        "azimuths, bar 1% (tests/test_rgl.cpp). The writer's resolution near grazing decides GGX, whose long tail weighs "
+        "azimuths, bar 1% (tests/io/test_rgl.cpp). The writer's resolution near grazing decides GGX, whose long tail weighs "
         "grazing back-scattering: on an unwarped 64-node square with 32 slices it came back 1.4-3.2% low.\n\n"
         "| input | NDF | smith | alpha_x, alpha_y, angle | fitted | alpha_x error | alpha_y error | angle error | D L1 |\n"
         "|---|---|---|---|---|---|---|---|---|\n";
@@ -131,7 +131,7 @@ void utia_fit_section(std::ostringstream& md, const std::string& scratch) {
         "GGX written by facetfit's UTIA writer (Schlick Fresnel), read as `fit` reads a `.bin` file: the isotropic "
         "fit of its azimuthal mean, back-scattering from the file's six diagonal polar angles (`lattice`) or from "
         "the mean's table between them (`table`, for comparison), and the 2D extraction's principal alphas and "
-        "angle (tests/test_accuracy.cpp, Utia.LoadsAsItsAzimuthalMeanForTheIsotropicFit).\n\n"
+        "angle (tests/fit/test_accuracy.cpp, Utia.LoadsAsItsAzimuthalMeanForTheIsotropicFit).\n\n"
         "| written | smith | isotropic alpha_ggx: lattice | table | anisotropic: alpha_x, alpha_y, angle |\n"
         "|---|---|---|---|---|\n";
   struct Case {
@@ -165,7 +165,7 @@ void anisotropic_lobe_section(std::ostringstream& md, const std::string& scratch
         "tensor writer (F = 1, no body: the format stores a microfacet lobe): the 2D extraction's moment estimates "
         "(no body: a body broadens them) and the anisotropic GGX lobe with a body and F82-tint Fresnel fitted on the "
         "file: a UTIA file at its node pairs, an RGL file on a half/difference lattice read through its evaluation "
-        "(docs/conventions.md). Height-correlated Smith (tests/test_refine.cpp).\n\n"
+        "(docs/conventions.md). Height-correlated Smith (tests/fit/test_refine.cpp).\n\n"
         "| file | written: GGX alpha_x, alpha_y, angle; body; f0 | moments: alpha_x, alpha_y, angle | fitted: alpha_x, alpha_y, angle | body | f0 | distance |\n"
         "|---|---|---|---|---|---|---|\n";
   FitOptions options;

@@ -58,7 +58,7 @@ int facetfit_representation_code(string file) { return facetfit_code(file, "repr
 // OSL renderers may compile acos, atan2, sin and cos to fast approximations (Cycles' OSL: acos off by up
 // to 9e-5 rad, cos by 6e-6), too coarse for the grid near the normal, where the first interval spans
 // 1.9e-4 rad. These use only +, *, / and sqrt; they agree with the C++ library's double maths to float
-// precision (tests/test_osl.cpp).
+// precision (tests/osl/test_osl_model.cpp).
 
 // atan(x) for x in [0, 1]: Abramowitz & Stegun 4.4.49, |error| <= 2e-8.
 float facetfit_atan_unit(float x) {

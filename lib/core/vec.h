@@ -38,7 +38,7 @@ inline bool above_horizon(const Vec3& o, const Vec3& i) { return above_horizon(o
 
 inline double clamp(double x, double lo, double hi) { return x < lo ? lo : (x > hi ? hi : x); }
 
-// The cube root, within 1e-15 relative of std::cbrt for normal numbers (tests/test_models.cpp) at 2.5x
+// The cube root, within 1e-15 relative of std::cbrt for normal numbers (tests/model/test_models.cpp) at 2.5x
 // its speed: glibc's calls frexp and scalbn out of line. A first guess from the exponent's bits divided
 // by three (within 6%), two Halley steps y (y^3 + 2x) / (2y^3 + x) (cubic: 1e-4, then 1e-12), one Newton
 // step for the last digits. Zero, infinities and NaN come back as they are, negative x as -cbrt(-x).

@@ -68,7 +68,7 @@ Rgb closure_albedo(const Closures& closures, double cos_o);
 double closure_error(const MeasuredBins& bins, const Closures& closures);
 
 // The largest relative difference, over `bins` and where given the albedo's residuals, between the fit's
-// hand-written derivatives and central differences at `at` (isotropic lobes): tests/test_closures.cpp's check.
+// hand-written derivatives and central differences at `at` (isotropic lobes): tests/fit/test_closures.cpp's check.
 double closure_jacobian_error(const MeasuredBins& bins, const Closures& at, const AlbedoTarget* albedo = nullptr);
 
 }  // namespace facetfit

@@ -22,7 +22,7 @@ std::vector<double> kernel_factor(const Backscatter& back, const ThetaGrid& grid
   // through the logarithm against theta, in which a lobe's fall over orders of magnitude is smooth and even
   // about the normal; through the values against u it overshoots between samples a lobe apart. On GGX and
   // Beckmann written as UTIA files the principal alphas come back within 1.9% down to alpha 0.2 this way,
-  // against 7% through the values (tests/test_utia.cpp). Dense samples (MERL's 90) keep the values in u.
+  // against 7% through the values (tests/io/test_utia.cpp). Dense samples (MERL's 90) keep the values in u.
   std::vector<double> us(m), qs(m), slope(m);
   for (std::size_t t = 0; t < m; ++t) qs[t] = back.value[t] * (times_cos ? std::cos(back.theta[t]) : 1.0);
   const double peak = *std::max_element(qs.begin(), qs.end());

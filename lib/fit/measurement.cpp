@@ -65,7 +65,7 @@ void normalize_weights(MeasuredBins& bins, double total) {
 // 1/stride of the range), not every stride-th: a source's samples come in nested loops over its nodes,
 // whose periods every stride-th would alias with (of a UTIA file's 48 azimuths, a stride of 24 keeps two).
 // Spread this way every off-pole view and light direction of a UTIA file keeps 6 to 14 of its 288 pairs
-// at stride 24 (tests/test_refine.cpp); the low bits of the same product, taken modulo the stride, left
+// at stride 24 (tests/fit/test_refine.cpp); the low bits of the same product, taken modulo the stride, left
 // 31 of them out.
 MeasuredBins sample_bins(const std::vector<MeasuredSample>& samples, std::uint64_t stride = 1) {
   MeasuredBins bins;

@@ -155,7 +155,7 @@ std::vector<Rgb> directional_albedo(const Brdf& model, const Proposal& proposal,
 // D(x) = sign(x) max(0, |x| - kAlbedoTolerance). The tolerance, 0.5 units of L* (about 1.3% of the albedo),
 // is of the order of the target's and the closures' moments' own errors (0.4% and 0.3%): with errors of 1% (a
 // target from a grid's midpoints, visible normals on 8 x 8 numbers) a two-lobe GGX mixture written in MERL came
-// back with a weight 5% off (tests/test_closures.cpp).
+// back with a weight 5% off (tests/fit/test_closures.cpp).
 constexpr double kAlbedoTolerance = 0.5 / 116.0;
 MetricResidual albedo_residual(const AlbedoTarget& target, std::size_t view, int channel, double rho);
 

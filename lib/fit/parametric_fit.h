@@ -36,7 +36,7 @@ ParametricFit fit_parametric(const MeasuredBins& bins, const MeasuredBins& error
 
 // The largest relative difference, over `bins`, between the hand-written derivatives of the fit's
 // residuals and central differences, at the parameters of `fit` (with its coat if it has one): the
-// check of fit_parametric's Jacobian (tests/test_refine.cpp).
+// check of fit_parametric's Jacobian (tests/fit/test_refine.cpp).
 double parametric_jacobian_error(const MeasuredBins& bins, Smith smith, const ParametricFit& fit);
 
 // The fit's distance from the measurement (measurement_error of its BRDF).

@@ -61,7 +61,7 @@ struct RefineOptions {
 double normalize_ndf(TabulatedNdf& ndf, const Quadrature& quadrature);
 
 // The largest relative difference, over `bins`, between the refinement's hand-written derivatives and
-// central differences at `at` (its ndf on `quadrature`'s grid): tests/test_refine.cpp's check.
+// central differences at `at` (its ndf on `quadrature`'s grid): tests/fit/test_refine.cpp's check.
 double refine_jacobian_error(const MeasuredBins& bins, const Quadrature& quadrature, Smith smith, const LobeFit& at);
 
 // Refines `start` (its ndf on `quadrature`'s grid) on `bins`; its coat, if any, is held.

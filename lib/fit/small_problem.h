@@ -25,7 +25,7 @@ class CostFunction;
 namespace facetfit {
 
 // The largest relative difference between `cost`'s Jacobian and central differences at `blocks` (which it
-// moves and restores): the check of the fits' hand-written derivatives (tests/test_refine.cpp).
+// moves and restores): the check of the fits' hand-written derivatives (tests/fit/test_refine.cpp).
 double jacobian_error(const ceres::CostFunction& cost, const std::vector<double*>& blocks);
 
 class SmallProblem {

@@ -14,7 +14,7 @@
 // nodes closest), with one node beyond each end, and is read by Catmull-Rom splines in the three variables:
 // its derivatives are continuous, as the solver's steps need. A view's cells of (alpha_x, alpha_y) nodes are
 // summed when a read first needs them (a fit visits a few dozen of the 1,225), once, whichever thread asks.
-// It agrees with the direct sum to 2e-4 of the albedo of F = 1 (tests/test_closures.cpp).
+// It agrees with the direct sum to 2e-4 of the albedo of F = 1 (tests/fit/test_closures.cpp).
 #pragma once
 
 #include <cstddef>

@@ -7,7 +7,7 @@
 // decoded value times 100 is the BRDF in 1/sr, as the issue describes the database's reader (the
 // readers published beside the data return the raw numbers). The scale could not be checked against a
 // real file here (none can be fetched): the writer encodes f / 100 so that facetfit's own files read
-// back to the BRDF they were written from (tests/test_utia.cpp); negative entries (noise) decode
+// back to the BRDF they were written from (tests/io/test_utia.cpp); negative entries (noise) decode
 // linearly and are kept, as for RGL.
 //
 // Between the nodes eval() is quadrilinear in (theta_i, phi_i, theta_v, phi_v) degrees, periodic in the

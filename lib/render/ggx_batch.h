@@ -1,7 +1,7 @@
 // The GGX material's sampling, f(o, i) and sampling density over a batch, in SIMD lanes (Google Highway,
 // the widest target the CPU has, chosen at run time). The same model as ShadingModel's sample_direction
 // and eval with a ParametricBrdf and a GgxProposal (render/shading.h): every term is theirs, in the same
-// order, so the two agree to rounding (tests/test_render.cpp).
+// order, so the two agree to rounding (tests/render/test_shading_lanes.cpp).
 #pragma once
 
 #include <cstddef>

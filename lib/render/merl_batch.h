@@ -1,7 +1,7 @@
 // A MERL-layout table's f(o, i) over a batch, in SIMD lanes (render/ggx_batch.h does GGX): HalfDiffTable::eval
 // with its linear lookup, every term its own in the same order (half/diff angles, bin coordinates, the
 // eight corners with missing neighbours dropped per channel), so the two agree to rounding
-// (tests/test_render.cpp). The arc cosines are render/lanes-inl.h's, the arc tangent Highway's.
+// (tests/render/test_shading_lanes.cpp). The arc cosines are render/lanes-inl.h's, the arc tangent Highway's.
 #pragma once
 
 #include <optional>

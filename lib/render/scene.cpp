@@ -532,7 +532,7 @@ std::shared_ptr<const ShadingModel> load_material(const SceneDesc& scene, const 
       if (fit.ok()) proposal = std::make_shared<VisibleSlopeProposal>(MicrofacetTables{fit.ndf(), fit.smith, fit.fresnel(), {}, {}});
     }
     // RGL files render through their own evaluation (the renderer's o is the viewer's side), not the
-    // MERL-layout table: with view slices this is Mitsuba's `measured` (tests/test_mitsuba.cpp).
+    // MERL-layout table: with view slices this is Mitsuba's `measured` (tests/io/test_mitsuba.cpp).
     if (rgl) {
       auto brdf = std::make_shared<RglBsdf>(*rgl);  // a copy shares the file's tables; the slices are its own
       brdf->set_slices(*parse_slices(m.slices));

@@ -37,14 +37,14 @@ struct LightDesc {
 };
 
 // The material types a scene names (docs/scene-format.md), each once: the scene parser, load_material,
-// `render --material-type` and the lanes test (tests/test_render.cpp) read this list.
+// `render --material-type` and the lanes test (tests/render/test_shading_lanes.cpp) read this list.
 struct MaterialType {
   const char* name;
   bool needs_file;  // a "file" is required
   bool reads_lut;   // the file is a LUT (`render --material` bakes a measurement first)
   // How the stream path shades its plain form (unstretched, isotropic; ShadingModel::has_lanes, f_in_lanes):
   // every part in SIMD lanes (f, density, sampling), or its density and sampling there and f one pair at
-  // a time. Tested for each type (tests/test_render.cpp): a type that leaves the lanes fails there.
+  // a time. Tested for each type (tests/render/test_shading_lanes.cpp): a type that leaves the lanes fails there.
   enum class Lanes { all, sampling } lanes;
 };
 inline constexpr MaterialType kMaterialTypes[] = {

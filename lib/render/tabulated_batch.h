@@ -2,7 +2,7 @@
 // render/ggx_batch.h does for GGX: ShadingModel's sample_direction and eval (f(o, i) and the sampling
 // density) with the lobe as BRDF and its visible slopes as proposal (model/visible_slopes.h), or the
 // proposal alone (its draws and density), every term theirs in the same order, in single precision: the
-// two agree to its rounding (tests/test_render.cpp), but for a draw whose number falls within rounding of
+// two agree to its rounding (tests/render/test_shading_lanes.cpp), but for a draw whose number falls within rounding of
 // a boundary between cells. The arc cosines of f's grid lookups are render/lanes-inl.h's (Highway's
 // polynomial); the proposal needs none.
 #pragma once

@@ -1,4 +1,4 @@
-"""Renders with Blender's Cycles (bpy wheel, OSL on the CPU) for tests/test_osl.cpp and docs/osl.md.
+"""Renders with Blender's Cycles (bpy wheel, OSL on the CPU) for tests/osl/test_osl_*.cpp and docs/osl.md.
 
     python cycles_render.py probe SHADER OUT.exr SIZE [NAME=VALUE ...]
         An orthographic view of the plane [-1, 1]^2 at z = 0, SIZE x SIZE pixels, one sample per pixel at

@@ -260,7 +260,7 @@ TEST(Cli, ConvertThenFitTheFile) {
 }
 
 // UTIA files: convert writes them (any input sampled at the file's nodes), fit and folder expansion take
-// them (as their azimuthal mean; tests/test_accuracy.cpp checks what comes back), bad outputs get a line.
+// them (as their azimuthal mean; tests/fit/test_accuracy.cpp checks what comes back), bad outputs get a line.
 TEST(Cli, ConvertToUtiaThenFitTheFile) {
   TempDir dir;
   const std::string path = dir.file("silver.bin");
@@ -269,7 +269,7 @@ TEST(Cli, ConvertToUtiaThenFitTheFile) {
   const RunResult r = facetfit("fit " + dir.path().string() + " --json");
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_EQ(lines(r.out), 1);
-  // The 15-degree grid limits it (tests/test_accuracy.cpp): -0.7% here.
+  // The 15-degree grid limits it (tests/fit/test_accuracy.cpp): -0.7% here.
   EXPECT_NEAR(nlohmann::json::parse(r.out)["alpha_ggx"].get<double>(), 0.60, 0.60 * 0.03);
   EXPECT_NEAR(nlohmann::json::parse(r.out)["anisotropic"]["alpha_ggx"]["alpha_y"].get<double>(), 0.60, 0.60 * 0.03);
   // An anisotropic file: its principal alphas beside the isotropic fit, in the record and the table.

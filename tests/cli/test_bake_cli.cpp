@@ -105,7 +105,7 @@ TEST(Bake, KilledMidRunLeavesOnlyWholeFiles) {
   TempDir out;
   const std::string dir = out.path().string();
   // Kill a forced rebake at different moments; after each kill, every visible output must be whole.
-  // (A kill rarely lands inside one write, which takes microseconds: test_atomic.cpp kills a writer
+  // (A kill rarely lands inside one write, which takes microseconds: io/test_atomic.cpp kills a writer
   // deterministically between writing and committing. This test checks the command as a whole.)
   for (int delay_ms : {60, 150, 250, 400, 550, 700}) {
     const pid_t pid = ::fork();
