@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <limits>
 #include <map>
+#include <optional>
 #include <utility>
 #include <vector>
 
@@ -124,8 +125,8 @@ std::vector<unsigned char> slurp(const std::string& path) {
   return bytes;
 }
 
-// Reads the field table, checking every extent against the file before anything trusts it.
-std::map<std::string, Field> parse_header(const std::string& path, const std::vector<unsigned char>& bytes) {
+// The 14 bytes before the field count: the magic string and version 1.0.
+void check_preamble(const std::string& path, const std::vector<unsigned char>& bytes) {
   if (bytes.size() < kPreamble)
     fail(path, "truncated header (" + std::to_string(bytes.size()) + " bytes; a tensor file starts with an " +
                    std::to_string(kPreamble) + "-byte preamble)");
@@ -134,59 +135,91 @@ std::map<std::string, Field> parse_header(const std::string& path, const std::ve
   if (bytes[12] != 1 || bytes[13] != 0)
     fail(path, "unsupported tensor file version " + std::to_string(bytes[12]) + "." + std::to_string(bytes[13]) +
                    " (this reader knows 1.0)");
+}
 
-  HeaderCursor in(path, bytes);
-  in.text(14, "preamble");
+// The number of fields, at least one and no more than the file's bytes could describe.
+std::uint64_t read_field_count(HeaderCursor& in, const std::string& path, std::size_t file_bytes) {
   const std::uint64_t n_fields = in.uint(4, "field count");
   if (n_fields == 0) fail(path, "tensor file has no fields");
-  if (n_fields > (bytes.size() - kPreamble) / kMinFieldEntry)
-    fail(path, "header claims " + std::to_string(n_fields) + " fields, more than a file of " +
-                   std::to_string(bytes.size()) + " bytes can describe (truncated, or a corrupt count)");
+  if (n_fields > (file_bytes - kPreamble) / kMinFieldEntry)
+    fail(path, "header claims " + std::to_string(n_fields) + " fields, more than a file of " + std::to_string(file_bytes) +
+                   " bytes can describe (truncated, or a corrupt count)");
+  return n_fields;
+}
 
+// A field's name: not empty, and printable, since names go into error messages, which must stay one
+// printable line. `entry` names the table entry in messages.
+std::string read_field_name(HeaderCursor& in, const std::string& path, const std::string& entry) {
+  const std::size_t name_length = static_cast<std::size_t>(in.uint(2, entry));
+  if (name_length == 0) fail(path, entry + " has an empty name");
+  const std::string name = in.text(name_length, entry);
+  for (const char ch : name)
+    if (ch < 0x20 || ch > 0x7e) fail(path, entry + " has a name with non-printable bytes");
+  return name;
+}
+
+// The product of a shape's extents, or nothing where it overflows 64 bits.
+std::optional<std::uint64_t> element_count(const std::vector<std::uint64_t>& shape) {
+  std::uint64_t count = 1;
+  for (const std::uint64_t n : shape) {
+    if (n != 0 && count > std::numeric_limits<std::uint64_t>::max() / n) return std::nullopt;
+    count *= n;
+  }
+  return count;
+}
+
+// The rest of a field's entry after its name: rank, dtype, offset and shape, with its element count and
+// byte size computed without overflow. `what` names the field in messages.
+Field read_field(HeaderCursor& in, const std::string& path, const std::string& what) {
+  Field f;
+  const std::uint64_t rank = in.uint(2, what);
+  f.dtype = static_cast<std::uint8_t>(in.uint(1, what));
+  f.offset = in.uint(8, what);
+  if (rank == 0 || rank > kMaxRank)
+    fail(path, what + " claims " + std::to_string(rank) + " dimensions (expected 1 to " + std::to_string(kMaxRank) + ")");
+  const std::size_t elem = dtype_bytes(f.dtype);
+  if (elem == 0) fail(path, what + " has unknown dtype " + std::to_string(f.dtype));
+  for (std::uint64_t d = 0; d < rank; ++d) f.shape.push_back(in.uint(8, what));
+
+  // Element count and byte size without overflow: both must fit in the file.
+  const std::optional<std::uint64_t> count = element_count(f.shape);
+  if (!count || *count > (std::numeric_limits<std::uint64_t>::max() / elem))
+    fail(path, what + " has impossible dimensions " + shape_string(f.shape) + " (size overflows)");
+  f.count = static_cast<std::size_t>(std::min<std::uint64_t>(*count, std::numeric_limits<std::size_t>::max()));
+  f.bytes = *count * elem;
+  return f;
+}
+
+// Every field's data lies inside the file and after the field table, which ends at byte `table_end`.
+// Checked only once the whole table has been read, so that a file cut inside the table reads as a
+// truncated header rather than as some field's missing data.
+void check_field_extents(const std::string& path, std::size_t file_bytes, std::size_t table_end,
+                         const std::map<std::string, Field>& fields) {
+  for (const auto& [name, f] : fields) {
+    if (f.offset > file_bytes || f.bytes > file_bytes - f.offset)
+      fail(path, "field '" + name + "' (" + shape_string(f.shape) + " " + dtype_name(f.dtype) + ", " +
+                     std::to_string(f.bytes) + " bytes at offset " + std::to_string(f.offset) +
+                     ") extends past the end of the file (" + std::to_string(file_bytes) + " bytes; truncated?)");
+    if (f.offset < table_end && f.bytes > 0)
+      fail(path, "field '" + name + "' at offset " + std::to_string(f.offset) + " overlaps the field table (which ends at byte " +
+                     std::to_string(table_end) + ")");
+  }
+}
+
+// Reads the field table, checking every extent against the file before anything trusts it.
+std::map<std::string, Field> parse_header(const std::string& path, const std::vector<unsigned char>& bytes) {
+  check_preamble(path, bytes);
+  HeaderCursor in(path, bytes);
+  in.text(14, "preamble");
+  const std::uint64_t n_fields = read_field_count(in, path, bytes.size());
   std::map<std::string, Field> fields;
   for (std::uint64_t k = 0; k < n_fields; ++k) {
     const std::string entry = "entry " + std::to_string(k) + " of the field table";
-    const std::size_t name_length = static_cast<std::size_t>(in.uint(2, entry));
-    if (name_length == 0) fail(path, entry + " has an empty name");
-    const std::string name = in.text(name_length, entry);
-    // Names go into error messages, which must stay one printable line.
-    for (const char ch : name)
-      if (ch < 0x20 || ch > 0x7e) fail(path, entry + " has a name with non-printable bytes");
+    const std::string name = read_field_name(in, path, entry);
     const std::string what = "field '" + name + "'";
-    Field f;
-    const std::uint64_t rank = in.uint(2, what);
-    f.dtype = static_cast<std::uint8_t>(in.uint(1, what));
-    f.offset = in.uint(8, what);
-    if (rank == 0 || rank > kMaxRank)
-      fail(path, what + " claims " + std::to_string(rank) + " dimensions (expected 1 to " + std::to_string(kMaxRank) + ")");
-    const std::size_t elem = dtype_bytes(f.dtype);
-    if (elem == 0) fail(path, what + " has unknown dtype " + std::to_string(f.dtype));
-    for (std::uint64_t d = 0; d < rank; ++d) f.shape.push_back(in.uint(8, what));
-
-    // Element count and byte size without overflow: both must fit in the file.
-    std::uint64_t count = 1;
-    bool overflow = false;
-    for (const std::uint64_t n : f.shape) {
-      if (n != 0 && count > std::numeric_limits<std::uint64_t>::max() / n) overflow = true;
-      if (!overflow) count *= n;
-    }
-    if (overflow || count > (std::numeric_limits<std::uint64_t>::max() / elem))
-      fail(path, what + " has impossible dimensions " + shape_string(f.shape) + " (size overflows)");
-    f.count = static_cast<std::size_t>(std::min<std::uint64_t>(count, std::numeric_limits<std::size_t>::max()));
-    f.bytes = count * elem;
-    if (!fields.emplace(name, std::move(f)).second) fail(path, what + " appears twice in the field table");
+    if (!fields.emplace(name, read_field(in, path, what)).second) fail(path, what + " appears twice in the field table");
   }
-  // Extents only once the whole table has been read, so that a file cut inside the table reads as
-  // a truncated header rather than as some field's missing data.
-  for (const auto& [name, f] : fields) {
-    if (f.offset > bytes.size() || f.bytes > bytes.size() - f.offset)
-      fail(path, "field '" + name + "' (" + shape_string(f.shape) + " " + dtype_name(f.dtype) + ", " +
-                     std::to_string(f.bytes) + " bytes at offset " + std::to_string(f.offset) +
-                     ") extends past the end of the file (" + std::to_string(bytes.size()) + " bytes; truncated?)");
-    if (f.offset < in.pos() && f.bytes > 0)
-      fail(path, "field '" + name + "' at offset " + std::to_string(f.offset) + " overlaps the field table (which ends at byte " +
-                     std::to_string(in.pos()) + ")");
-  }
+  check_field_extents(path, bytes.size(), in.pos(), fields);
   return fields;
 }
 
