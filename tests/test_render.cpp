@@ -24,6 +24,7 @@
 #include "render/renderer.h"
 #include "render/camera_batch.h"
 #include "render/environment.h"
+#include "render/materials.h"
 #include "render/ggx_batch.h"
 #include "render/merl_batch.h"
 #include "render/shading.h"
