@@ -16,6 +16,7 @@
 #include "io/input.h"
 #include "lut/bake.h"
 #include "render/environment.h"
+#include "render/materials.h"
 #include "render/renderer.h"
 
 namespace facetfit::cli {

@@ -57,6 +57,124 @@ BinCoords bin_coords(const Vec3& o, const Vec3& i) {
           hd.theta_d / (0.5 * kPi) * HalfDiffTable::kThetaD, phi_d / kPi * HalfDiffTable::kPhiD};
 }
 
+// A MERL file: three 32-bit dimensions, then 3 x kBins doubles, channel by channel (HalfDiffTable::kFileBytes).
+constexpr std::size_t kHeaderBytes = 3 * sizeof(std::int32_t);
+constexpr std::size_t kValues = 3 * HalfDiffTable::kBins;
+
+// The values are read in chunks of 1 MiB: chunk c holds values [first, first + n) of the file.
+constexpr std::size_t kChunk = std::size_t(1) << 17;  // doubles
+constexpr std::size_t kChunks = (kValues + kChunk - 1) / kChunk;
+struct Chunk {
+  std::size_t first, n;
+};
+
+Chunk chunk_at(std::size_t chunk) {
+  const std::size_t first = chunk * kChunk;
+  return {first, std::min(kChunk, kValues - first)};
+}
+
+// Reads a chunk's doubles into `buf`; false on a short read.
+bool read_chunk(int fd, const Chunk& c, double* buf) {
+  const auto bytes = ssize_t(c.n * sizeof(double));
+  return ::pread(fd, buf, std::size_t(bytes), off_t(kHeaderBytes + c.first * sizeof(double))) == bytes;
+}
+
+// Opens `path` for reading, once it is known to be a regular file: a FIFO or a device would make open()
+// wait for a writer forever, and its size would mean nothing. Returns the descriptor.
+int open_regular_file(const std::string& path) {
+  std::error_code ec;
+  const auto status = fs::status(path, ec);
+  if (!fs::exists(status)) fail(path, "cannot open: no such file");
+  if (fs::is_directory(status)) fail(path, "is a folder, not a MERL .binary file");
+  if (!fs::is_regular_file(status)) fail(path, "not a regular file");
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) fail(path, std::string("cannot open: ") + std::strerror(errno));
+  return fd;
+}
+
+// The header's dimensions, checked before they are trusted with any allocation, and the file's size
+// against them.
+void check_header(const std::string& path, int fd) {
+  std::error_code ec;
+  const auto size = fs::file_size(path, ec);
+  if (ec) fail(path, "cannot read its size: " + ec.message());
+  if (size == 0) fail(path, "file is empty");
+  std::int32_t dims[3] = {0, 0, 0};
+  if (size < sizeof dims || ::pread(fd, dims, sizeof dims, 0) != ssize_t(sizeof dims))
+    fail(path, "truncated header (" + std::to_string(size) + " bytes; a MERL file starts with three 32-bit dimensions)");
+  if (dims[0] != HalfDiffTable::kThetaH || dims[1] != HalfDiffTable::kThetaD || dims[2] != HalfDiffTable::kPhiD)
+    fail(path, "header claims " + std::to_string(dims[0]) + " x " + std::to_string(dims[1]) + " x " +
+                   std::to_string(dims[2]) + " bins; a MERL isotropic table is 90 x 90 x 180");
+  if (size != HalfDiffTable::kFileBytes)
+    fail(path, "size is " + std::to_string(size) + " bytes, expected " + std::to_string(HalfDiffTable::kFileBytes) +
+                   (size < HalfDiffTable::kFileBytes ? " (truncated)" : " (trailing data)"));
+}
+
+// A chunk's values into the table's floats `out` (the chunk's first): scaled by their channel's kScale,
+// negative values missing. Returns how many are not representable.
+int convert_chunk(const double* buf, const Chunk& chunk, float* out) {
+  int nonfinite = 0;
+  // A chunk may straddle two channels: convert channel by channel.
+  for (std::size_t t = 0; t < chunk.n;) {
+    const std::size_t c = (chunk.first + t) / HalfDiffTable::kBins;
+    const std::size_t end = std::min(chunk.n, (c + 1) * HalfDiffTable::kBins - chunk.first);
+    const double scale = HalfDiffTable::kScale[c];
+#pragma omp simd reduction(+ : nonfinite)
+    for (std::size_t k = t; k < end; ++k) {
+      const double x = buf[k];
+      nonfinite += representable(x, scale) ? 0 : 1;
+      out[k] = x < 0.0 ? kMissing : float(x * scale);
+    }
+    t = end;
+  }
+  return nonfinite;
+}
+
+// Every chunk read with pread and converted in parallel into `table` (3 x kBins floats, channel-planar):
+// the copy out of the page cache and the conversion both run on every core, and no 35 MB buffer of
+// doubles is ever allocated. Returns each chunk's state: 0 a short read, 1 converted, 2 converted with a
+// value that is not representable.
+std::vector<unsigned char> convert_chunks(int fd, float* table) {
+  tbb::enumerable_thread_specific<std::vector<double>> buffers([] { return std::vector<double>(kChunk); });
+  std::vector<unsigned char> chunk_ok(kChunks, 0);
+  tbb::parallel_for(std::size_t(0), kChunks, [&](std::size_t chunk) {
+    std::vector<double>& buf = buffers.local();
+    const Chunk c = chunk_at(chunk);
+    if (!read_chunk(fd, c, buf.data())) return;
+    chunk_ok[chunk] = convert_chunk(buf.data(), c, table + c.first) == 0 ? 1 : 2;
+  });
+  return chunk_ok;
+}
+
+// Value `at` of the file (`value`), not representable: the message names its byte offset, channel and bin.
+[[noreturn]] void fail_unrepresentable(const std::string& path, std::size_t at, double value) {
+  const std::size_t c = at / HalfDiffTable::kBins, bin = at % HalfDiffTable::kBins;
+  const std::size_t offset = kHeaderBytes + at * sizeof(double);
+  const int k = int(bin % HalfDiffTable::kPhiD), j = int(bin / HalfDiffTable::kPhiD % HalfDiffTable::kThetaD);
+  const int i = int(bin / (HalfDiffTable::kPhiD * HalfDiffTable::kThetaD));
+  char text[48];
+  std::snprintf(text, sizeof text, "%g (out of float's range)", value);
+  const std::string what = std::isnan(value) ? "NaN" : std::isinf(value) ? "Inf" : text;
+  fail(path, what + " at byte offset " + std::to_string(offset) + " (" + HalfDiffTable::channel_name(int(c)) +
+                 " channel, bin theta_h " + std::to_string(i) + ", theta_d " + std::to_string(j) + ", phi_d " +
+                 std::to_string(k) + ")");
+}
+
+// The first problem of convert_chunks in file order: a short read, or the first value that is not
+// representable (its chunk read again).
+void report_first_problem(const std::string& path, int fd, const std::vector<unsigned char>& chunk_ok) {
+  for (std::size_t chunk = 0; chunk < kChunks; ++chunk) {
+    if (chunk_ok[chunk] == 1) continue;
+    if (chunk_ok[chunk] == 0) fail(path, "read error (file changed while reading?)");
+    const Chunk c = chunk_at(chunk);
+    std::vector<double> buf(c.n);
+    if (!read_chunk(fd, c, buf.data())) fail(path, "read error (file changed while reading?)");
+    for (std::size_t t = 0; t < c.n; ++t)
+      if (!representable(buf[t], HalfDiffTable::kScale[(c.first + t) / HalfDiffTable::kBins]))
+        fail_unrepresentable(path, c.first + t, buf[t]);
+  }
+}
+
 
 }  // namespace
 
@@ -132,80 +250,10 @@ void HalfDiffTable::set_missing(int i, int j, int k) {
 }
 
 HalfDiffTable HalfDiffTable::read(const std::string& path, BinPoint at) {
-  std::error_code ec;
-  const auto status = fs::status(path, ec);
-  if (!fs::exists(status)) fail(path, "cannot open: no such file");
-  if (fs::is_directory(status)) fail(path, "is a folder, not a MERL .binary file");
-  // A FIFO or a device: open() would wait for a writer forever, and a size means nothing.
-  if (!fs::is_regular_file(status)) fail(path, "not a regular file");
-  const FileDescriptor file{::open(path.c_str(), O_RDONLY | O_CLOEXEC)};
-  const int fd = file.fd;
-  if (fd < 0) fail(path, std::string("cannot open: ") + std::strerror(errno));
-
-  const auto size = fs::file_size(path, ec);
-  if (ec) fail(path, "cannot read its size: " + ec.message());
-  if (size == 0) fail(path, "file is empty");
-  std::int32_t dims[3] = {0, 0, 0};
-  if (size < sizeof dims || ::pread(fd, dims, sizeof dims, 0) != ssize_t(sizeof dims))
-    fail(path, "truncated header (" + std::to_string(size) + " bytes; a MERL file starts with three 32-bit dimensions)");
-  // Check the dimensions before trusting them with any allocation.
-  if (dims[0] != kThetaH || dims[1] != kThetaD || dims[2] != kPhiD)
-    fail(path, "header claims " + std::to_string(dims[0]) + " x " + std::to_string(dims[1]) + " x " +
-                   std::to_string(dims[2]) + " bins; a MERL isotropic table is 90 x 90 x 180");
-  if (size != kFileBytes)
-    fail(path, "size is " + std::to_string(size) + " bytes, expected " + std::to_string(kFileBytes) +
-                   (size < kFileBytes ? " (truncated)" : " (trailing data)"));
-
-  // Chunks of 1 MiB read with pread and converted in parallel into the table: the copy out of the page
-  // cache and the conversion both run on every core, and no 35 MB buffer of doubles is ever allocated.
+  const FileDescriptor file{open_regular_file(path)};
+  check_header(path, file.fd);
   HalfDiffTable table{Uninitialized{}};
-  constexpr std::size_t kChunk = std::size_t(1) << 17;  // doubles
-  const std::size_t total = 3 * kBins, chunks = (total + kChunk - 1) / kChunk;
-  tbb::enumerable_thread_specific<std::vector<double>> buffers([] { return std::vector<double>(kChunk); });
-  std::vector<unsigned char> chunk_ok(chunks, 0);
-  tbb::parallel_for(std::size_t(0), chunks, [&](std::size_t chunk) {
-    std::vector<double>& buf = buffers.local();
-    const std::size_t first = chunk * kChunk, n = std::min(kChunk, total - first);
-    const auto bytes = ssize_t(n * sizeof(double));
-    if (::pread(fd, buf.data(), std::size_t(bytes), off_t(sizeof dims + first * sizeof(double))) != bytes) return;
-    float* out = table.data_.data() + first;
-    int nonfinite = 0;
-    // A chunk may straddle two channels: convert channel by channel.
-    for (std::size_t t = 0; t < n;) {
-      const std::size_t c = (first + t) / kBins, end = std::min(n, (c + 1) * kBins - first);
-      const double scale = kScale[c];
-#pragma omp simd reduction(+ : nonfinite)
-      for (std::size_t k = t; k < end; ++k) {
-        const double x = buf[k];
-        nonfinite += representable(x, scale) ? 0 : 1;
-        out[k] = x < 0.0 ? kMissing : float(x * scale);
-      }
-      t = end;
-    }
-    chunk_ok[chunk] = nonfinite == 0 ? 1 : 2;
-  });
-
-  // Report the first problem in file order.
-  for (std::size_t chunk = 0; chunk < chunks; ++chunk) {
-    if (chunk_ok[chunk] == 1) continue;
-    if (chunk_ok[chunk] == 0) fail(path, "read error (file changed while reading?)");
-    const std::size_t first = chunk * kChunk, n = std::min(kChunk, total - first);
-    std::vector<double> buf(n);
-    if (::pread(fd, buf.data(), n * sizeof(double), off_t(sizeof dims + first * sizeof(double))) != ssize_t(n * sizeof(double)))
-      fail(path, "read error (file changed while reading?)");
-    for (std::size_t t = 0; t < n; ++t) {
-      const std::size_t c = (first + t) / kBins, bin = (first + t) % kBins;
-      if (representable(buf[t], kScale[c])) continue;
-      const std::size_t offset = sizeof dims + (first + t) * sizeof(double);
-      const int k = int(bin % kPhiD), j = int(bin / kPhiD % kThetaD), i = int(bin / (kPhiD * kThetaD));
-      char value[48];
-      std::snprintf(value, sizeof value, "%g (out of float's range)", buf[t]);
-      const std::string what = std::isnan(buf[t]) ? "NaN" : std::isinf(buf[t]) ? "Inf" : value;
-      fail(path, what + " at byte offset " + std::to_string(offset) + " (" +
-                     channel_name(int(c)) + " channel, bin theta_h " + std::to_string(i) + ", theta_d " + std::to_string(j) +
-                     ", phi_d " + std::to_string(k) + ")");
-    }
-  }
+  report_first_problem(path, file.fd, convert_chunks(file.fd, table.data_.data()));
   return at == BinPoint::center ? table.centres_to_edges() : table;
 }
 

@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <limits>
 #include <map>
+#include <optional>
 #include <utility>
 #include <vector>
 
@@ -124,8 +125,8 @@ std::vector<unsigned char> slurp(const std::string& path) {
   return bytes;
 }
 
-// Reads the field table, checking every extent against the file before anything trusts it.
-std::map<std::string, Field> parse_header(const std::string& path, const std::vector<unsigned char>& bytes) {
+// The 14 bytes before the field count: the magic string and version 1.0.
+void check_preamble(const std::string& path, const std::vector<unsigned char>& bytes) {
   if (bytes.size() < kPreamble)
     fail(path, "truncated header (" + std::to_string(bytes.size()) + " bytes; a tensor file starts with an " +
                    std::to_string(kPreamble) + "-byte preamble)");
@@ -134,59 +135,91 @@ std::map<std::string, Field> parse_header(const std::string& path, const std::ve
   if (bytes[12] != 1 || bytes[13] != 0)
     fail(path, "unsupported tensor file version " + std::to_string(bytes[12]) + "." + std::to_string(bytes[13]) +
                    " (this reader knows 1.0)");
+}
 
-  HeaderCursor in(path, bytes);
-  in.text(14, "preamble");
+// The number of fields, at least one and no more than the file's bytes could describe.
+std::uint64_t read_field_count(HeaderCursor& in, const std::string& path, std::size_t file_bytes) {
   const std::uint64_t n_fields = in.uint(4, "field count");
   if (n_fields == 0) fail(path, "tensor file has no fields");
-  if (n_fields > (bytes.size() - kPreamble) / kMinFieldEntry)
-    fail(path, "header claims " + std::to_string(n_fields) + " fields, more than a file of " +
-                   std::to_string(bytes.size()) + " bytes can describe (truncated, or a corrupt count)");
+  if (n_fields > (file_bytes - kPreamble) / kMinFieldEntry)
+    fail(path, "header claims " + std::to_string(n_fields) + " fields, more than a file of " + std::to_string(file_bytes) +
+                   " bytes can describe (truncated, or a corrupt count)");
+  return n_fields;
+}
 
+// A field's name: not empty, and printable, since names go into error messages, which must stay one
+// printable line. `entry` names the table entry in messages.
+std::string read_field_name(HeaderCursor& in, const std::string& path, const std::string& entry) {
+  const std::size_t name_length = static_cast<std::size_t>(in.uint(2, entry));
+  if (name_length == 0) fail(path, entry + " has an empty name");
+  const std::string name = in.text(name_length, entry);
+  for (const char ch : name)
+    if (ch < 0x20 || ch > 0x7e) fail(path, entry + " has a name with non-printable bytes");
+  return name;
+}
+
+// The product of a shape's extents, or nothing where it overflows 64 bits.
+std::optional<std::uint64_t> element_count(const std::vector<std::uint64_t>& shape) {
+  std::uint64_t count = 1;
+  for (const std::uint64_t n : shape) {
+    if (n != 0 && count > std::numeric_limits<std::uint64_t>::max() / n) return std::nullopt;
+    count *= n;
+  }
+  return count;
+}
+
+// The rest of a field's entry after its name: rank, dtype, offset and shape, with its element count and
+// byte size computed without overflow. `what` names the field in messages.
+Field read_field(HeaderCursor& in, const std::string& path, const std::string& what) {
+  Field f;
+  const std::uint64_t rank = in.uint(2, what);
+  f.dtype = static_cast<std::uint8_t>(in.uint(1, what));
+  f.offset = in.uint(8, what);
+  if (rank == 0 || rank > kMaxRank)
+    fail(path, what + " claims " + std::to_string(rank) + " dimensions (expected 1 to " + std::to_string(kMaxRank) + ")");
+  const std::size_t elem = dtype_bytes(f.dtype);
+  if (elem == 0) fail(path, what + " has unknown dtype " + std::to_string(f.dtype));
+  for (std::uint64_t d = 0; d < rank; ++d) f.shape.push_back(in.uint(8, what));
+
+  // Element count and byte size without overflow: both must fit in the file.
+  const std::optional<std::uint64_t> count = element_count(f.shape);
+  if (!count || *count > (std::numeric_limits<std::uint64_t>::max() / elem))
+    fail(path, what + " has impossible dimensions " + shape_string(f.shape) + " (size overflows)");
+  f.count = static_cast<std::size_t>(std::min<std::uint64_t>(*count, std::numeric_limits<std::size_t>::max()));
+  f.bytes = *count * elem;
+  return f;
+}
+
+// Every field's data lies inside the file and after the field table, which ends at byte `table_end`.
+// Checked only once the whole table has been read, so that a file cut inside the table reads as a
+// truncated header rather than as some field's missing data.
+void check_field_extents(const std::string& path, std::size_t file_bytes, std::size_t table_end,
+                         const std::map<std::string, Field>& fields) {
+  for (const auto& [name, f] : fields) {
+    if (f.offset > file_bytes || f.bytes > file_bytes - f.offset)
+      fail(path, "field '" + name + "' (" + shape_string(f.shape) + " " + dtype_name(f.dtype) + ", " +
+                     std::to_string(f.bytes) + " bytes at offset " + std::to_string(f.offset) +
+                     ") extends past the end of the file (" + std::to_string(file_bytes) + " bytes; truncated?)");
+    if (f.offset < table_end && f.bytes > 0)
+      fail(path, "field '" + name + "' at offset " + std::to_string(f.offset) + " overlaps the field table (which ends at byte " +
+                     std::to_string(table_end) + ")");
+  }
+}
+
+// Reads the field table, checking every extent against the file before anything trusts it.
+std::map<std::string, Field> parse_header(const std::string& path, const std::vector<unsigned char>& bytes) {
+  check_preamble(path, bytes);
+  HeaderCursor in(path, bytes);
+  in.text(14, "preamble");
+  const std::uint64_t n_fields = read_field_count(in, path, bytes.size());
   std::map<std::string, Field> fields;
   for (std::uint64_t k = 0; k < n_fields; ++k) {
     const std::string entry = "entry " + std::to_string(k) + " of the field table";
-    const std::size_t name_length = static_cast<std::size_t>(in.uint(2, entry));
-    if (name_length == 0) fail(path, entry + " has an empty name");
-    const std::string name = in.text(name_length, entry);
-    // Names go into error messages, which must stay one printable line.
-    for (const char ch : name)
-      if (ch < 0x20 || ch > 0x7e) fail(path, entry + " has a name with non-printable bytes");
+    const std::string name = read_field_name(in, path, entry);
     const std::string what = "field '" + name + "'";
-    Field f;
-    const std::uint64_t rank = in.uint(2, what);
-    f.dtype = static_cast<std::uint8_t>(in.uint(1, what));
-    f.offset = in.uint(8, what);
-    if (rank == 0 || rank > kMaxRank)
-      fail(path, what + " claims " + std::to_string(rank) + " dimensions (expected 1 to " + std::to_string(kMaxRank) + ")");
-    const std::size_t elem = dtype_bytes(f.dtype);
-    if (elem == 0) fail(path, what + " has unknown dtype " + std::to_string(f.dtype));
-    for (std::uint64_t d = 0; d < rank; ++d) f.shape.push_back(in.uint(8, what));
-
-    // Element count and byte size without overflow: both must fit in the file.
-    std::uint64_t count = 1;
-    bool overflow = false;
-    for (const std::uint64_t n : f.shape) {
-      if (n != 0 && count > std::numeric_limits<std::uint64_t>::max() / n) overflow = true;
-      if (!overflow) count *= n;
-    }
-    if (overflow || count > (std::numeric_limits<std::uint64_t>::max() / elem))
-      fail(path, what + " has impossible dimensions " + shape_string(f.shape) + " (size overflows)");
-    f.count = static_cast<std::size_t>(std::min<std::uint64_t>(count, std::numeric_limits<std::size_t>::max()));
-    f.bytes = count * elem;
-    if (!fields.emplace(name, std::move(f)).second) fail(path, what + " appears twice in the field table");
+    if (!fields.emplace(name, read_field(in, path, what)).second) fail(path, what + " appears twice in the field table");
   }
-  // Extents only once the whole table has been read, so that a file cut inside the table reads as
-  // a truncated header rather than as some field's missing data.
-  for (const auto& [name, f] : fields) {
-    if (f.offset > bytes.size() || f.bytes > bytes.size() - f.offset)
-      fail(path, "field '" + name + "' (" + shape_string(f.shape) + " " + dtype_name(f.dtype) + ", " +
-                     std::to_string(f.bytes) + " bytes at offset " + std::to_string(f.offset) +
-                     ") extends past the end of the file (" + std::to_string(bytes.size()) + " bytes; truncated?)");
-    if (f.offset < in.pos() && f.bytes > 0)
-      fail(path, "field '" + name + "' at offset " + std::to_string(f.offset) + " overlaps the field table (which ends at byte " +
-                     std::to_string(in.pos()) + ")");
-  }
+  check_field_extents(path, bytes.size(), in.pos(), fields);
   return fields;
 }
 
@@ -228,6 +261,8 @@ class FieldSet {
   }
 
   const unsigned char* data(const Field& f) const { return bytes_.data() + f.offset; }
+
+  const std::string& path() const { return path_; }
 
   void check(bool ok, const std::string& problem) const {
     if (!ok) fail(path_, problem);
@@ -370,6 +405,95 @@ double build_warp_slice(double* pdf, double* cond, double* marg, std::size_t nx,
   return total;
 }
 
+// The slices' parameter `name` (phi_i or theta_i), in radians: not empty, every value within [lo, hi]
+// (`interval`, as messages write it), strictly increasing.
+std::vector<double> read_slice_angles(const FieldSet& in, const std::string& name, double lo, double hi, const char* interval) {
+  const Field& f = in.get(name, kFloat32, 1);
+  in.check(f.count >= 1, "field '" + name + "' is empty");
+  std::vector<double> angles = in.floats(name, f);
+  for (std::size_t k = 0; k < angles.size(); ++k) {
+    const double v = angles[k];
+    in.check(v >= lo && v <= hi, "field '" + name + "' has " + std::to_string(v) + " at element " + std::to_string(k) +
+                                     ", outside " + interval);
+    in.check(k == 0 || v > angles[k - 1], "field '" + name + "' is not strictly increasing at element " + std::to_string(k));
+  }
+  return angles;
+}
+
+// The symmetry an anisotropic file declares by the span of its phi_i (RglBsdf::Tables::reduction): 2 pi
+// over the span, one of 1, 2 and 4.
+int phi_reduction(const FieldSet& in, const std::vector<double>& phi_i) {
+  const double span = phi_i.back() - phi_i.front();
+  const int reduction = int(std::lround(2.0 * kPi / span));
+  in.check(reduction == 1 || reduction == 2 || reduction == 4,
+           "field 'phi_i' spans " + std::to_string(span) + " radians; an anisotropic file spans 2 pi, pi or pi/2");
+  return reduction;
+}
+
+// The largest slice elevation below the horizon (RglBsdf::measured_elevation_limit); 0 without one.
+double largest_below_horizon(const std::vector<double>& theta_i) {
+  double limit = 0.0;
+  for (const double v : theta_i)
+    if (v < 0.5 * kPi - 1e-6) limit = std::max(limit, v);
+  return limit;
+}
+
+// The file's description, without the NULs that pad it.
+std::string read_description(const FieldSet& in) {
+  const Field& desc = in.get("description", kUInt8, 1);
+  std::string text(reinterpret_cast<const char*>(in.data(desc)), desc.count);
+  while (!text.empty() && text.back() == '\0') text.pop_back();
+  return text;
+}
+
+// A table over the sample square of at least 2 x 2 nodes (interpolation needs them), its values all > 0
+// (`positive`) or all >= 0.
+Grid read_grid(const FieldSet& in, const char* name, bool positive) {
+  const Field& f = in.get(name, kFloat32, 2);
+  in.check(f.shape[0] >= 2 && f.shape[1] >= 2,
+           std::string("field '") + name + "' has shape " + dims(f) + "; interpolation needs at least 2 x 2");
+  Grid g;
+  g.ny = static_cast<std::size_t>(f.shape[0]);
+  g.nx = static_cast<std::size_t>(f.shape[1]);
+  g.v = in.floats(name, f);
+  for (std::size_t k = 0; k < g.v.size(); ++k) {
+    if (positive ? g.v[k] > 0.0 : g.v[k] >= 0.0) continue;
+    fail(in.path(), std::string("field '") + name + "' has " + (positive ? "a non-positive" : "a negative") +
+                        " value at element " + std::to_string(k));
+  }
+  return g;
+}
+
+// The optional luminance table: unused by eval (it drives importance sampling), but a file whose
+// luminance disagrees in shape with its RGB table (`rgb`, already checked) is inconsistent.
+void check_luminance(const FieldSet& in, const Field& rgb, const std::string& params) {
+  if (!in.has("luminance")) return;
+  const Field& lum = in.get("luminance", kFloat32, 4);
+  in.check(lum.shape[0] == rgb.shape[0] && lum.shape[1] == rgb.shape[1] && lum.shape[2] == rgb.shape[3] &&
+               lum.shape[3] == rgb.shape[4],
+           "field 'luminance' has shape " + dims(lum) + ", expected " + params + " x " + std::to_string(rgb.shape[3]) + " x " +
+               std::to_string(rgb.shape[4]) + " to match 'rgb'");
+}
+
+// integral D cos d(omega) of a phi-averaged NDF on the nodes of u_theta, linear in u between them:
+// 2 pi int_0^1 D(u) cos(theta) sin(theta) (d theta / du) du with theta = (pi/2) u^2, by a Gauss rule on
+// each interval.
+double projected_ndf_integral(const std::vector<double>& ndf_iso) {
+  double integral = 0.0;
+  const double du = 1.0 / double(ndf_iso.size() - 1);
+  const GaussRule gauss;
+  for (std::size_t x = 0; x + 1 < ndf_iso.size(); ++x) {
+    for (std::size_t q = 0; q < gauss.x.size(); ++q) {
+      const double s = gauss.x[q];
+      const double u = (double(x) + s) * du;
+      const double theta = 0.5 * kPi * u * u;
+      const double d = (1.0 - s) * ndf_iso[x] + s * ndf_iso[x + 1];
+      integral += du * gauss.w[q] * d * std::cos(theta) * std::sin(theta) * kPi * u;
+    }
+  }
+  return 2.0 * kPi * integral;
+}
+
 }  // namespace
 
 struct RglBsdf::Tables {
@@ -403,6 +527,12 @@ struct RglBsdf::Tables {
   std::vector<double> sigma_iso;  // sigma averaged over u_phi, at the nx nodes of u_theta
 
   std::array<double, 2> invert_vndf(const SliceBlend& b, double u0, double u1) const;
+
+  // Steps of RglBsdf::read, once phi_i and theta_i are read; `params` writes their counts as the
+  // messages give them.
+  void read_vndf(const FieldSet& in, const std::string& params);
+  void read_rgb(const FieldSet& in, const std::string& params);
+  void average_over_phi(const FieldSet& in);
 };
 
 // The point of the sample square that the VNDF warp of slice blend b maps to u (the inverse of
@@ -436,122 +566,78 @@ const std::string& RglBsdf::description() const { return t_->description; }
 bool RglBsdf::jacobian() const { return t_->jacobian; }
 double RglBsdf::measured_ndf_stored_integral() const { return t_->ndf_integral; }
 
+// The VNDF of each slice (phi_i x theta_i x rows x columns, at least 2 x 2), no density negative, and
+// its warp; every slice must have mass.
+void RglBsdf::Tables::read_vndf(const FieldSet& in, const std::string& params) {
+  const std::uint64_t n_phi = phi_i.size(), n_theta = theta_i.size();
+  const Field& vndf = in.get("vndf", kFloat32, 4);
+  in.check(vndf.shape[0] == n_phi && vndf.shape[1] == n_theta && vndf.shape[2] >= 2 && vndf.shape[3] >= 2,
+           "field 'vndf' has shape " + dims(vndf) + ", expected " + params + " x rows x columns, at least 2 x 2");
+  vy = static_cast<std::size_t>(vndf.shape[2]);
+  vx = static_cast<std::size_t>(vndf.shape[3]);
+  vndf_pdf = in.floats("vndf", vndf);
+  for (std::size_t k = 0; k < vndf_pdf.size(); ++k)
+    if (vndf_pdf[k] < 0.0) fail(in.path(), "field 'vndf' has a negative density at element " + std::to_string(k));
+  vndf_cond.resize(vndf_pdf.size());
+  const std::size_t slices = static_cast<std::size_t>(n_phi * n_theta);
+  vndf_marg.resize(slices * vy);
+  for (std::size_t s = 0; s < slices; ++s) {
+    const std::size_t slice = vx * vy;
+    const double total = build_warp_slice(vndf_pdf.data() + s * slice, vndf_cond.data() + s * slice,
+                                          vndf_marg.data() + s * vy, vx, vy);
+    in.check(total > 0.0 && std::isfinite(total),
+             "field 'vndf' slice " + std::to_string(s) + " (phi_i " + std::to_string(phi_i[s / n_theta]) + ", theta_i " +
+                 std::to_string(theta_i[s % n_theta]) + ") has no mass");
+  }
+}
+
+// The RGB of each slice (phi_i x theta_i x 3 x rows x columns, at least 2 x 2) and the luminance's
+// shape against it.
+void RglBsdf::Tables::read_rgb(const FieldSet& in, const std::string& params) {
+  const std::uint64_t n_phi = phi_i.size(), n_theta = theta_i.size();
+  const Field& f = in.get("rgb", kFloat32, 5);
+  in.check(f.shape[0] == n_phi && f.shape[1] == n_theta && f.shape[2] == 3 && f.shape[3] >= 2 && f.shape[4] >= 2,
+           "field 'rgb' has shape " + dims(f) + ", expected " + params + " x 3 x rows x columns, at least 2 x 2");
+  ry = static_cast<std::size_t>(f.shape[3]);
+  rx = static_cast<std::size_t>(f.shape[4]);
+  rgb = in.floats("rgb", f);  // negative values (noise, out-of-gamut colour) are kept
+  check_luminance(in, f, params);
+}
+
+// Phi-averaged NDF and sigma: the mean of the bilinear interpolant over u_phi is the trapezoid rule over
+// rows. The NDF's integral normalizes measured_ndf.
+void RglBsdf::Tables::average_over_phi(const FieldSet& in) {
+  ndf_iso = phi_average(ndf);
+  sigma_iso = phi_average(sigma);
+  ndf_integral = projected_ndf_integral(ndf_iso);
+  in.check(ndf_integral > 0.0, "field 'ndf' is zero everywhere");
+}
+
+// Every check runs before anything trusts what it checks, in the order of the file's fields as the
+// messages name them.
 RglBsdf RglBsdf::read(const std::string& path) {
   const std::vector<unsigned char> bytes = slurp(path);
   const FieldSet in(path, bytes, parse_header(path, bytes));
   auto t = std::make_shared<Tables>();
 
-  const Field& phi_i = in.get("phi_i", kFloat32, 1);
-  in.check(phi_i.count >= 1, "field 'phi_i' is empty");
-  t->phi_i = in.floats("phi_i", phi_i);
-  for (std::size_t k = 0; k < t->phi_i.size(); ++k) {
-    const double v = t->phi_i[k];
-    in.check(std::abs(v) <= kPi + 1e-4, "field 'phi_i' has " + std::to_string(v) + " at element " + std::to_string(k) +
-                                            ", outside [-pi, pi]");
-    in.check(k == 0 || v > t->phi_i[k - 1], "field 'phi_i' is not strictly increasing at element " + std::to_string(k));
-  }
+  t->phi_i = read_slice_angles(in, "phi_i", -(kPi + 1e-4), kPi + 1e-4, "[-pi, pi]");
   t->isotropic = t->phi_i.size() <= 2;
-  if (!t->isotropic) {
-    const double span = t->phi_i.back() - t->phi_i.front();
-    t->reduction = int(std::lround(2.0 * kPi / span));
-    in.check(t->reduction == 1 || t->reduction == 2 || t->reduction == 4,
-             "field 'phi_i' spans " + std::to_string(span) + " radians; an anisotropic file spans 2 pi, pi or pi/2");
-  }
-  const std::uint64_t n_phi = phi_i.count;
+  if (!t->isotropic) t->reduction = phi_reduction(in, t->phi_i);
+  t->description = read_description(in);
+  t->theta_i = read_slice_angles(in, "theta_i", 0.0, 0.5 * kPi + 1e-4, "[0, pi/2]");
+  t->measured_limit = largest_below_horizon(t->theta_i);
 
-  const Field& desc = in.get("description", kUInt8, 1);
-  t->description.assign(reinterpret_cast<const char*>(in.data(desc)), desc.count);
-  while (!t->description.empty() && t->description.back() == '\0') t->description.pop_back();
-
-  const Field& theta_i = in.get("theta_i", kFloat32, 1);
-  in.check(theta_i.count >= 1, "field 'theta_i' is empty");
-  t->theta_i = in.floats("theta_i", theta_i);
-  for (std::size_t k = 0; k < t->theta_i.size(); ++k) {
-    const double v = t->theta_i[k];
-    if (v < 0.5 * kPi - 1e-6) t->measured_limit = std::max(t->measured_limit, v);
-    in.check(v >= 0.0 && v <= 0.5 * kPi + 1e-4, "field 'theta_i' has " + std::to_string(v) + " at element " +
-                                                    std::to_string(k) + ", outside [0, pi/2]");
-    in.check(k == 0 || v > t->theta_i[k - 1], "field 'theta_i' is not strictly increasing at element " + std::to_string(k));
-  }
-  const std::uint64_t n_theta = theta_i.count;
-
-  const auto read_grid = [&](const char* name, Grid& g, bool positive) {
-    const Field& f = in.get(name, kFloat32, 2);
-    in.check(f.shape[0] >= 2 && f.shape[1] >= 2,
-             std::string("field '") + name + "' has shape " + dims(f) + "; interpolation needs at least 2 x 2");
-    g.ny = static_cast<std::size_t>(f.shape[0]);
-    g.nx = static_cast<std::size_t>(f.shape[1]);
-    g.v = in.floats(name, f);
-    for (std::size_t k = 0; k < g.v.size(); ++k) {
-      if (positive ? g.v[k] > 0.0 : g.v[k] >= 0.0) continue;
-      fail(path, std::string("field '") + name + "' has " + (positive ? "a non-positive" : "a negative") +
-                     " value at element " + std::to_string(k));
-    }
-  };
-  read_grid("ndf", t->ndf, false);
-  read_grid("sigma", t->sigma, true);  // eval divides by it
-
-  const Field& vndf = in.get("vndf", kFloat32, 4);
-  const std::string params = std::to_string(n_phi) + " (phi_i) x " + std::to_string(n_theta) + " (theta_i)";
-  in.check(vndf.shape[0] == n_phi && vndf.shape[1] == n_theta && vndf.shape[2] >= 2 && vndf.shape[3] >= 2,
-           "field 'vndf' has shape " + dims(vndf) + ", expected " + params + " x rows x columns, at least 2 x 2");
-  t->vy = static_cast<std::size_t>(vndf.shape[2]);
-  t->vx = static_cast<std::size_t>(vndf.shape[3]);
-  t->vndf_pdf = in.floats("vndf", vndf);
-  for (std::size_t k = 0; k < t->vndf_pdf.size(); ++k)
-    if (t->vndf_pdf[k] < 0.0) fail(path, "field 'vndf' has a negative density at element " + std::to_string(k));
-  t->vndf_cond.resize(t->vndf_pdf.size());
-  const std::size_t slices = static_cast<std::size_t>(n_phi * n_theta);
-  t->vndf_marg.resize(slices * t->vy);
-  for (std::size_t s = 0; s < slices; ++s) {
-    const std::size_t slice = t->vx * t->vy;
-    const double total = build_warp_slice(t->vndf_pdf.data() + s * slice, t->vndf_cond.data() + s * slice,
-                                          t->vndf_marg.data() + s * t->vy, t->vx, t->vy);
-    in.check(total > 0.0 && std::isfinite(total),
-             "field 'vndf' slice " + std::to_string(s) + " (phi_i " + std::to_string(t->phi_i[s / n_theta]) + ", theta_i " +
-                 std::to_string(t->theta_i[s % n_theta]) + ") has no mass");
-  }
-
-  const Field& rgb = in.get("rgb", kFloat32, 5);
-  in.check(rgb.shape[0] == n_phi && rgb.shape[1] == n_theta && rgb.shape[2] == 3 && rgb.shape[3] >= 2 && rgb.shape[4] >= 2,
-           "field 'rgb' has shape " + dims(rgb) + ", expected " + params + " x 3 x rows x columns, at least 2 x 2");
-  t->ry = static_cast<std::size_t>(rgb.shape[3]);
-  t->rx = static_cast<std::size_t>(rgb.shape[4]);
-  t->rgb = in.floats("rgb", rgb);  // negative values (noise, out-of-gamut colour) are kept
-
-  // Unused by eval (it drives importance sampling), but a file whose luminance disagrees with its
-  // RGB table is inconsistent.
-  if (in.has("luminance")) {
-    const Field& lum = in.get("luminance", kFloat32, 4);
-    in.check(lum.shape[0] == n_phi && lum.shape[1] == n_theta && lum.shape[2] == rgb.shape[3] && lum.shape[3] == rgb.shape[4],
-             "field 'luminance' has shape " + dims(lum) + ", expected " + params + " x " + std::to_string(rgb.shape[3]) +
-                 " x " + std::to_string(rgb.shape[4]) + " to match 'rgb'");
-  }
+  t->ndf = read_grid(in, "ndf", false);
+  t->sigma = read_grid(in, "sigma", true);  // eval divides by it
+  const std::string params = std::to_string(t->phi_i.size()) + " (phi_i) x " + std::to_string(t->theta_i.size()) + " (theta_i)";
+  t->read_vndf(in, params);
+  t->read_rgb(in, params);
 
   const Field& jac = in.get("jacobian", kUInt8, 1);
   in.check(jac.count == 1, "field 'jacobian' has shape " + dims(jac) + ", expected 1");
   t->jacobian = in.data(jac)[0] != 0;
 
-  // Phi-averaged NDF and sigma: the mean of the bilinear interpolant over u_phi is the trapezoid rule over rows.
-  const Grid& g = t->ndf;
-  t->ndf_iso = phi_average(g);
-  t->sigma_iso = phi_average(t->sigma);
-  // integral D cos d(omega) = 2 pi int_0^1 D(u) cos(theta) sin(theta) (d theta / du) du, theta = (pi/2) u^2.
-  double integral = 0.0;
-  const double du = 1.0 / double(g.nx - 1);
-  const GaussRule gauss;
-  for (std::size_t x = 0; x + 1 < g.nx; ++x) {
-    for (std::size_t q = 0; q < gauss.x.size(); ++q) {
-      const double s = gauss.x[q];
-      const double u = (double(x) + s) * du;
-      const double theta = 0.5 * kPi * u * u;
-      const double d = (1.0 - s) * t->ndf_iso[x] + s * t->ndf_iso[x + 1];
-      integral += du * gauss.w[q] * d * std::cos(theta) * std::sin(theta) * kPi * u;
-    }
-  }
-  t->ndf_integral = 2.0 * kPi * integral;
-  in.check(t->ndf_integral > 0.0, "field 'ndf' is zero everywhere");
-
+  t->average_over_phi(in);
   return RglBsdf(std::move(t));
 }
 

@@ -36,35 +36,8 @@ struct LightDesc {
   Rgb value{1.0};        // directional: irradiance (W/m^2 per unit area facing it); point: intensity
 };
 
-// The material types a scene names (docs/scene-format.md), each once: the scene parser, load_material,
-// `render --material-type` and the lanes test (tests/render/test_shading_lanes.cpp) read this list.
-struct MaterialType {
-  const char* name;
-  bool needs_file;  // a "file" is required
-  bool reads_lut;   // the file is a LUT (`render --material` bakes a measurement first)
-  // How the stream path shades its plain form (unstretched, isotropic; ShadingModel::has_lanes, f_in_lanes):
-  // every part in SIMD lanes (f, density, sampling), or its density and sampling there and f one pair at
-  // a time. Tested for each type (tests/render/test_shading_lanes.cpp): a type that leaves the lanes fails there.
-  enum class Lanes { all, sampling } lanes;
-};
-inline constexpr MaterialType kMaterialTypes[] = {
-    {"measured", true, false, MaterialType::Lanes::sampling},  // MERL tables' f in lanes too; RGL's and UTIA's not
-    {"lut", true, true, MaterialType::Lanes::all},
-    {"ggx", false, true, MaterialType::Lanes::sampling},
-    {"beckmann", false, true, MaterialType::Lanes::sampling},
-    {"lsq", true, true, MaterialType::Lanes::sampling},
-    {"closures", true, true, MaterialType::Lanes::sampling},
-    {"material", true, true, MaterialType::Lanes::sampling},  // closures, as the production material picks them
-    {"lambert", false, false, MaterialType::Lanes::all},
-    {"analytic", true, false, MaterialType::Lanes::sampling},
-};
-// The named type, or null.
-const MaterialType* find_material_type(const std::string& name);
-// "measured, lut, ... or analytic", for messages and help.
-std::string material_type_list();
-
 struct MaterialDesc {
-  std::string type = "lambert";  // one of kMaterialTypes
+  std::string type = "lambert";  // one of kMaterialTypes (render/materials.h)
   std::string file;       // measured: any facetfit input; lut: the LUT; ggx/beckmann: optional LUT to take alpha and Fresnel from
   double alpha = 0.0;     // ggx/beckmann without a LUT
   Rgb f0{0.04}, f82{0.04};
@@ -143,7 +116,8 @@ struct Lut;
 std::shared_ptr<const ShadingModel> lut_parametric_model(const Lut& lut, const std::string& family, Smith smith, bool fresnel_curve,
                                                          bool anisotropic = false);
 
-// The shading model of a material: loads its file (and fits or tabulates what sampling needs).
+// The shading model of a material: loads its file (and fits or tabulates what sampling needs), by the
+// factory of its type's row of kMaterialTypes (render/materials.h). Throws Error for a type not there.
 std::shared_ptr<const ShadingModel> load_material(const SceneDesc& scene, const MaterialDesc& m);
 
 }  // namespace facetfit

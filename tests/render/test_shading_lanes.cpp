@@ -25,6 +25,7 @@
 #include "render/ggx_batch.h"
 #include "render/lambert_batch.h"
 #include "render/merl_batch.h"
+#include "render/materials.h"
 #include "render/scene.h"
 #include "render/shading.h"
 #include "render/simd_targets.h"
