@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "color/ciede2000.h"
-#include "color/colorspace.h"
+#include "color/ocio_config.h"
 #include "color/display.h"
 #include "color/image_diff.h"
 #include "commands.h"

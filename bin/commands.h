@@ -8,9 +8,9 @@
 #include <optional>
 #include <string>
 
-#include "color/colorspace.h"
+#include "color/ocio_config.h"
 #include "color/display.h"
-#include "core/color_space.h"
+#include "core/rgb_space.h"
 #include "fit/fit.h"
 
 namespace facetfit::cli {
@@ -44,7 +44,7 @@ void add_tolerance_option(CLI::App* cmd, double& tolerance);
 // The FitOptions they name, or nullopt after reporting a usage error (status 2).
 std::optional<FitOptions> fit_options(const FitSettings& settings, int& status);
 
-// The working colour space of a bake or a render (core/color_space.h): --working-space, from the config of
+// The working colour space of a bake or a render (core/rgb_space.h): --working-space, from the config of
 // --ocio-config or $OCIO. In the command module (bin/color_commands.cpp): it reads OpenColorIO.
 // And the pictures' display and view (--display, --view: render --png, the report's pictures).
 struct ColorSettings {

@@ -8,7 +8,7 @@
 
 #include "commands.h"
 #include "core/error.h"
-#include "farm.h"
+#include "farm_schedulers.h"
 #include "io/input.h"
 #include "lut/record.h"
 #include "progress.h"
@@ -47,7 +47,7 @@ struct ReportArgs {
   std::uint64_t max_memory = 0;
   FitSettings settings;
   ColorSettings color;  // the pictures' --display and --view
-  // --farm local|slurm: the report as a plan of shards (report/farm.h) run by an adapter (bin/farm.h).
+  // --farm local|slurm: the report as a plan of shards (report/farm.h) run by an adapter (bin/farm_schedulers.h).
   std::string farm;
   int shards = 4;
   bool wait = false, dry_run = false;

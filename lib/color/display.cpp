@@ -6,7 +6,7 @@
 #include <cmath>
 #include <string>
 
-#include "color/colorspace_ocio.h"
+#include "color/ocio_handles.h"
 #include "core/error.h"
 
 namespace facetfit {

@@ -12,7 +12,7 @@
 #include <string>
 
 #include "color/ciede2000.h"
-#include "core/color_space.h"
+#include "core/rgb_space.h"
 #include "core/vec.h"
 
 namespace facetfit {

@@ -11,7 +11,7 @@
 namespace facetfit {
 
 using Vec3 = glm::dvec3;
-using Rgb = glm::dvec3;  // linear RGB: Rec.709 primaries, or the working space a LUT or a render names (core/color_space.h)
+using Rgb = glm::dvec3;  // linear RGB: Rec.709 primaries, or the working space a LUT or a render names (core/rgb_space.h)
 
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kInvPi = 1.0 / kPi;

@@ -300,30 +300,30 @@ struct Solved {
 Solved solve(const MeasuredBins& bins, const AlbedoTarget* albedo, const Closures& start, int max_iterations) {
   Unknowns u(start);
   SmallProblem problem;
-  for (const MeasuredBins::Row& row : bins.rows) problem.AddResidualBlock(new ClosureRowCost(bins, row, u.lobes, u.with_coat), nullptr, u.blocks());
-  if (albedo && !albedo->cos_o.empty()) problem.AddResidualBlock(new AlbedoCost(*albedo, u.lobes, u.with_coat), nullptr, u.blocks());
+  for (const MeasuredBins::Row& row : bins.rows) problem.add_residual_block(new ClosureRowCost(bins, row, u.lobes, u.with_coat), u.blocks());
+  if (albedo && !albedo->cos_o.empty()) problem.add_residual_block(new AlbedoCost(*albedo, u.lobes, u.with_coat), u.blocks());
   if (bins.rows.empty()) return {start, 0.0};
-  for (int c = 0; c < 3; ++c) problem.SetParameterLowerBound(u.body.data(), c, 0.0);
+  for (int c = 0; c < 3; ++c) problem.set_lower_bound(u.body.data(), c, 0.0);
   if (u.with_coat) {
-    problem.SetParameterLowerBound(u.coat.data(), 0, std::log(1e-3));
-    problem.SetParameterUpperBound(u.coat.data(), 0, 0.0);
-    problem.SetParameterLowerBound(u.coat.data(), 1, 0.0);
-    problem.SetParameterUpperBound(u.coat.data(), 1, 1.0);
+    problem.set_lower_bound(u.coat.data(), 0, std::log(1e-3));
+    problem.set_upper_bound(u.coat.data(), 0, 0.0);
+    problem.set_lower_bound(u.coat.data(), 1, 0.0);
+    problem.set_upper_bound(u.coat.data(), 1, 1.0);
   } else {
-    problem.SetParameterBlockConstant(u.coat.data());
+    problem.set_constant(u.coat.data());
   }
   for (Unknowns::Lobe& l : u.lobes) {
     const bool tint = l.fresnel == ClosureLobe::Fresnel::f82_tint;
-    problem.SetParameterLowerBound(l.shape.data(), 0, std::log(1e-3));
-    problem.SetParameterUpperBound(l.shape.data(), 0, 0.0);
-    problem.SetParameterLowerBound(l.shape.data(), 1, tint ? 0.0 : 0.25);
-    problem.SetParameterUpperBound(l.shape.data(), 1, tint ? 1.0 : 10.0);
-    problem.SetParameterLowerBound(l.shape.data(), 2, 0.0);
-    problem.SetParameterUpperBound(l.shape.data(), 2, kMaxViewExponent);
+    problem.set_lower_bound(l.shape.data(), 0, std::log(1e-3));
+    problem.set_upper_bound(l.shape.data(), 0, 0.0);
+    problem.set_lower_bound(l.shape.data(), 1, tint ? 0.0 : 0.25);
+    problem.set_upper_bound(l.shape.data(), 1, tint ? 1.0 : 10.0);
+    problem.set_lower_bound(l.shape.data(), 2, 0.0);
+    problem.set_upper_bound(l.shape.data(), 2, kMaxViewExponent);
     for (double* block : {l.f0.data(), l.second.data()})
-      for (int c = 0; c < 3; ++c) problem.SetParameterLowerBound(block, c, 0.0), problem.SetParameterUpperBound(block, c, 1.0);
+      for (int c = 0; c < 3; ++c) problem.set_lower_bound(block, c, 0.0), problem.set_upper_bound(block, c, 1.0);
   }
-  const double cost = problem.Solve(max_iterations, 1e-6).final_cost;
+  const double cost = problem.solve(max_iterations, 1e-6).final_cost;
   return {u.closures(), cost};
 }
 

@@ -23,17 +23,17 @@ using namespace lobe_terms;
 // body, reflectances f0 and f82 in [0, 1] (the starts are clamped there by the callers).
 void bound_lobe(SmallProblem& problem, double* log_alpha, int alphas, double* body, double* f0, double* f82) {
   for (int a = 0; a < alphas; ++a) {
-    problem.SetParameterLowerBound(log_alpha, a, std::log(1e-3));
-    problem.SetParameterUpperBound(log_alpha, a, std::log(4.0));
+    problem.set_lower_bound(log_alpha, a, std::log(1e-3));
+    problem.set_upper_bound(log_alpha, a, std::log(4.0));
   }
   for (double* p : {body, f0, f82})
-    for (int c = 0; c < 3; ++c) problem.SetParameterLowerBound(p, c, 0.0);
+    for (int c = 0; c < 3; ++c) problem.set_lower_bound(p, c, 0.0);
   for (double* p : {f0, f82})
-    for (int c = 0; c < 3; ++c) problem.SetParameterUpperBound(p, c, 1.0);
+    for (int c = 0; c < 3; ++c) problem.set_upper_bound(p, c, 1.0);
 }
 
 // The parametric fits' solve: a dense problem of 8 to 14 unknowns (fit/small_problem.h).
-void solve(SmallProblem& problem, int max_iterations) { problem.Solve(max_iterations, 1e-6); }
+void solve(SmallProblem& problem, int max_iterations) { problem.solve(max_iterations, 1e-6); }
 
 // The derivatives of residual r (channel e) in the colour blocks, body (0), f0 (2) and f82 (3), of a model
 // body / pi + F lobe + ...; dm is the residual's derivative in the model.
@@ -134,18 +134,18 @@ ParametricFit fit_parametric(const MeasuredBins& bins, const MeasuredBins& error
   double coat[2] = {std::log(with_coat ? start.coat.alpha : 0.1), start.coat.f0};
   SmallProblem problem;
   for (const MeasuredBins::Row& row : bins.rows) {
-    problem.AddResidualBlock(new RowCost(bins, row, start.type, smith, start.fresnel, with_coat), nullptr, body, log_alpha, f0, f82, coat);
+    problem.add_residual_block(new RowCost(bins, row, start.type, smith, start.fresnel, with_coat), body, log_alpha, f0, f82, coat);
   }
   if (bins.rows.empty()) return fit;
   bound_lobe(problem, log_alpha, 1, body, f0, f82);
-  if (start.fresnel == ParametricFit::FresnelForm::schlick) problem.SetParameterBlockConstant(f82);
+  if (start.fresnel == ParametricFit::FresnelForm::schlick) problem.set_constant(f82);
   if (with_coat) {
-    problem.SetParameterLowerBound(coat, 0, std::log(1e-3));
-    problem.SetParameterUpperBound(coat, 0, std::log(1.0));
-    problem.SetParameterLowerBound(coat, 1, 0.0);
-    problem.SetParameterUpperBound(coat, 1, 1.0);
+    problem.set_lower_bound(coat, 0, std::log(1e-3));
+    problem.set_upper_bound(coat, 0, std::log(1.0));
+    problem.set_lower_bound(coat, 1, 0.0);
+    problem.set_upper_bound(coat, 1, 1.0);
   } else {
-    problem.SetParameterBlockConstant(coat);
+    problem.set_constant(coat);
   }
 
   solve(problem, max_iterations);
@@ -259,7 +259,7 @@ AnisotropicParametricFit fit_parametric_anisotropic(const MeasuredBins& bins, co
   if (bins.rows.empty()) return fit;
   SmallProblem problem;
   for (const MeasuredBins::Row& row : bins.rows) {
-    problem.AddResidualBlock(new AnisotropicRowCost(bins, row, start.type, smith), nullptr, body, shape, f0, f82);
+    problem.add_residual_block(new AnisotropicRowCost(bins, row, start.type, smith), body, shape, f0, f82);
   }
   bound_lobe(problem, shape, 2, body, f0, f82);  // log alpha_x, log alpha_y; the angle is free
 

@@ -350,30 +350,28 @@ std::vector<AlbedoRefineCost::View> albedo_views(const AlbedoTarget& target, con
 void add_smoothness(SmallProblem& problem, const FresnelKnots& knots, LobeUnknowns& x, const RefineOptions& options) {
   const std::vector<int>& k = knots.entry;
   for (std::size_t j = 1; j + 1 < k.size(); ++j)
-    problem.AddResidualBlock(new ceres::AutoDiffCostFunction<SecondDifference<3>, 3, 3, 3, 3>(
-                                 new SecondDifference<3>(fresnel_smoothness(options.fresnel_smoothness, k[j - 1], k[j], k[j + 1]))),
-                             nullptr, x.fresnel[std::size_t(k[j - 1])].data(), x.fresnel[std::size_t(k[j])].data(),
+    problem.add_residual_block(new ceres::AutoDiffCostFunction<SecondDifference<3>, 3, 3, 3, 3>(
+                                 new SecondDifference<3>(fresnel_smoothness(options.fresnel_smoothness, k[j - 1], k[j], k[j + 1]))), x.fresnel[std::size_t(k[j - 1])].data(), x.fresnel[std::size_t(k[j])].data(),
                              x.fresnel[std::size_t(k[j + 1])].data());
   std::vector<double>& d = x.d;
   for (std::size_t j = 1; j + 1 < d.size(); ++j) {
     const double scale = std::max(d[j], 1e-3 * d[0] + 1e-6);
-    problem.AddResidualBlock(new ceres::AutoDiffCostFunction<SecondDifference<1>, 1, 1, 1, 1>(
+    problem.add_residual_block(new ceres::AutoDiffCostFunction<SecondDifference<1>, 1, 1, 1, 1>(
                                  new SecondDifference<1>{options.ndf_smoothness / scale, -2.0 * options.ndf_smoothness / scale,
-                                                         options.ndf_smoothness / scale}),
-                             nullptr, &d[j - 1], &d[j], &d[j + 1]);
+                                                         options.ndf_smoothness / scale}), &d[j - 1], &d[j], &d[j + 1]);
   }
 }
 
 // Bounds, not a clamp afterwards: left free, the solve trades negative nodes against each other. A
 // Fresnel factor is a reflectance: in [0, 1] (above 1 the fit would trade the NDF's scale for it).
 void set_bounds(SmallProblem& problem, const FresnelKnots& knots, LobeUnknowns& x) {
-  for (int c = 0; c < 3; ++c) problem.SetParameterLowerBound(x.body.data(), c, 0.0);
-  problem.SetParameterLowerBound(&x.exponent, 0, 1.0), problem.SetParameterUpperBound(&x.exponent, 0, kMaxBodyExponent);
+  for (int c = 0; c < 3; ++c) problem.set_lower_bound(x.body.data(), c, 0.0);
+  problem.set_lower_bound(&x.exponent, 0, 1.0), problem.set_upper_bound(&x.exponent, 0, kMaxBodyExponent);
   for (int j : knots.entry)
     for (int c = 0; c < 3; ++c)
-      problem.SetParameterLowerBound(x.fresnel[std::size_t(j)].data(), c, 0.0),
-          problem.SetParameterUpperBound(x.fresnel[std::size_t(j)].data(), c, 1.0);
-  for (double& v : x.d) problem.SetParameterLowerBound(&v, 0, 0.0);
+      problem.set_lower_bound(x.fresnel[std::size_t(j)].data(), c, 0.0),
+          problem.set_upper_bound(x.fresnel[std::size_t(j)].data(), c, 1.0);
+  for (double& v : x.d) problem.set_lower_bound(&v, 0, 0.0);
 }
 
 // The fit the unknowns stand for: the body, its exponent (Lambert's where it does nothing visible: within
@@ -430,21 +428,20 @@ LobeFit refine_lobe(const MeasuredBins& bins, const Quadrature& quad, Smith smit
       std::vector<double*> blocks{x.body.data(), &x.exponent};
       for (int e : row_entries[r].node) blocks.push_back(x.fresnel[std::size_t(e)].data());
       for (int n : row_nodes[r].node) blocks.push_back(&x.d[std::size_t(n)]);
-      problem.AddResidualBlock(new LobeRowCost(bins, bins.rows[r], terms, row_entries[r], row_nodes[r]), nullptr, blocks);
+      problem.add_residual_block(new LobeRowCost(bins, bins.rows[r], terms, row_entries[r], row_nodes[r]), blocks);
     }
     const std::vector<double*> all_nodes = x.node_blocks();
-    problem.AddResidualBlock(new NormalizationCost(quad.projected_area(), 10.0), nullptr, all_nodes);
+    problem.add_residual_block(new NormalizationCost(quad.projected_area(), 10.0), all_nodes);
     if (albedo) {
       std::vector<double*> blocks{x.body.data(), &x.exponent};
       for (int e : knots.entry) blocks.push_back(x.fresnel[std::size_t(e)].data());
       blocks.insert(blocks.end(), all_nodes.begin(), all_nodes.end());
-      problem.AddResidualBlock(new AlbedoRefineCost(*options.albedo, albedo_views(*options.albedo, fit, smith, quad.grid(), knots),
-                                                    knots.size(), x.d.size()),
-                               nullptr, blocks);
+      problem.add_residual_block(new AlbedoRefineCost(*options.albedo, albedo_views(*options.albedo, fit, smith, quad.grid(), knots),
+                                                    knots.size(), x.d.size()), blocks);
     }
     add_smoothness(problem, knots, x, options);
     set_bounds(problem, knots, x);
-    problem.Solve(options.max_iterations, options.function_tolerance);
+    problem.solve(options.max_iterations, options.function_tolerance);
 
     fit.ndf.ndf = x.d;
     const double area = normalize_ndf(fit.ndf, quad);  // F D stays what the solve found

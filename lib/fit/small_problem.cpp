@@ -55,16 +55,16 @@ std::size_t SmallProblem::block_of(double* values, int size) {
   return blocks_.size() - 1;
 }
 
-void SmallProblem::AddResidualBlock(ceres::CostFunction* cost, std::nullptr_t, std::vector<double*> blocks) {
+void SmallProblem::add_residual_block(ceres::CostFunction* cost, std::vector<double*> blocks) {
   Residuals r{std::unique_ptr<ceres::CostFunction>(cost), {}};
   const std::vector<int32_t>& sizes = cost->parameter_block_sizes();
   for (std::size_t k = 0; k < blocks.size(); ++k) r.blocks.push_back(int(block_of(blocks[k], sizes[k])));
   residuals_.push_back(std::move(r));
 }
 
-void SmallProblem::SetParameterLowerBound(double* block, int index, double bound) { blocks_[block_of(block)].lower[std::size_t(index)] = bound; }
-void SmallProblem::SetParameterUpperBound(double* block, int index, double bound) { blocks_[block_of(block)].upper[std::size_t(index)] = bound; }
-void SmallProblem::SetParameterBlockConstant(double* block) { blocks_[block_of(block)].constant = true; }
+void SmallProblem::set_lower_bound(double* block, int index, double bound) { blocks_[block_of(block)].lower[std::size_t(index)] = bound; }
+void SmallProblem::set_upper_bound(double* block, int index, double bound) { blocks_[block_of(block)].upper[std::size_t(index)] = bound; }
+void SmallProblem::set_constant(double* block) { blocks_[block_of(block)].constant = true; }
 
 namespace {
 
@@ -240,7 +240,7 @@ int levenberg_marquardt(const Evaluate& evaluate, const Vector& lower, const Vec
 
 }  // namespace
 
-SmallProblem::Summary SmallProblem::Solve(int max_iterations, double function_tolerance) {
+SmallProblem::Summary SmallProblem::solve(int max_iterations, double function_tolerance) {
   Summary summary;
   int n = 0;
   for (Block& b : blocks_) b.offset = b.constant ? -1 : (n += b.size) - b.size;

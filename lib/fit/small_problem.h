@@ -37,23 +37,23 @@ class SmallProblem {
 
   // The residual block `cost` (the problem takes it) over `blocks` (each of the size the cost function declares). A block is
   // known by its address; the first use of an address adds it, unbounded and variable.
-  void AddResidualBlock(ceres::CostFunction* cost, std::nullptr_t, std::vector<double*> blocks);
+  void add_residual_block(ceres::CostFunction* cost, std::vector<double*> blocks);
   template <class... Blocks>
-  void AddResidualBlock(ceres::CostFunction* cost, std::nullptr_t, Blocks*... blocks) {
-    AddResidualBlock(cost, nullptr, std::vector<double*>{blocks...});
+  void add_residual_block(ceres::CostFunction* cost, Blocks*... blocks) {
+    add_residual_block(cost, std::vector<double*>{blocks...});
   }
-  void SetParameterLowerBound(double* block, int index, double bound);
-  void SetParameterUpperBound(double* block, int index, double bound);
-  void SetParameterBlockConstant(double* block);
+  void set_lower_bound(double* block, int index, double bound);
+  void set_upper_bound(double* block, int index, double bound);
+  void set_constant(double* block);
 
   struct Summary {
     int iterations = 0;       // accepted steps
     double final_cost = 0.0;  // 1/2 sum r^2
   };
   // Moves the blocks' values (clamped into their bounds first) toward a minimum of 1/2 sum r^2.
-  Summary Solve(int max_iterations, double function_tolerance = 1e-6);
+  Summary solve(int max_iterations, double function_tolerance = 1e-6);
 
-  // What the problem holds, as Solve's steps (small_problem.cpp) read it.
+  // What the problem holds, as solve's steps (small_problem.cpp) read it.
   struct Block {
     double* values;
     int size;

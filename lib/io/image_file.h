@@ -34,7 +34,7 @@ struct ImageSpec {
   // Scene-linear colour (a render): an OpenEXR file then carries the space's standard `chromaticities`
   // attribute and its name (oiio:ColorSpace), for compositors and image tools. Empty name: neither.
   std::string linear_space;
-  std::array<float, 8> linear_chromaticities{};  // red, green, blue, white (x, y): core/color_space.h
+  std::array<float, 8> linear_chromaticities{};  // red, green, blue, white (x, y): core/rgb_space.h
   std::map<std::string, ImageAttribute> attributes;
 
   ImageSpec() = default;

@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "core/color_space.h"
+#include "core/rgb_space.h"
 #include "fit/fit.h"
 #include "fit/recommend.h"
 
@@ -16,7 +16,7 @@ struct BakeOptions {
   double tolerance = kDefaultTolerance;  // how much farther a parametric fit may be and still be recommended (fit/recommend.h)
   bool with_sampling = true;
   bool force = false;  // bake even when the cache says the outputs are current
-  // The space of the LUT's colours (core/color_space.h) and its matrix from lin_rec709, the fit's space.
+  // The space of the LUT's colours (core/rgb_space.h) and its matrix from lin_rec709, the fit's space.
   std::string colorspace = kRec709Space;
   ColorMatrix from_rec709{1.0};
 };

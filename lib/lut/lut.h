@@ -6,7 +6,7 @@
 #include <optional>
 #include <string>
 
-#include "core/color_space.h"
+#include "core/rgb_space.h"
 #include "fit/fit.h"
 #include "fit/recommend.h"
 #include "model/parametric.h"
@@ -71,7 +71,7 @@ struct LutMetadata {
   Closures closures;
   double error_closures = 0.0;
   std::vector<std::string> warnings;  // implausible values found when fitting (fit/plausibility.h)
-  // The linear space every colour above and every Fresnel row is in (core/color_space.h), and its matrix
+  // The linear space every colour above and every Fresnel row is in (core/rgb_space.h), and its matrix
   // from lin_rec709. Written only when it is another space (facetfit:colorspace, facetfit:colorspace_matrix).
   std::string colorspace = kRec709Space;
   ColorMatrix from_rec709{1.0};

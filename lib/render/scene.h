@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "core/color_space.h"
+#include "core/rgb_space.h"
 #include "core/vec.h"
 #include "model/smith.h"
 #include "model/stretch.h"
@@ -84,7 +84,7 @@ struct SceneDesc {
   std::vector<ObjectDesc> objects;
   std::string base_dir = ".";  // where relative file names resolve
   std::string source;          // the scene file (or what stands for it), named in errors; empty: made in code
-  // The linear space the render is in (core/color_space.h) and its matrix from lin_rec709. The scene's
+  // The linear space the render is in (core/rgb_space.h) and its matrix from lin_rec709. The scene's
   // colours (lights, environment, plain materials) and measurements are lin_rec709 and converted by it;
   // a LUT from the space it records.
   std::string working_space = kRec709Space;

@@ -1,6 +1,6 @@
 // The nightly report split over a cluster: which materials each shard renders, balanced by the previous
 // report's timings and deterministic, each shard's command and the merge's. A plan is data: the
-// scheduler adapters of the command (bin/farm.cpp: local processes, Slurm) run or submit it, and print it.
+// scheduler adapters of the command (bin/farm_schedulers.cpp: local processes, Slurm) run or submit it, and print it.
 #pragma once
 
 #include <nlohmann/json.hpp>

@@ -20,7 +20,7 @@
 #include <vector>
 
 #include "arrays.h"
-#include "color/colorspace.h"
+#include "color/ocio_config.h"
 #include "color/image_diff.h"
 #include "core/error.h"
 #include "core/memory_budget.h"

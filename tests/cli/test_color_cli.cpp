@@ -401,7 +401,7 @@ TEST(WorkingSpace, AnAcesCgBakeRendersAsTheRec709Bake) {
     EXPECT_GT(mean_delta_e(rec709, raw), 1.0) << m << ": the conversion back is not what closes the gap";
   }
   // The LUT says its space; the render's EXR names it and carries its chromaticities as the config's
-  // conversion places them: AP1's primaries adapted to the D65 white (core/color_space.h).
+  // conversion places them: AP1's primaries adapted to the D65 white (core/rgb_space.h).
   EXPECT_NE(facetfit("info " + dir.file("acescg/red-plastic.exr")).out.find("colour space    ACEScg"), std::string::npos);
   // Its MaterialX document says the space in MaterialX's own name; a Rec.709 bake's says lin_rec709.
   ASSERT_EQ(facetfit("export " + dir.file("acescg/red-plastic.exr") + " " + dir.file("rec709/gold-ggx-0.15.exr") + " -o " + dir.file("mtlx")).status, 0);

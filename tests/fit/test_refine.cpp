@@ -209,8 +209,8 @@ class Offsets final : public ceres::CostFunction {
 TEST(SmallProblem, ReachesTheRosenbrockValleysEnd) {
   double x[2] = {-1.2, 1.0};
   SmallProblem problem;
-  problem.AddResidualBlock(new Rosenbrock, nullptr, x);
-  const SmallProblem::Summary s = problem.Solve(200, 1e-14);
+  problem.add_residual_block(new Rosenbrock, x);
+  const SmallProblem::Summary s = problem.solve(200, 1e-14);
   EXPECT_NEAR(x[0], 1.0, 1e-5);
   EXPECT_NEAR(x[1], 1.0, 1e-5);
   EXPECT_LT(s.final_cost, 1e-10);
@@ -220,12 +220,12 @@ TEST(SmallProblem, ReachesTheRosenbrockValleysEnd) {
 TEST(SmallProblem, StopsAtTheBoundsAndKeepsConstantBlocks) {
   double x[3] = {0.0, 0.5, 0.0}, fixed[3] = {7.0, 8.0, 9.0};
   SmallProblem problem;
-  problem.AddResidualBlock(new Offsets, nullptr, x);
-  problem.AddResidualBlock(new Offsets, nullptr, fixed);
-  problem.SetParameterUpperBound(x, 0, 1.0);  // the minimum, 2, is past it
-  problem.SetParameterLowerBound(x, 1, 0.0);  // -1 is below it
-  problem.SetParameterBlockConstant(fixed);
-  problem.Solve(50);
+  problem.add_residual_block(new Offsets, x);
+  problem.add_residual_block(new Offsets, fixed);
+  problem.set_upper_bound(x, 0, 1.0);  // the minimum, 2, is past it
+  problem.set_lower_bound(x, 1, 0.0);  // -1 is below it
+  problem.set_constant(fixed);
+  problem.solve(50);
   EXPECT_NEAR(x[0], 1.0, 1e-12);
   EXPECT_NEAR(x[1], 0.0, 1e-12);
   EXPECT_NEAR(x[2], 5.0, 1e-6);

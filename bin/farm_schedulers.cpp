@@ -1,7 +1,7 @@
 // The scheduler adapters of `report --farm`: a plan (report/farm.h) run as local processes, or submitted to
 // Slurm as one job array and a merge job. Both retry a failed shard once and publish the merged report
 // only when every shard succeeded.
-#include "farm.h"
+#include "farm_schedulers.h"
 
 #include <fcntl.h>
 #include <spawn.h>

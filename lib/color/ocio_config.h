@@ -1,11 +1,11 @@
 // The colour spaces of a studio's OpenColorIO config: the matrix from lin_rec709 to a working space
-// (ACEScg, say), for a bake or a render in that space (core/color_space.h).
+// (ACEScg, say), for a bake or a render in that space (core/rgb_space.h).
 #pragma once
 
 #include <memory>
 #include <string>
 
-#include "core/color_space.h"
+#include "core/rgb_space.h"
 
 namespace facetfit {
 
@@ -23,7 +23,7 @@ class ColorConfig {
   // conversion is not a 3x3 matrix (a log or display space).
   ColorMatrix from_rec709(const std::string& space) const;
 
-  struct Opaque;  // OpenColorIO's config (color/colorspace_ocio.h)
+  struct Opaque;  // OpenColorIO's config (color/ocio_handles.h)
   const Opaque* opaque() const { return config_.get(); }
 
  private:

@@ -2,7 +2,7 @@
 //
 // facetfit measures and fits in linear RGB with Rec.709 primaries and the D65 white (kRec709Space): the
 // RGB of MERL, RGL and UTIA files. A studio renders in another linear space (ACEScg), named by its
-// OpenColorIO config (color/colorspace.h reads the matrices off it). Between two linear spaces a colour
+// OpenColorIO config (color/ocio_config.h reads the matrices off it). Between two linear spaces a colour
 // converts by one matrix, rgb_to = M rgb_from; a LUT and a render record the space their colours are in.
 #pragma once
 

@@ -1,4 +1,4 @@
-#include "color/colorspace.h"
+#include "color/ocio_config.h"
 
 #include <cmath>
 #include <cstdlib>
@@ -7,7 +7,7 @@
 
 #include <glm/matrix.hpp>
 
-#include "color/colorspace_ocio.h"
+#include "color/ocio_handles.h"
 #include "core/error.h"
 
 namespace facetfit {

@@ -3,7 +3,7 @@
 
 #include <OpenColorIO/OpenColorIO.h>
 
-#include "color/colorspace.h"
+#include "color/ocio_config.h"
 
 namespace OCIO = OCIO_NAMESPACE;
 

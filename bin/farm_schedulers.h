@@ -1,4 +1,4 @@
-// The scheduler adapters of `report --farm` (bin/farm.cpp): they run or submit a plan (report/farm.h).
+// The scheduler adapters of `report --farm` (bin/farm_schedulers.cpp): they run or submit a plan (report/farm.h).
 #pragma once
 
 #include <string>
