@@ -24,7 +24,7 @@ Representation recommend(double error_tabulated, double error_ggx, double error_
   const bool closures_fitted = error_closures > 0.0;
   double nearest = error_tabulated;
   for (double e : {error_ggx, error_beckmann, closures_fitted ? error_closures : error_tabulated}) nearest = std::min(nearest, e);
-  const double bar = std::max(nearest * (1.0 + tolerance), nearest + 0.005);
+  const double bar = std::max(nearest * (1.0 + tolerance), nearest + kAbsoluteTolerance);
   // A distance that is not a number (a fit that failed, or a NaN bar) never passes.
   const bool ggx = error_ggx <= bar, beckmann = error_beckmann <= bar;
   if (ggx && beckmann) return error_ggx <= error_beckmann ? Representation::ggx : Representation::beckmann;

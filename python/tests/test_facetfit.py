@@ -63,21 +63,24 @@ def test_recommended_agrees_with_the_record_and_the_lut(tmp_path):
     f = facetfit.fit("builtin:red-plastic")
     rec = f.recommended()
     assert rec == f.record["recommended"]
-    # The tabulated lobe is nearest (0.002 from the measurement), the closures within 0.005 of it (0.005), the
-    # F82 GGX fit beyond (0.028): the closures are the cheapest near enough. A tolerance of 20 takes the GGX fit.
-    assert rec["representation"] == "closures" and rec["alpha"] is None
-    assert rec["error"] == pytest.approx(f.record["closures"]["error"])
+    # The tabulated lobe is nearest (0.002 from the measurement), the closures (0.0048) beyond 0.2 / 116 of it,
+    # the F82 GGX fit far beyond (0.028): the tabulated lobe. A tolerance of 2 takes the closures, 20 the GGX fit.
+    assert rec["representation"] == "tabulated" and rec["alpha"] is None
+    assert rec["error"] == pytest.approx(f.record["error"])
+    closures = f.recommended(tolerance=2.0)
+    assert closures["representation"] == "closures" and closures["alpha"] is None
+    assert closures["error"] == pytest.approx(f.record["closures"]["error"])
     cheap = f.recommended(tolerance=20.0)
     assert cheap["representation"] == "ggx" and cheap["alpha"] == pytest.approx(f.record["ggx"]["alpha"])
     assert cheap["alpha"] != pytest.approx(f.alpha_ggx, rel=1e-3)  # the moment estimate is not the fit
     f.write_lut(tmp_path / "red.exr")
     lut = facetfit.read_lut(tmp_path / "red.exr")
     assert lut.representation == rec["representation"] == lut.recommended["representation"]
-    assert lut.recommended["alpha"] is None  # the closures' alphas are their lobes'
+    assert lut.recommended["alpha"] is None  # the tabulated lobe's NDF is a table
     assert lut.recommended["error"] == pytest.approx(rec["error"], rel=1e-6)
     for key in ("f0", "f82", "body"):
         assert lut.recommended[key] == pytest.approx(rec[key], rel=1e-6, abs=1e-7)
-    assert f.recommended(tolerance=0.0)["representation"] == "closures"  # within the absolute 0.005
+    assert f.recommended(tolerance=0.0)["representation"] == "tabulated"
     assert facetfit.fit("builtin:black-glossy-ggx-0.08").recommended()["alpha"] is None
 
 

@@ -206,13 +206,13 @@ TEST(Bake, RecommendedParametersAgreeEverywhere) {
       EXPECT_EQ(sidecar["representation"], from_fit["representation"]);
       EXPECT_EQ(from_info["representation"], from_fit["representation"]);
       EXPECT_EQ(from_info["alpha"].is_null(), from_fit["representation"] == "tabulated" || from_fit["representation"] == "closures");
-      // The one definition: the cheapest representation within max((1 + T) d, d + 0.005) of the nearest one's d,
-      // the nearer parametric fit, else the closures (where fitted), else the tabulated lobe.
+      // The one definition: the cheapest representation within max((1 + T) d, d + 0.2 / 116) of the nearest one's d
+      // (0.2 L* units), the nearer parametric fit, else the closures (where fitted), else the tabulated lobe.
       const nlohmann::json record = nlohmann::json::parse(fit.out);
       const double tab = record["error"], ggx = record["ggx"]["error"], beckmann = record["beckmann"]["error"];
       const double closures = record["closures"]["error"];
       const double d = std::min({tab, ggx, beckmann, closures > 0.0 ? closures : tab});
-      const double tolerance = flags == " --tolerance 100" ? 100.0 : 0.02, bar = std::max((1.0 + tolerance) * d, d + 0.005);
+      const double tolerance = flags == " --tolerance 100" ? 100.0 : 0.02, bar = std::max((1.0 + tolerance) * d, d + 0.2 / 116.0);
       const std::string expected = std::min(ggx, beckmann) <= bar ? (ggx <= beckmann ? "ggx" : "beckmann")
                                    : closures > 0.0 && closures <= bar ? "closures"
                                                                        : "tabulated";

@@ -112,7 +112,10 @@ TEST(Stress, ANaNDistanceIsNeverRecommended) {
 // tabulated lobe; closures that were not fitted (distance 0, --refine none) are not a candidate.
 TEST(Stress, RecommendationIsTheCheapestNearEnough) {
   EXPECT_EQ(recommend(0.100, 0.102, 0.2, 0.101, 0.02), Representation::ggx);
-  EXPECT_EQ(recommend(0.100, 0.2, 0.2, 0.104, 0.02), Representation::closures);
+  EXPECT_EQ(recommend(0.100, 0.2, 0.2, 0.1019, 0.02), Representation::closures);  // within 2%
+  // Within 0.2 L* units (0.2 / 116 = 0.00172) where 2% is less, and just beyond it.
+  EXPECT_EQ(recommend(0.010, 0.2, 0.2, 0.0117, 0.02), Representation::closures);
+  EXPECT_EQ(recommend(0.010, 0.2, 0.2, 0.0118, 0.02), Representation::tabulated);
   EXPECT_EQ(recommend(0.100, 0.2, 0.2, 0.2, 0.02), Representation::tabulated);
   EXPECT_EQ(recommend(0.2, 0.1, 0.2, 0.0, 0.02), Representation::ggx);
   EXPECT_EQ(recommend(0.2, 0.3, 0.3, 0.0, 0.02), Representation::tabulated);
