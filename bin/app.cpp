@@ -73,7 +73,7 @@ void add_max_memory_option(CLI::App* cmd, std::uint64_t& bytes, const std::strin
 void add_tolerance_option(CLI::App* cmd, double& tolerance) {
   cmd->add_option("--tolerance", tolerance,
                   "The recommended representation is the cheapest to shade (a GGX or Beckmann fit, then the closures, then "
-                  "the tabulated lobe) whose distance from the measurement is at most (1 + T) times the nearest one's (or 0.005 more)")
+                  "the tabulated lobe) whose distance from the measurement is at most (1 + T) times the nearest one's (or 0.2 L* units, 0.2 / 116, more)")
       ->check(finite_in(0.0, 1e30))  // what a LUT reader accepts (lut/lut.cpp)
       ->capture_default_str();
 }
