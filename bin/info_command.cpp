@@ -4,6 +4,7 @@
 
 #include "commands.h"
 #include "core/error.h"
+#include "fit/representations.h"
 #include "io/input.h"
 #include "lut/lut.h"
 #include "lut/record.h"
@@ -28,9 +29,8 @@ nlohmann::json info_json(const Lut& lut) {
   const auto parametric = [](const LutMetadata::Parametric& p, double error) {
     return parametric_json(p.alpha, p.body, p.f0, p.f82, p.coat, error);
   };
-  j["metadata"]["ggx"] = parametric(m.ggx, m.error_ggx);
-  j["metadata"]["beckmann"] = parametric(m.beckmann, m.error_beckmann);
-  j["metadata"]["lsq"] = parametric(m.lsq, m.error_lsq);
+  for (const RepresentationRow& r : kRepresentations)  // ggx, beckmann, lsq (fit/representations.h)
+    if (r.parametric) j["metadata"][r.name] = parametric(*m.fit(r.name), m.distance(r.name));
   // What the production OSL material renders: version 5's closures, or an older LUT's one lobe.
   j["metadata"]["closures"] = closures_json(lut.closures(), m.error_closures);
   j["metadata"]["anisotropic"] = nullptr;
@@ -102,17 +102,18 @@ void print_info(const Lut& lut) {
   if (m.coat.present()) std::printf(", coat alpha %.5f f0 %.4f", m.coat.alpha, m.coat.f0);
   std::printf("\n");
   // Distances from the measurement (fit/measurement.h); a LUT baked before fit revision 9 with --refine none has 0.
-  std::printf("distance        tabulated %.4f (paper's fit %.4f), ggx %.4f, beckmann %.4f, lsq %.4f\n", m.error,
-              m.error_extraction, m.error_ggx, m.error_beckmann, m.error_lsq);
+  std::printf("distance        tabulated %.4f (paper's fit %.4f)", m.error, m.error_extraction);
+  for (const RepresentationRow& r : kRepresentations)
+    if (r.parametric) std::printf(", %s %.4f", r.name, m.distance(r.name));
+  std::printf("\n");
   const auto parametric = [](const char* name, const LutMetadata::Parametric& p) {
     std::printf("%-15s alpha %.5f, body %.4f %.4f %.4f, f0 %.4f %.4f %.4f, f82 %.4f %.4f %.4f", name, p.alpha, p.body.r,
                 p.body.g, p.body.b, p.f0.r, p.f0.g, p.f0.b, p.f82.r, p.f82.g, p.f82.b);
     if (p.coat.present()) std::printf(", coat alpha %.5f f0 %.4f", p.coat.alpha, p.coat.f0);
     std::printf("\n");
   };
-  parametric("ggx", m.ggx);
-  parametric("beckmann", m.beckmann);
-  parametric("lsq", m.lsq);
+  for (const RepresentationRow& r : kRepresentations)
+    if (r.parametric) parametric(r.name, *m.fit(r.name));
   print_closures(lut.closures(), m.error_closures, m.format_version >= kLutClosuresVersion);
   if (const auto& a = lut.anisotropic) {
     const AnisotropicParametricFit& g = m.anisotropic_ggx;

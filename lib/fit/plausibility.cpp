@@ -4,6 +4,7 @@
 #include <cstdio>
 
 #include "fit/fit.h"
+#include "fit/representations.h"
 #include "model/parametric.h"
 #include "model/tabulated.h"
 
@@ -65,11 +66,12 @@ std::vector<std::string> plausibility_warnings(const HalfDiffTable& table, const
     break;
   }
   if (fit.refined)
-    for (const auto& [name, p] : {std::pair<const char*, const ParametricFit*>{"ggx", &fit.ggx}, {"beckmann", &fit.beckmann}, {"lsq", &fit.lsq}}) {
-      const auto [c0, f0] = above(p->f0, 1.0);
-      const auto [c82, f82] = above(p->f82, 1.0);
-      if (c0 >= 0) out.push_back(std::string(name) + format(" fit: f0 above 1 (%.3f, ", f0) + HalfDiffTable::channel_name(c0) + ")");
-      if (c82 >= 0) out.push_back(std::string(name) + format(" fit: f82 above 1 (%.3f, ", f82) + HalfDiffTable::channel_name(c82) + ")");
+    for (const RepresentationRow& r : kRepresentations) {  // the parametric fits (fit/representations.h)
+      if (!r.parametric) continue;
+      const auto [c0, f0] = above((fit.*r.parametric).f0, 1.0);
+      const auto [c82, f82] = above((fit.*r.parametric).f82, 1.0);
+      if (c0 >= 0) out.push_back(std::string(r.name) + format(" fit: f0 above 1 (%.3f, ", f0) + HalfDiffTable::channel_name(c0) + ")");
+      if (c82 >= 0) out.push_back(std::string(r.name) + format(" fit: f82 above 1 (%.3f, ", f82) + HalfDiffTable::channel_name(c82) + ")");
     }
   // Directional albedo of the measurement and of the tabulated representation.
   const TabulatedMicrofacet model(fit.lobe.tables(fit.smith), {});

@@ -17,6 +17,7 @@
 #include "core/error.h"
 #include "core/frame.h"
 #include "core/quadrature_rules.h"
+#include "io/tensor_file.h"
 
 namespace facetfit {
 
@@ -24,84 +25,13 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// Tensor file layout (little-endian), as written by RGL's tools and read by Mitsuba's TensorFile:
-//   "tensor_file\0" (12 bytes), version major, minor (1 byte each), field count (uint32), then per
-//   field: name length (uint16), name, rank (uint16), dtype (uint8), data offset from the start of
-//   the file (uint64), extent of each dimension (uint64 each). The arrays follow the table.
-constexpr char kMagic[12] = {'t', 'e', 'n', 's', 'o', 'r', '_', 'f', 'i', 'l', 'e', '\0'};
-constexpr std::size_t kPreamble = 12 + 2 + 4;
-// Smallest possible table entry: a one-character name, rank 1.
-constexpr std::size_t kMinFieldEntry = 2 + 1 + 2 + 1 + 8 + 8;
-constexpr unsigned kMaxRank = 8;
+// RGL's files are Mitsuba tensor files: io/tensor_file.h parses them, this file says what their fields mean.
+
 // Far above any RGL material file (the RGB isotropic ones are 0.66 MB); guards the one allocation
 // sized from outside, the file buffer.
 constexpr std::uintmax_t kMaxFileBytes = std::uintmax_t(1) << 30;
 
-// dtype codes of the format (as enumerated by RGL's own reader, powitacq's Tensor::Type):
-// 1 uint8, 2 int8, 3 uint16, 4 int16, 5 uint32, 6 int32, 7 uint64, 8 int64, 9 float16, 10 float32,
-// 11 float64. Verified on the database files: `description` is 1, `version` 5, the tables 10.
-constexpr std::uint8_t kUInt8 = 1;
-constexpr std::uint8_t kFloat32 = 10;
-
-std::size_t dtype_bytes(std::uint8_t dtype) {
-  static constexpr std::size_t kBytes[] = {0, 1, 1, 2, 2, 4, 4, 8, 8, 2, 4, 8};
-  return dtype < std::size(kBytes) ? kBytes[dtype] : 0;
-}
-
-const char* dtype_name(std::uint8_t dtype) {
-  static constexpr const char* kNames[] = {"invalid", "uint8",  "int8",   "uint16",  "int16",   "uint32",
-                                           "int32",   "uint64", "int64",  "float16", "float32", "float64"};
-  return dtype < std::size(kNames) ? kNames[dtype] : "unknown";
-}
-
-struct Field {
-  std::uint8_t dtype = 0;
-  std::uint64_t offset = 0;
-  std::vector<std::uint64_t> shape;
-  std::size_t count = 0;     // product of shape; fits in the file once extents are checked
-  std::uint64_t bytes = 0;  // count times the element size, without overflow
-};
-
-std::string shape_string(const std::vector<std::uint64_t>& shape) {
-  std::string s;
-  for (std::size_t k = 0; k < shape.size(); ++k) s += (k ? " x " : "") + std::to_string(shape[k]);
-  return s.empty() ? "(scalar)" : s;
-}
-
-// Bounded little-endian reads of the header; running off the end is a truncated header.
-class HeaderCursor {
- public:
-  HeaderCursor(const std::string& path, const std::vector<unsigned char>& bytes) : path_(path), bytes_(bytes) {}
-
-  std::uint64_t uint(std::size_t width, const std::string& what) {
-    need(width, what);
-    std::uint64_t v = 0;
-    for (std::size_t k = 0; k < width; ++k) v |= std::uint64_t(bytes_[pos_ + k]) << (8 * k);
-    pos_ += width;
-    return v;
-  }
-
-  std::string text(std::size_t length, const std::string& what) {
-    need(length, what);
-    std::string s(reinterpret_cast<const char*>(bytes_.data() + pos_), length);
-    pos_ += length;
-    return s;
-  }
-
-  std::size_t pos() const { return pos_; }
-
- private:
-  void need(std::size_t width, const std::string& what) const {
-    if (width > bytes_.size() - pos_)
-      fail(path_, "truncated header: " + what + " at byte " + std::to_string(pos_) + " runs past the end of the file (" +
-                      std::to_string(bytes_.size()) + " bytes)");
-  }
-
-  const std::string& path_;
-  const std::vector<unsigned char>& bytes_;
-  std::size_t pos_ = 0;
-};
-
+// The file's bytes, for io/tensor_file.h to parse.
 std::vector<unsigned char> slurp(const std::string& path) {
   std::error_code ec;
   const auto status = fs::status(path, ec);
@@ -125,156 +55,8 @@ std::vector<unsigned char> slurp(const std::string& path) {
   return bytes;
 }
 
-// The 14 bytes before the field count: the magic string and version 1.0.
-void check_preamble(const std::string& path, const std::vector<unsigned char>& bytes) {
-  if (bytes.size() < kPreamble)
-    fail(path, "truncated header (" + std::to_string(bytes.size()) + " bytes; a tensor file starts with an " +
-                   std::to_string(kPreamble) + "-byte preamble)");
-  if (std::memcmp(bytes.data(), kMagic, sizeof kMagic) != 0)
-    fail(path, "not a tensor file (the first 12 bytes are not \"tensor_file\\0\")");
-  if (bytes[12] != 1 || bytes[13] != 0)
-    fail(path, "unsupported tensor file version " + std::to_string(bytes[12]) + "." + std::to_string(bytes[13]) +
-                   " (this reader knows 1.0)");
-}
-
-// The number of fields, at least one and no more than the file's bytes could describe.
-std::uint64_t read_field_count(HeaderCursor& in, const std::string& path, std::size_t file_bytes) {
-  const std::uint64_t n_fields = in.uint(4, "field count");
-  if (n_fields == 0) fail(path, "tensor file has no fields");
-  if (n_fields > (file_bytes - kPreamble) / kMinFieldEntry)
-    fail(path, "header claims " + std::to_string(n_fields) + " fields, more than a file of " + std::to_string(file_bytes) +
-                   " bytes can describe (truncated, or a corrupt count)");
-  return n_fields;
-}
-
-// A field's name: not empty, and printable, since names go into error messages, which must stay one
-// printable line. `entry` names the table entry in messages.
-std::string read_field_name(HeaderCursor& in, const std::string& path, const std::string& entry) {
-  const std::size_t name_length = static_cast<std::size_t>(in.uint(2, entry));
-  if (name_length == 0) fail(path, entry + " has an empty name");
-  const std::string name = in.text(name_length, entry);
-  for (const char ch : name)
-    if (ch < 0x20 || ch > 0x7e) fail(path, entry + " has a name with non-printable bytes");
-  return name;
-}
-
-// The product of a shape's extents, or nothing where it overflows 64 bits.
-std::optional<std::uint64_t> element_count(const std::vector<std::uint64_t>& shape) {
-  std::uint64_t count = 1;
-  for (const std::uint64_t n : shape) {
-    if (n != 0 && count > std::numeric_limits<std::uint64_t>::max() / n) return std::nullopt;
-    count *= n;
-  }
-  return count;
-}
-
-// The rest of a field's entry after its name: rank, dtype, offset and shape, with its element count and
-// byte size computed without overflow. `what` names the field in messages.
-Field read_field(HeaderCursor& in, const std::string& path, const std::string& what) {
-  Field f;
-  const std::uint64_t rank = in.uint(2, what);
-  f.dtype = static_cast<std::uint8_t>(in.uint(1, what));
-  f.offset = in.uint(8, what);
-  if (rank == 0 || rank > kMaxRank)
-    fail(path, what + " claims " + std::to_string(rank) + " dimensions (expected 1 to " + std::to_string(kMaxRank) + ")");
-  const std::size_t elem = dtype_bytes(f.dtype);
-  if (elem == 0) fail(path, what + " has unknown dtype " + std::to_string(f.dtype));
-  for (std::uint64_t d = 0; d < rank; ++d) f.shape.push_back(in.uint(8, what));
-
-  // Element count and byte size without overflow: both must fit in the file.
-  const std::optional<std::uint64_t> count = element_count(f.shape);
-  if (!count || *count > (std::numeric_limits<std::uint64_t>::max() / elem))
-    fail(path, what + " has impossible dimensions " + shape_string(f.shape) + " (size overflows)");
-  f.count = static_cast<std::size_t>(std::min<std::uint64_t>(*count, std::numeric_limits<std::size_t>::max()));
-  f.bytes = *count * elem;
-  return f;
-}
-
-// Every field's data lies inside the file and after the field table, which ends at byte `table_end`.
-// Checked only once the whole table has been read, so that a file cut inside the table reads as a
-// truncated header rather than as some field's missing data.
-void check_field_extents(const std::string& path, std::size_t file_bytes, std::size_t table_end,
-                         const std::map<std::string, Field>& fields) {
-  for (const auto& [name, f] : fields) {
-    if (f.offset > file_bytes || f.bytes > file_bytes - f.offset)
-      fail(path, "field '" + name + "' (" + shape_string(f.shape) + " " + dtype_name(f.dtype) + ", " +
-                     std::to_string(f.bytes) + " bytes at offset " + std::to_string(f.offset) +
-                     ") extends past the end of the file (" + std::to_string(file_bytes) + " bytes; truncated?)");
-    if (f.offset < table_end && f.bytes > 0)
-      fail(path, "field '" + name + "' at offset " + std::to_string(f.offset) + " overlaps the field table (which ends at byte " +
-                     std::to_string(table_end) + ")");
-  }
-}
-
-// Reads the field table, checking every extent against the file before anything trusts it.
-std::map<std::string, Field> parse_header(const std::string& path, const std::vector<unsigned char>& bytes) {
-  check_preamble(path, bytes);
-  HeaderCursor in(path, bytes);
-  in.text(14, "preamble");
-  const std::uint64_t n_fields = read_field_count(in, path, bytes.size());
-  std::map<std::string, Field> fields;
-  for (std::uint64_t k = 0; k < n_fields; ++k) {
-    const std::string entry = "entry " + std::to_string(k) + " of the field table";
-    const std::string name = read_field_name(in, path, entry);
-    const std::string what = "field '" + name + "'";
-    if (!fields.emplace(name, read_field(in, path, what)).second) fail(path, what + " appears twice in the field table");
-  }
-  check_field_extents(path, bytes.size(), in.pos(), fields);
-  return fields;
-}
-
-// Required fields with their expected dtype and rank; shapes are cross-checked by the caller.
-class FieldSet {
- public:
-  FieldSet(const std::string& path, const std::vector<unsigned char>& bytes, std::map<std::string, Field> fields)
-      : path_(path), bytes_(bytes), fields_(std::move(fields)) {}
-
-  bool has(const std::string& name) const { return fields_.count(name) != 0; }
-
-  const Field& get(const std::string& name, std::uint8_t dtype, std::size_t rank) const {
-    const auto it = fields_.find(name);
-    if (it == fields_.end()) fail(path_, "required field '" + name + "' is missing");
-    const Field& f = it->second;
-    if (f.dtype != dtype)
-      fail(path_, "field '" + name + "' is " + dtype_name(f.dtype) + ", expected " + dtype_name(dtype));
-    if (f.shape.size() != rank)
-      fail(path_, "field '" + name + "' has shape " + shape_string(f.shape) + ", expected " + std::to_string(rank) +
-                      " dimension" + (rank == 1 ? "" : "s"));
-    return f;
-  }
-
-  // float32 payload as doubles; NaN or infinity is an error, since every table here feeds eval.
-  std::vector<double> floats(const std::string& name, const Field& f) const {
-    std::vector<double> out(f.count);
-    const unsigned char* p = bytes_.data() + f.offset;
-    for (std::size_t k = 0; k < f.count; ++k, p += 4) {
-      const std::uint32_t bits = std::uint32_t(p[0]) | std::uint32_t(p[1]) << 8 | std::uint32_t(p[2]) << 16 |
-                                 std::uint32_t(p[3]) << 24;
-      float v;
-      std::memcpy(&v, &bits, sizeof v);
-      if (!std::isfinite(v))
-        fail(path_, "field '" + name + "' has " + (std::isnan(v) ? "a NaN" : "an infinity") + " at element " +
-                        std::to_string(k) + " (byte offset " + std::to_string(f.offset + 4 * k) + ")");
-      out[k] = double(v);
-    }
-    return out;
-  }
-
-  const unsigned char* data(const Field& f) const { return bytes_.data() + f.offset; }
-
-  const std::string& path() const { return path_; }
-
-  void check(bool ok, const std::string& problem) const {
-    if (!ok) fail(path_, problem);
-  }
-
- private:
-  const std::string& path_;
-  const std::vector<unsigned char>& bytes_;
-  std::map<std::string, Field> fields_;
-};
-
-std::string dims(const Field& f) { return shape_string(f.shape); }
+// A field's shape as messages write it.
+std::string dims(const TensorField& f) { return tensor_shape_string(f.shape); }
 
 // A value table on the nodes of a uniform nx x ny grid over [0,1]^2, rows of nx along x.
 struct Grid {
@@ -407,8 +189,8 @@ double build_warp_slice(double* pdf, double* cond, double* marg, std::size_t nx,
 
 // The slices' parameter `name` (phi_i or theta_i), in radians: not empty, every value within [lo, hi]
 // (`interval`, as messages write it), strictly increasing.
-std::vector<double> read_slice_angles(const FieldSet& in, const std::string& name, double lo, double hi, const char* interval) {
-  const Field& f = in.get(name, kFloat32, 1);
+std::vector<double> read_slice_angles(const TensorFile& in, const std::string& name, double lo, double hi, const char* interval) {
+  const TensorField& f = in.get(name, kTensorFloat32, 1);
   in.check(f.count >= 1, "field '" + name + "' is empty");
   std::vector<double> angles = in.floats(name, f);
   for (std::size_t k = 0; k < angles.size(); ++k) {
@@ -422,7 +204,7 @@ std::vector<double> read_slice_angles(const FieldSet& in, const std::string& nam
 
 // The symmetry an anisotropic file declares by the span of its phi_i (RglBsdf::Tables::reduction): 2 pi
 // over the span, one of 1, 2 and 4.
-int phi_reduction(const FieldSet& in, const std::vector<double>& phi_i) {
+int phi_reduction(const TensorFile& in, const std::vector<double>& phi_i) {
   const double span = phi_i.back() - phi_i.front();
   const int reduction = int(std::lround(2.0 * kPi / span));
   in.check(reduction == 1 || reduction == 2 || reduction == 4,
@@ -439,8 +221,8 @@ double largest_below_horizon(const std::vector<double>& theta_i) {
 }
 
 // The file's description, without the NULs that pad it.
-std::string read_description(const FieldSet& in) {
-  const Field& desc = in.get("description", kUInt8, 1);
+std::string read_description(const TensorFile& in) {
+  const TensorField& desc = in.get("description", kTensorUInt8, 1);
   std::string text(reinterpret_cast<const char*>(in.data(desc)), desc.count);
   while (!text.empty() && text.back() == '\0') text.pop_back();
   return text;
@@ -448,8 +230,8 @@ std::string read_description(const FieldSet& in) {
 
 // A table over the sample square of at least 2 x 2 nodes (interpolation needs them), its values all > 0
 // (`positive`) or all >= 0.
-Grid read_grid(const FieldSet& in, const char* name, bool positive) {
-  const Field& f = in.get(name, kFloat32, 2);
+Grid read_grid(const TensorFile& in, const char* name, bool positive) {
+  const TensorField& f = in.get(name, kTensorFloat32, 2);
   in.check(f.shape[0] >= 2 && f.shape[1] >= 2,
            std::string("field '") + name + "' has shape " + dims(f) + "; interpolation needs at least 2 x 2");
   Grid g;
@@ -466,9 +248,9 @@ Grid read_grid(const FieldSet& in, const char* name, bool positive) {
 
 // The optional luminance table: unused by eval (it drives importance sampling), but a file whose
 // luminance disagrees in shape with its RGB table (`rgb`, already checked) is inconsistent.
-void check_luminance(const FieldSet& in, const Field& rgb, const std::string& params) {
+void check_luminance(const TensorFile& in, const TensorField& rgb, const std::string& params) {
   if (!in.has("luminance")) return;
-  const Field& lum = in.get("luminance", kFloat32, 4);
+  const TensorField& lum = in.get("luminance", kTensorFloat32, 4);
   in.check(lum.shape[0] == rgb.shape[0] && lum.shape[1] == rgb.shape[1] && lum.shape[2] == rgb.shape[3] &&
                lum.shape[3] == rgb.shape[4],
            "field 'luminance' has shape " + dims(lum) + ", expected " + params + " x " + std::to_string(rgb.shape[3]) + " x " +
@@ -530,9 +312,9 @@ struct RglBsdf::Tables {
 
   // Steps of RglBsdf::read, once phi_i and theta_i are read; `params` writes their counts as the
   // messages give them.
-  void read_vndf(const FieldSet& in, const std::string& params);
-  void read_rgb(const FieldSet& in, const std::string& params);
-  void average_over_phi(const FieldSet& in);
+  void read_vndf(const TensorFile& in, const std::string& params);
+  void read_rgb(const TensorFile& in, const std::string& params);
+  void average_over_phi(const TensorFile& in);
 };
 
 // The point of the sample square that the VNDF warp of slice blend b maps to u (the inverse of
@@ -568,9 +350,9 @@ double RglBsdf::measured_ndf_stored_integral() const { return t_->ndf_integral; 
 
 // The VNDF of each slice (phi_i x theta_i x rows x columns, at least 2 x 2), no density negative, and
 // its warp; every slice must have mass.
-void RglBsdf::Tables::read_vndf(const FieldSet& in, const std::string& params) {
+void RglBsdf::Tables::read_vndf(const TensorFile& in, const std::string& params) {
   const std::uint64_t n_phi = phi_i.size(), n_theta = theta_i.size();
-  const Field& vndf = in.get("vndf", kFloat32, 4);
+  const TensorField& vndf = in.get("vndf", kTensorFloat32, 4);
   in.check(vndf.shape[0] == n_phi && vndf.shape[1] == n_theta && vndf.shape[2] >= 2 && vndf.shape[3] >= 2,
            "field 'vndf' has shape " + dims(vndf) + ", expected " + params + " x rows x columns, at least 2 x 2");
   vy = static_cast<std::size_t>(vndf.shape[2]);
@@ -593,9 +375,9 @@ void RglBsdf::Tables::read_vndf(const FieldSet& in, const std::string& params) {
 
 // The RGB of each slice (phi_i x theta_i x 3 x rows x columns, at least 2 x 2) and the luminance's
 // shape against it.
-void RglBsdf::Tables::read_rgb(const FieldSet& in, const std::string& params) {
+void RglBsdf::Tables::read_rgb(const TensorFile& in, const std::string& params) {
   const std::uint64_t n_phi = phi_i.size(), n_theta = theta_i.size();
-  const Field& f = in.get("rgb", kFloat32, 5);
+  const TensorField& f = in.get("rgb", kTensorFloat32, 5);
   in.check(f.shape[0] == n_phi && f.shape[1] == n_theta && f.shape[2] == 3 && f.shape[3] >= 2 && f.shape[4] >= 2,
            "field 'rgb' has shape " + dims(f) + ", expected " + params + " x 3 x rows x columns, at least 2 x 2");
   ry = static_cast<std::size_t>(f.shape[3]);
@@ -606,7 +388,7 @@ void RglBsdf::Tables::read_rgb(const FieldSet& in, const std::string& params) {
 
 // Phi-averaged NDF and sigma: the mean of the bilinear interpolant over u_phi is the trapezoid rule over
 // rows. The NDF's integral normalizes measured_ndf.
-void RglBsdf::Tables::average_over_phi(const FieldSet& in) {
+void RglBsdf::Tables::average_over_phi(const TensorFile& in) {
   ndf_iso = phi_average(ndf);
   sigma_iso = phi_average(sigma);
   ndf_integral = projected_ndf_integral(ndf_iso);
@@ -617,7 +399,7 @@ void RglBsdf::Tables::average_over_phi(const FieldSet& in) {
 // messages name them.
 RglBsdf RglBsdf::read(const std::string& path) {
   const std::vector<unsigned char> bytes = slurp(path);
-  const FieldSet in(path, bytes, parse_header(path, bytes));
+  const TensorFile in(path, bytes);
   auto t = std::make_shared<Tables>();
 
   t->phi_i = read_slice_angles(in, "phi_i", -(kPi + 1e-4), kPi + 1e-4, "[-pi, pi]");
@@ -633,7 +415,7 @@ RglBsdf RglBsdf::read(const std::string& path) {
   t->read_vndf(in, params);
   t->read_rgb(in, params);
 
-  const Field& jac = in.get("jacobian", kUInt8, 1);
+  const TensorField& jac = in.get("jacobian", kTensorUInt8, 1);
   in.check(jac.count == 1, "field 'jacobian' has shape " + dims(jac) + ", expected 1");
   t->jacobian = in.data(jac)[0] != 0;
 

@@ -372,6 +372,34 @@ void write_lut(const std::string& path, const Lut& lut) {
   write_image_atomic(path, spec, pixels.data(), [](const std::string& temp) { read_lut(temp); });
 }
 
+namespace {
+
+// Where the metadata keeps each parametric fit and its distance, by representation name.
+struct StoredFit {
+  const char* name;
+  LutMetadata::Parametric LutMetadata::*fit;
+  double LutMetadata::*error;
+};
+constexpr StoredFit kStoredFits[] = {{"ggx", &LutMetadata::ggx, &LutMetadata::error_ggx},
+                                     {"beckmann", &LutMetadata::beckmann, &LutMetadata::error_beckmann},
+                                     {"lsq", &LutMetadata::lsq, &LutMetadata::error_lsq}};
+
+}  // namespace
+
+const LutMetadata::Parametric* LutMetadata::fit(const std::string& family) const {
+  for (const StoredFit& s : kStoredFits)
+    if (family == s.name) return &(this->*s.fit);
+  return nullptr;
+}
+
+double LutMetadata::distance(const std::string& name) const {
+  if (name == "tabulated") return error;
+  if (name == "closures") return error_closures;
+  for (const StoredFit& s : kStoredFits)
+    if (name == s.name) return this->*s.error;
+  return std::nan("");
+}
+
 std::optional<ParametricBrdf> Lut::parametric(const std::string& family, Smith smith) const {
   const LutMetadata::Parametric* p = meta.fit(family);
   if (!p) return std::nullopt;

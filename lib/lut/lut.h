@@ -53,9 +53,7 @@ struct LutMetadata {
   };
   Parametric ggx, beckmann, lsq;
   // The fit named "ggx", "beckmann" or "lsq"; null for another name.
-  const Parametric* fit(const std::string& family) const {
-    return family == "ggx" ? &ggx : family == "beckmann" ? &beckmann : family == "lsq" ? &lsq : nullptr;
-  }
+  const Parametric* fit(const std::string& family) const;
   // Distance of each representation from the measurement (fit/measurement.h), and of the paper's pure fit.
   double error = 0.0, error_ggx = 0.0, error_beckmann = 0.0, error_lsq = 0.0, error_extraction = 0.0;
   // Relative L1 distance (projected-area weighted) of each parametric NDF from the tabulated one.
@@ -70,6 +68,8 @@ struct LutMetadata {
   // The closure representation (version 5; empty before) and its distance from the measurement.
   Closures closures;
   double error_closures = 0.0;
+  // The distance of the representation named `name` (tabulated, ggx, beckmann, lsq, closures); NaN for another name.
+  double distance(const std::string& name) const;
   std::vector<std::string> warnings;  // implausible values found when fitting (fit/plausibility.h)
   // The linear space every colour above and every Fresnel row is in (core/rgb_space.h), and its matrix
   // from lin_rec709. Written only when it is another space (facetfit:colorspace, facetfit:colorspace_matrix).

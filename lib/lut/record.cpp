@@ -2,6 +2,8 @@
 
 #include <fstream>
 
+#include "fit/representations.h"
+
 namespace facetfit {
 
 nlohmann::json coat_json(const Coat& coat) {
@@ -75,8 +77,11 @@ nlohmann::json fit_record(const std::string& source, const FitResult& fit, doubl
     j["coat"] = coat_json(fit.lobe.coat);
     j["error"] = fit.error;
     j["error_extraction"] = fit.error_extraction;
-    for (const auto& [name, p] : {std::pair<const char*, const ParametricFit*>{"ggx", &fit.ggx}, {"beckmann", &fit.beckmann}, {"lsq", &fit.lsq}})
-      j[name] = parametric_json(p->alpha, p->body, p->f0, p->f82, p->coat, p->error);
+    for (const RepresentationRow& r : kRepresentations)  // ggx, beckmann, lsq (fit/representations.h)
+      if (r.parametric) {
+        const ParametricFit& p = fit.*r.parametric;
+        j[r.name] = parametric_json(p.alpha, p.body, p.f0, p.f82, p.coat, p.error);
+      }
     j["closures"] = closures_json(fit.closures.closures, fit.closures.error);
     j["warnings"] = fit.warnings;
     j["anisotropic"] = nullptr;

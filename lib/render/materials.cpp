@@ -6,10 +6,12 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <utility>
 
 #include "core/error.h"
 #include "fit/fit.h"
+#include "fit/representations.h"
 #include "io/input.h"
 #include "io/rgl.h"
 #include "io/utia.h"
@@ -24,6 +26,19 @@
 #include "render/shading.h"
 
 namespace facetfit {
+
+// Each representation of a fit renders from a LUT as a material type (fit/representations.h): the report
+// renders it so. A row whose type is missing here, or reads no LUT, does not compile.
+static_assert(
+    [] {
+      for (const RepresentationRow& r : kRepresentations) {
+        bool found = false;
+        for (const MaterialType& t : kMaterialTypes) found = found || (std::string_view(t.name) == r.material_type && t.reads_lut);
+        if (!found) return false;
+      }
+      return true;
+    }(),
+    "every row of kRepresentations renders as a material type of kMaterialTypes that reads a LUT");
 
 namespace {
 
@@ -97,7 +112,7 @@ std::shared_ptr<const ShadingModel> closure_model(const SceneDesc& scene, const 
 std::shared_ptr<const ShadingModel> lut_parametric_model(const Lut& lut, const std::string& family, Smith smith, bool fresnel_curve,
                                                          bool anisotropic) {
   const LutMetadata::Parametric* p = lut.meta.fit(family);
-  if (!p) fail("family '" + family + "'", "must be ggx, beckmann or lsq");
+  if (!p) fail("family '" + family + "'", "must be " + parametric_names());
   if (anisotropic && family == "ggx" && lut.anisotropic) {
     // The anisotropic GGX fit with its body; the proposal is the isotropic GGX of the same area (alpha_x
     // alpha_y), tabulated like the one below: the axes change which directions are likely, not coverage.

@@ -5,6 +5,8 @@
 #include <iterator>
 #include <sstream>
 
+#include "core/error.h"
+#include "fit/representations.h"
 #include "model/closures.h"
 #include "model/fresnel.h"
 
@@ -68,23 +70,39 @@ std::vector<PlotSeries> incidence_plane(double theta_i_degrees, const std::vecto
 }
 
 std::vector<std::pair<std::string, std::string>> material_figures(const Brdf& measured, const Lut& lut) {
+  // Each representation the LUT holds, in report order and colour (fit/representations.h): the parametric fits
+  // by name (left out without an alpha: not fitted), the tabulated lobe and the closures.
   const TabulatedMicrofacet tabulated = lut.model();
-  std::vector<std::pair<std::string, ParametricBrdf>> fits;
-  for (const char* family : {"ggx", "beckmann", "lsq"})
-    if (auto p = lut.parametric(family, lut.meta.smith); p && p->ndf().alpha_x > 0.0) fits.emplace_back(family, *p);
   const ClosureBrdf closures(lut.closures());
-  std::vector<std::pair<std::string, const Brdf*>> brdfs{{"measured", &measured}, {"tabulated", &tabulated}};
-  for (const auto& [name, brdf] : fits) brdfs.emplace_back(name, &brdf);
-  brdfs.emplace_back("closures", &closures);
+  std::vector<ParametricBrdf> fits;
+  fits.reserve(std::size(kRepresentations));  // the pointers into it below stay valid
+  std::vector<std::pair<std::string, const Brdf*>> brdfs{{"measured", &measured}};
+  std::vector<std::string> colours{"black"};
+  for (const RepresentationRow& r : kRepresentations) {
+    const std::string name = r.name;
+    const Brdf* brdf = name == "tabulated" ? &tabulated : name == "closures" ? static_cast<const Brdf*>(&closures) : nullptr;
+    if (r.parametric) {
+      const auto p = lut.parametric(name, lut.meta.smith);
+      if (!p || !(p->ndf().alpha_x > 0.0)) continue;
+      brdf = &fits.emplace_back(*p);
+    }
+    if (!brdf) throw Error("material_figures: no BRDF for the representation " + name + " (report/plots.cpp)");
+    brdfs.emplace_back(r.name, brdf);
+    colours.emplace_back(r.colour);
+  }
   std::vector<std::pair<std::string, std::string>> out;
-  for (const double theta_i : {0.0, 30.0, 60.0})
+  for (const double theta_i : {0.0, 30.0, 60.0}) {
+    std::vector<PlotSeries> series = incidence_plane(theta_i, brdfs);
+    for (std::size_t k = 0; k < series.size(); ++k) series[k].colour = colours[k];
     out.emplace_back("lobes_" + std::to_string(int(theta_i)) + ".svg", line_chart_svg("incidence plane, theta_i " + std::to_string(int(theta_i)) + " deg", "theta_o (deg)",
-                          "cbrt(f cos)", incidence_plane(theta_i, brdfs)));
+                          "cbrt(f cos)", series));
+  }
   // NDF: the tabulated one and the analytic D of the parametric fits.
-  std::vector<PlotSeries> ndf{{"tabulated", "#1f77b4", {}, false}};
+  const auto colour = [](const char* name) { return find_representation(name)->colour; };
+  std::vector<PlotSeries> ndf{{"tabulated", colour("tabulated"), {}, false}};
   const double a_ggx = lut.meta.ggx.alpha > 0.0 ? lut.meta.ggx.alpha : lut.meta.alpha_ggx;
   const double a_beckmann = lut.meta.beckmann.alpha > 0.0 ? lut.meta.beckmann.alpha : lut.meta.alpha_beckmann;
-  PlotSeries ggx{"ggx", "#d62728", {}, true}, beckmann{"beckmann", "#2ca02c", {}, true};
+  PlotSeries ggx{"ggx", colour("ggx"), {}, true}, beckmann{"beckmann", colour("beckmann"), {}, true};
   for (int d = 0; d <= 88; ++d) {
     const double theta = d * kPi / 180.0;
     const Vec3 h = spherical_direction(theta, 0.0);

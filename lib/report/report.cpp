@@ -13,6 +13,7 @@
 
 #include "color/image_diff.h"
 #include "core/error.h"
+#include "fit/representations.h"
 #include "io/atomic_file.h"
 #include "io/folder_lock.h"
 #include "io/input.h"
@@ -27,23 +28,10 @@ namespace facetfit {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-namespace {
-
-// Each column's representation and its colour in the plots. lsq: the classical Lambert + GGX + Schlick
-// least-squares fit, what users get today; closures: what the production OSL material renders.
-struct Column {
-  const char* name;
-  const char* colour;
-};
-constexpr Column kColumns[] = {
-    {"tabulated", "#1f77b4"}, {"ggx", "#d62728"}, {"beckmann", "#2ca02c"}, {"lsq", "#9467bd"}, {"closures", "#ff7f0e"}};
-
-}  // namespace
-
 const std::vector<std::string>& report_representations() {
   static const std::vector<std::string> names = [] {
     std::vector<std::string> n;
-    for (const Column& c : kColumns) n.push_back(c.name);
+    for (const RepresentationRow& r : kRepresentations) n.push_back(r.name);
     return n;
   }();
   return names;
@@ -189,14 +177,15 @@ std::string time_error_plot(const json& report) {
       << "<text x='240' y='292'>render time (s, log scale)</text><text x='4' y='14'>mean Delta E 2000</text>"
       << "<text x='50' y='275'>" << axis_number(min_t) << "</text><text x='500' y='275'>" << axis_number(max_t) << "</text>"
       << "<text x='8' y='30'>" << axis_number(max_de) << "</text>";
-  for (std::size_t k = 0; k < report_representations().size(); ++k) {
-    const std::string& r = report_representations()[k];
-    svg << "<text x='" << 555 << "' y='" << 30 + 14 * k << "' fill='" << kColumns[k].colour << "'>&#9679; " << r << "</text>";
+  for (std::size_t k = 0; k < std::size(kRepresentations); ++k) {
+    const std::string r = kRepresentations[k].name;
+    const char* colour = kRepresentations[k].colour;
+    svg << "<text x='" << 555 << "' y='" << 30 + 14 * k << "' fill='" << colour << "'>&#9679; " << r << "</text>";
     for (const json& m : report["materials"]) {
       if (!m["delta_e"].contains(r)) continue;
       const double t = m["seconds"]["render"][r].get<double>(), de = m["delta_e"][r].get<double>();
       const double x = 50 + 490 * (std::log10(std::max(t, 1e-6)) - lo) / (hi - lo), y = 260 - 240 * de / max_de;
-      svg << "<circle cx='" << x << "' cy='" << y << "' r='4' fill='" << kColumns[k].colour << "'><title>"
+      svg << "<circle cx='" << x << "' cy='" << y << "' r='4' fill='" << colour << "'><title>"
           << html_escape(m["name"].get<std::string>()) << " " << r << ": " << de << "</title></circle>";
     }
   }
@@ -524,8 +513,9 @@ void render_material(const ReportOptions& o, const std::string& source, const st
   write_display_png(image("measured.png"), measured.rgba.data(), measured.width, measured.height, 4, pictures);
   std::vector<bool> mask(std::size_t(measured.width) * measured.height);
   for (std::size_t p = 0; p < mask.size(); ++p) mask[p] = measured.rgba[p * 4 + 3] >= 1.0f;  // the sphere
-  for (const std::string& r : report_representations()) {
-    const RenderedImage img = render_as(r == "tabulated" ? "lut" : r, lut);
+  for (const RepresentationRow& row : kRepresentations) {
+    const std::string r = row.name;
+    const RenderedImage img = render_as(row.material_type, lut);
     entry["seconds"]["render"][r] = img.seconds;
     write_display_png(image(r + ".png"), img.rgba.data(), img.width, img.height, 4, pictures);
     const ImageDiff diff = image_delta_e(measured.rgb(), false, img.rgb(), false, mask, display);

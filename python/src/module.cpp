@@ -25,6 +25,7 @@
 #include "core/error.h"
 #include "core/memory_budget.h"
 #include "fit/fit.h"
+#include "fit/representations.h"
 #include "io/atomic_file.h"
 #include "io/input.h"
 #include "lut/bake.h"
@@ -389,6 +390,11 @@ PYBIND11_MODULE(_facetfit, m) {
           "The representation a renderer should use and its own parameters, as `facetfit fit` shows them: "
           "{representation, tolerance, alpha (None for tabulated), body, f0, f82, coat, error}")
       .def_property_readonly("error", [](const Fit& f) { return f.result.error; })
+      .def_property_readonly("distances", [](const Fit& f) {
+        py::dict d;  // every representation (fit/representations.h), in report order
+        for (const RepresentationRow& r : kRepresentations) d[r.name] = r.distance(f.result);
+        return d;
+      }, "each representation's distance from the measurement: {tabulated, ggx, beckmann, lsq, closures}")
       .def_property_readonly("error_extraction", [](const Fit& f) { return f.result.error_extraction; })
       .def_property_readonly("eigenvalue", [](const Fit& f) { return f.result.extraction.eigenvalue; })
       .def_property_readonly("iterations", [](const Fit& f) { return f.result.extraction.iterations; })
@@ -443,6 +449,11 @@ PYBIND11_MODULE(_facetfit, m) {
       .def_property_readonly("representation", [](const Lut& l) { return std::string(to_string(l.meta.representation)); })
       .def_property_readonly("recommended", [](const Lut& l) { return to_python(recommended_json(recommended_parameters(l.meta), l.meta.tolerance)); },
                              "the recommended representation and its own parameters, as Fit.recommended() with the bake's tolerance")
+      .def_property_readonly("distances", [](const Lut& l) {
+        py::dict d;
+        for (const RepresentationRow& r : kRepresentations) d[r.name] = l.meta.distance(r.name);
+        return d;
+      }, "each representation's distance from the measurement, as Fit.distances")
       .def_property_readonly("alpha_ggx", [](const Lut& l) { return l.meta.alpha_ggx; }, "the paper's moment estimate (see Fit.alpha_ggx)")
       .def_property_readonly("alpha_beckmann", [](const Lut& l) { return l.meta.alpha_beckmann; }, "the paper's moment estimate")
       .def_property_readonly("warnings", [](const Lut& l) { return l.meta.warnings; })
@@ -469,7 +480,7 @@ PYBIND11_MODULE(_facetfit, m) {
       .def(
           "parametric",
           [](const Lut& l, const std::string& family) {
-            if (!l.meta.fit(family)) throw py::value_error("family: must be ggx, beckmann or lsq, not '" + family + "'");
+            if (!l.meta.fit(family)) throw py::value_error("family: must be " + parametric_names() + ", not '" + family + "'");
             return Model{lut_parametric_model(l, family, l.tables.smith, false)};
           },
           py::arg("family"), "One of the parametric fits the LUT carries: 'ggx', 'beckmann' or 'lsq'.");

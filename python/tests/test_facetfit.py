@@ -81,6 +81,12 @@ def test_recommended_agrees_with_the_record_and_the_lut(tmp_path):
     for key in ("f0", "f82", "body"):
         assert lut.recommended[key] == pytest.approx(rec[key], rel=1e-6, abs=1e-7)
     assert f.recommended(tolerance=0.0)["representation"] == "tabulated"
+    # Every representation's distance (fit/representations.h), the record's and, as floats, the LUT's.
+    assert list(f.distances) == ["tabulated", "ggx", "beckmann", "lsq", "closures"]
+    assert f.distances["tabulated"] == f.error and f.distances["closures"] == f.record["closures"]["error"]
+    for name in ("ggx", "beckmann", "lsq"):
+        assert f.distances[name] == f.record[name]["error"]
+    assert lut.distances == pytest.approx(f.distances, rel=1e-6)
     assert facetfit.fit("builtin:black-glossy-ggx-0.08").recommended()["alpha"] is None
 
 
