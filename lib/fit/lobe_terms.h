@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "core/vec.h"
+#include "model/fresnel.h"
 #include "model/ndf.h"
 #include "model/smith.h"
 
@@ -46,19 +47,19 @@ inline WithSlope ndf_of(NdfType type, double alpha, double c) {
   return {d, 2.0 * alpha * d * (t2 / a2 - 1.0) / a2};
 }
 
-// G2 of Lambda_i, Lambda_o, and d/dalpha through both.
+// G2 of Lambda_i, Lambda_o (smith_g2), and d/dalpha through both.
 inline WithSlope g2_of(Smith smith, const WithSlope& li, const WithSlope& lo) {
   switch (smith) {
     case Smith::masking: {
-      const WithSlope& l = li.value > lo.value ? li : lo;
-      const double g = 1.0 / (1.0 + l.value);
-      return {g, -g * g * l.slope};
+      const double g = smith_g2(smith, lo.value, li.value);
+      return {g, -g * g * (li.value > lo.value ? li : lo).slope};
     }
     case Smith::correlated: {
-      const double g = 1.0 / (1.0 + li.value + lo.value);
+      const double g = smith_g2(smith, lo.value, li.value);
       return {g, -g * g * (li.slope + lo.slope)};
     }
     case Smith::separable: {
+      // G1(i) G1(o), each needed for the derivative.
       const double gi = 1.0 / (1.0 + li.value), go = 1.0 / (1.0 + lo.value);
       return {gi * go, -gi * go * (gi * li.slope + go * lo.slope)};
     }
@@ -66,13 +67,12 @@ inline WithSlope g2_of(Smith smith, const WithSlope& li, const WithSlope& lo) {
   return {};
 }
 
-// 1 - Schlick's weight: d Schlick(f0, mu) / d f0.
-inline double schlick_slope(double mu) {
-  const double m = 1.0 - mu, m2 = m * m;
-  return 1.0 - m2 * m2 * m;
-}
+// 1 - Schlick's weight (1 - mu)^5: d Schlick(f0, mu) / d f0.
+inline double schlick_slope(double mu) { return 1.0 - fresnel_formulas::schlick_weight(ScalarOps{}, mu); }
 
-// mu (1 - mu)^6: the shape of the F82-tint correction.
+// mu (1 - mu)^6: the shape of the F82-tint correction, multiplied as ((1 - mu)^3)^2, not as the renderer's
+// ((1 - mu)^2)^3 (fresnel_formulas::f82_basis): the fits were made with this rounding, and the other moves
+// the bits of two of the fourteen RGL bakes.
 inline double f82_basis(double mu) {
   const double m = 1.0 - mu, m3 = m * m * m;
   return mu * m3 * m3;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "model/fresnel.h"
 #include "model/ggx_visible.h"
 #include "model/smith.h"
 #include "model/tabulated_ndf.h"
@@ -23,7 +24,7 @@ Ndf ClosureLobe::ndf(double cos_o) const {
 Rgb ClosureLobe::fresnel_at(double cos_d) const {
   const double mu = clamp(cos_d, 0.0, 1.0);
   if (fresnel == Fresnel::f82_tint) return F82Tint(f0, f82).eval(mu);
-  return f0 + (f90 - f0) * std::pow(1.0 - mu, exponent);
+  return fresnel_formulas::generalized_schlick(f0, f90, std::pow(1.0 - mu, exponent));
 }
 
 namespace {
@@ -41,7 +42,7 @@ std::pair<Rgb, double> schlick_f90(const ClosureLobe& lobe, double e, const std:
   const Rgb f90 = glm::clamp(lobe.f0 + cross / square, Rgb(0.0), Rgb(1.0));
   double error = 0.0;
   for (double mu : mus) {
-    const Rgb r = lobe.fresnel_at(mu) - (lobe.f0 + (f90 - lobe.f0) * std::pow(1.0 - mu, e));
+    const Rgb r = lobe.fresnel_at(mu) - fresnel_formulas::generalized_schlick(lobe.f0, f90, std::pow(1.0 - mu, e));
     error += glm::dot(r, r);
   }
   return {f90, error};

@@ -8,9 +8,8 @@
 namespace facetfit {
 
 Rgb fresnel_schlick(const Rgb& f0, double cos_d) {
-  const double m = clamp(1.0 - cos_d, 0.0, 1.0);
-  const double m5 = (m * m) * (m * m) * m;
-  return f0 + (Rgb(1.0) - f0) * m5;
+  const ScalarOps op;
+  return fresnel_formulas::schlick(op, f0, fresnel_formulas::schlick_weight(op, cos_d));
 }
 
 namespace {
@@ -45,24 +44,17 @@ double fresnel_dielectric(double eta, double cos_d) {
   return 0.5 * (r_parl * r_parl + r_perp * r_perp);
 }
 
-namespace {
-
-// mu (1 - mu)^6, the sixth power multiplied out (four products), not a std::pow call on every evaluation.
-double f82_basis(double mu) {
-  const double m2 = (1.0 - mu) * (1.0 - mu);
-  return mu * m2 * m2 * m2;
-}
-
-}  // namespace
-
 F82Tint::F82Tint(const Rgb& normal_incidence, const Rgb& f82) : f0(normal_incidence) {
   constexpr double mu82 = 1.0 / 7.0;
-  a = (fresnel_schlick(f0, mu82) - f82) / f82_basis(mu82);
+  a = (fresnel_schlick(f0, mu82) - f82) / fresnel_formulas::f82_basis(ScalarOps{}, mu82);
 }
 
 Rgb F82Tint::eval(double cos_d) const {
+  const ScalarOps op;
   const double mu = clamp(cos_d, 0.0, 1.0);
-  return glm::max(fresnel_schlick(f0, mu) - a * f82_basis(mu), Rgb(0.0));
+  const double w = fresnel_formulas::schlick_weight(op, mu), basis = fresnel_formulas::f82_basis(op, mu);
+  return {fresnel_formulas::f82_tint(op, f0.r, a.r, w, basis), fresnel_formulas::f82_tint(op, f0.g, a.g, w, basis),
+          fresnel_formulas::f82_tint(op, f0.b, a.b, w, basis)};
 }
 
 Rgb Fresnel::eval(double cos_d) const {

@@ -4,8 +4,14 @@
 #include <cmath>
 
 #include "core/vec.h"
+#include "model/scalar_ops.h"
 
 namespace facetfit {
+
+// Schlick's and F82-tint's formulas, which the renderer's SIMD lanes compile too.
+namespace fresnel_formulas {
+#include "model/fresnel_terms-inl.h"
+}  // namespace fresnel_formulas
 
 // Schlick's approximation with normal-incidence reflectance f0.
 Rgb fresnel_schlick(const Rgb& f0, double cos_d);

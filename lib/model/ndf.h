@@ -40,7 +40,7 @@ struct Ndf {
     if (h.z <= 0.0) return 0.0;
     if (type == NdfType::ggx) {
       const double ax2 = alpha_x * alpha_x, ay2 = alpha_y * alpha_y;
-      return ggx::D(ggx::ScalarOps{}, h.x, h.y, h.z, ax2, ay2, ax2 * alpha_x * ay2 * alpha_y / kPi);
+      return ggx::D(ScalarOps{}, h.x, h.y, h.z, ax2, ay2, ax2 * alpha_x * ay2 * alpha_y / kPi);
     }
     const double c2 = h.z * h.z;
     return slope_pdf(-h.x / h.z, -h.y / h.z) / (c2 * c2);
@@ -48,7 +48,7 @@ struct Ndf {
   // Smith's Lambda for direction w; sigma(w) = cos(theta_w) (1 + Lambda(w)) is the projected area.
   double lambda(const Vec3& w) const {
     if (w.z <= 0.0) return std::numeric_limits<double>::infinity();
-    if (type == NdfType::ggx) return ggx::lambda(ggx::ScalarOps{}, w.x, w.y, w.z, alpha_x * alpha_x, alpha_y * alpha_y);
+    if (type == NdfType::ggx) return ggx::lambda(ScalarOps{}, w.x, w.y, w.z, alpha_x * alpha_x, alpha_y * alpha_y);
     return std::max(0.0, sigma(w) / w.z - 1.0);
   }
   double sigma(const Vec3& w) const;

@@ -1,11 +1,13 @@
 // Smith masking-shadowing: the three ways facetfit couples masking G1 and shadowing into G2.
 //
 // All three are written through Smith's Lambda, with G1(k) = 1 / (1 + Lambda(k)) = cos(theta_k) / sigma(k).
+// The formulas are in model/smith_terms-inl.h, which the renderer's SIMD lanes compile too.
 #pragma once
 
-#include <algorithm>
 #include <optional>
 #include <string>
+
+#include "model/scalar_ops.h"
 
 namespace facetfit {
 
@@ -19,28 +21,16 @@ enum class Smith {
   separable,
 };
 
-inline double smith_g2(Smith smith, double lambda_o, double lambda_i) {
-  switch (smith) {
-    case Smith::masking: return 1.0 / (1.0 + std::max(lambda_i, lambda_o));
-    case Smith::correlated: return 1.0 / (1.0 + lambda_i + lambda_o);
-    case Smith::separable: return 1.0 / ((1.0 + lambda_i) * (1.0 + lambda_o));
-  }
-  return 0.0;
-}
+namespace smith_formulas {
+#include "model/smith_terms-inl.h"
+}  // namespace smith_formulas
 
-// The same G2 from the two G1 values (G1 in [0, 1]; 0 at the horizon), without dividing by zero.
-inline double smith_g2_from_g1(Smith smith, double g1_o, double g1_i) {
-  switch (smith) {
-    case Smith::masking: return std::min(g1_i, g1_o);
-    case Smith::correlated: {
-      // 1 / (1/G1i + 1/G1o - 1) rewritten so that G1 = 0 gives 0.
-      const double den = g1_i + g1_o - g1_i * g1_o;
-      return den > 0.0 ? g1_i * g1_o / den : 0.0;
-    }
-    case Smith::separable: return g1_i * g1_o;
-  }
-  return 0.0;
-}
+// G2 from the two Lambdas (smith_formulas::g2).
+inline double smith_g2(Smith smith, double lambda_o, double lambda_i) { return smith_formulas::g2(ScalarOps{}, smith, lambda_o, lambda_i); }
+
+// The same G2 from the two G1 values (G1 in [0, 1]; 0 at the horizon), without dividing by zero
+// (smith_formulas::g2_from_g1).
+inline double smith_g2_from_g1(Smith smith, double g1_o, double g1_i) { return smith_formulas::g2_from_g1(ScalarOps{}, smith, g1_o, g1_i); }
 
 inline const char* to_string(Smith smith) {
   switch (smith) {

@@ -31,6 +31,7 @@ void EvalGgxBatch(const GgxBatchModel& model, EvaluationBatch& batch) {
   const D d;
   const std::size_t n = batch.padded_size();
   const V zero = hn::Zero(d), one = hn::Set(d, 1.0);
+  const lanes::LaneOps<D> op{d};
   // The NDF's terms as Ndf::D and Ndf::lambda form them (alpha_x = alpha_y), for the same rounding.
   const double al = model.alpha;
   const V a2 = hn::Set(d, al * al), d_numerator = hn::Set(d, al * al * al * al * al * al / kPi);
@@ -51,12 +52,7 @@ void EvalGgxBatch(const GgxBatchModel& model, EvaluationBatch& batch) {
     hx = hx * inv_len, hy = hy * inv_len, hz = hz * inv_len;
     const V dh = lanes::ggx_ndf(d, hx, hy, hz, a2, a2, d_numerator);
     const V lambda_o = lanes::ggx_lambda(d, ox, oy, oz, a2, a2), lambda_i = lanes::ggx_lambda(d, ix, iy, iz, a2, a2);
-    V g2;
-    switch (model.smith) {
-      case Smith::masking: g2 = lanes::reciprocal(d, one + hn::Max(lambda_i, lambda_o)); break;
-      case Smith::correlated: g2 = lanes::reciprocal(d, one + lambda_i + lambda_o); break;
-      case Smith::separable: g2 = lanes::reciprocal(d, (one + lambda_i) * (one + lambda_o)); break;
-    }
+    const V g2 = lanes::smith_formulas::g2(op, model.smith, lambda_o, lambda_i);
     const V four_cos = hn::Set(d, 4.0) * iz * oz;
     const V cos_d = hn::Min(hn::Max(ix * hx + iy * hy + iz * hz, zero), one);
     const V specular = lanes::divide(d, dh * g2, four_cos);
@@ -64,9 +60,8 @@ void EvalGgxBatch(const GgxBatchModel& model, EvaluationBatch& batch) {
     if (model.curve) {
       lanes::fresnel_curve(d, &model.curve[0].r, cos_d, fresnel);
     } else {
-      const V m5 = lanes::schlick_weight(d, cos_d);
-      const V m = one - cos_d, m2 = m * m, basis = cos_d * m2 * m2 * m2;
-      for (int c = 0; c < 3; ++c) fresnel[c] = hn::Max(f0[c] + (one - f0[c]) * m5 - a[c] * basis, zero);
+      const V m5 = lanes::fresnel_formulas::schlick_weight(op, cos_d), basis = lanes::fresnel_formulas::f82_basis(op, cos_d);
+      for (int c = 0; c < 3; ++c) fresnel[c] = lanes::fresnel_formulas::f82_tint(op, f0[c], a[c], m5, basis);
     }
     V coat_f = zero, coat_pdf = zero;
     const V o_dot_h = ox * hx + oy * hy + oz * hz;

@@ -15,6 +15,7 @@
 #include "core/vec.h"
 #include "model/coat.h"
 #include "model/fresnel_curve.h"
+#include "model/smith.h"
 #include "render/shading_batch.h"
 
 HWY_BEFORE_NAMESPACE();
@@ -245,20 +246,32 @@ HWY_INLINE CosSinOf<VT> cos_sin_turn(DT d, VT u) {
   return cos_sin(d, set(d, 2.0 * kPi) * hn::IfThenElse(u >= set(d, 0.5), u - one, u));
 }
 
-// GGX's D and Lambda, the library's text (model/ggx_terms-inl.h) compiled for this target.
+// The library's formulas written once over a number type (model/ggx_terms-inl.h: GGX's D and Lambda;
+// model/smith_terms-inl.h: Smith's G2; model/fresnel_terms-inl.h: Schlick and F82-tint), compiled for
+// this target.
 namespace ggx {
 #include "model/ggx_terms-inl.h"
 }  // namespace ggx
+namespace smith_formulas {
+#include "model/smith_terms-inl.h"
+}  // namespace smith_formulas
+namespace fresnel_formulas {
+#include "model/fresnel_terms-inl.h"
+}  // namespace fresnel_formulas
 
-// What ggx::D and ggx::lambda need of DT's vectors: the lanes' division, the square root, constants and a
-// choice by sign.
+// What those formulas need of DT's vectors (ScalarOps, model/scalar_ops.h, for double): the lanes'
+// division and reciprocal, the square root, constants, min and max, and choices by sign.
 template <class DT, class VT = hn::Vec<DT>>
 struct LaneOps {
   DT d;
   VT divide(VT a, VT b) const { return lanes::divide(d, a, b); }
+  VT reciprocal(VT x) const { return lanes::reciprocal(d, x); }
   VT sqrt(VT x) const { return hn::Sqrt(x); }
   VT constant(double c) const { return set(d, c); }
+  VT min(VT a, VT b) const { return hn::Min(a, b); }
+  VT max(VT a, VT b) const { return hn::Max(a, b); }
   VT where_positive(VT x, VT v) const { return hn::IfThenElseZero(x > hn::Zero(d), v); }
+  VT positive_or(VT x, VT otherwise) const { return hn::IfThenElse(x > hn::Zero(d), x, otherwise); }
 };
 
 // Smith's Lambda of GGX for w above the horizon (ggx::lambda).
@@ -271,13 +284,6 @@ HWY_INLINE VT ggx_lambda(DT d, VT wx, VT wy, VT wz, VT ax2, VT ay2) {
 template <class DT, class VT = hn::Vec<DT>>
 HWY_INLINE VT ggx_ndf(DT d, VT hx, VT hy, VT hz, VT ax2, VT ay2, VT numerator_over_pi) {
   return ggx::D(LaneOps<DT>{d}, hx, hy, hz, ax2, ay2, numerator_over_pi);
-}
-
-// (1 - mu)^5 of Schlick's approximation, mu clamped to [0, 1] as fresnel_schlick does.
-template <class DT, class VT = hn::Vec<DT>>
-HWY_INLINE VT schlick_weight(DT d, VT cos_d) {
-  const VT m = hn::Min(hn::Max(set(d, 1.0) - cos_d, hn::Zero(d)), set(d, 1.0));
-  return (m * m) * (m * m) * m;
 }
 
 // The tabulated Fresnel curve at cos(theta_d) in [0, 1]: linear between its entries, one per degree of
@@ -319,9 +325,14 @@ HWY_INLINE CoatTermsOf<VT> coat_terms(DT d, const Coat& coat, VT ox, VT oy, VT o
   const VT a2 = set(d, a * a), numerator = set(d, a * a * a * a * a * a / kPi), one = set(d, 1.0);
   const VT dc = ggx_ndf(d, hx, hy, hz, a2, a2, numerator);
   const VT lc_o = ggx_lambda(d, ox, oy, oz, a2, a2), lc_i = ggx_lambda(d, ix, iy, iz, a2, a2);
-  const VT f0 = set(d, coat.f0);
-  const VT fc = f0 + (one - f0) * schlick_weight(d, cos_d);
-  return {fc * dc * (one / (one + lc_i + lc_o)) / four_cos, hn::IfThenElseZero(o_faces_h, (one / (one + lc_o)) * dc / (set(d, 4.0) * oz))};
+  // The coat's G2 and G1(o) divide, where the lobes' kernels take AVX-512's reciprocal estimate (LaneOps).
+  struct DividingOps : LaneOps<DT> {
+    VT reciprocal(VT x) const { return set(this->d, 1.0) / x; }
+  };
+  const DividingOps op{{d}};
+  const VT fc = fresnel_formulas::schlick(op, set(d, coat.f0), fresnel_formulas::schlick_weight(op, cos_d));
+  const VT g2 = smith_formulas::g2(op, Smith::correlated, lc_o, lc_i);
+  return {fc * dc * g2 / four_cos, hn::IfThenElseZero(o_faces_h, (one / (one + lc_o)) * dc / (set(d, 4.0) * oz))};
 }
 
 template <class VT>

@@ -223,16 +223,7 @@ void EvalTabulatedBatch(const TabulatedBatchModel& model, EvaluationBatch& batch
       const GridPosition normal = locate(d, hn::IfThenElse(h_up, hz, one), hn::IfThenElseZero(h_up, one_minus), resolution);
       const V dh = hn::IfThenElseZero(h_up, hn::Max(zero, spline(d, model.ndf, normal, resolution)));
       const V g1_i = g1(d, model, iz), g1_o = g1(d, model, oz);
-      V g2;
-      switch (model.smith) {
-        case Smith::masking: g2 = hn::Min(g1_i, g1_o); break;
-        case Smith::correlated: {
-          const V den = g1_i + g1_o - g1_i * g1_o;
-          g2 = hn::IfThenElseZero(den > zero, lanes::divide(d, g1_i * g1_o, hn::IfThenElse(den > zero, den, one)));
-          break;
-        }
-        case Smith::separable: g2 = g1_i * g1_o; break;
-      }
+      const V g2 = lanes::smith_formulas::g2_from_g1(lanes::LaneOps<DF>{d}, model.smith, g1_o, g1_i);
       V fresnel[3];
       lanes::fresnel_curve(d, model.curve, cos_d, fresnel);
       const V specular = lanes::divide(d, dh * g2, four_cos);
