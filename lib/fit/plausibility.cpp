@@ -2,10 +2,12 @@
 
 #include <cmath>
 #include <cstdio>
+#include <optional>
 
 #include "fit/fit.h"
 #include "fit/representations.h"
 #include "model/parametric.h"
+#include "model/proposal.h"
 #include "model/tabulated.h"
 
 namespace facetfit {
@@ -33,10 +35,10 @@ Rgb directional_albedo(const Brdf& brdf, const Vec3& o, int n) {
   Rgb sum(0.0);
   for (int a = 0; a < n; ++a)
     for (int b = 0; b < n; ++b) {
-      // Cosine-weighted: r = sqrt(u1) on the unit disk, so each cell holds cos(theta) d(omega) = pi / n^2.
-      const double r = std::sqrt((a + 0.5) / n), phi = 2.0 * kPi * (b + 0.5) / n;
-      const Vec3 i(r * std::cos(phi), r * std::sin(phi), std::sqrt(std::max(0.0, 1.0 - r * r)));
-      if (const auto f = brdf.eval(o, i)) sum += *f;
+      // Cosine-weighted at the cells' midpoints, so each cell holds cos(theta) d(omega) = pi / n^2.
+      const std::optional<Vec3> i = cosine_direction((a + 0.5) / n, (b + 0.5) / n);
+      if (!i) continue;
+      if (const auto f = brdf.eval(o, *i)) sum += *f;
     }
   return sum * (kPi / double(n * n));
 }

@@ -14,6 +14,7 @@
 #include "core/vec.h"
 #include "model/coat.h"
 #include "model/ggx_visible.h"
+#include "model/scalar_ops.h"
 
 namespace facetfit {
 
@@ -27,11 +28,16 @@ class Proposal {
   virtual double pdf(const Vec3& o, const Vec3& i) const = 0;
 };
 
-// A direction of density cos(theta) / pi from two uniform numbers: r = sqrt(u1) on the unit disk, lifted
-// to the hemisphere; nullopt on the horizon.
+namespace warps {
+#include "model/warps-inl.h"
+}  // namespace warps
+
+// A direction of density cos(theta) / pi from two uniform numbers (warps::cosine_hemisphere); nullopt on
+// the horizon.
 inline std::optional<Vec3> cosine_direction(double u1, double u2) {
-  const double r = std::sqrt(u1), phi = 2.0 * kPi * u2;
-  const Vec3 i(r * std::cos(phi), r * std::sin(phi), std::sqrt(std::max(0.0, 1.0 - r * r)));
+  const double phi = 2.0 * kPi * u2;
+  Vec3 i;
+  warps::cosine_hemisphere(ScalarOps{}, u1, std::cos(phi), std::sin(phi), i.x, i.y, i.z);
   if (i.z <= 0.0) return std::nullopt;
   return i;
 }

@@ -15,7 +15,7 @@ namespace facetfit {
 // Fills the batch's r, g, b (albedo / pi) and pdf (cos theta_i / pi) for its padded_size() pairs; zero
 // where o or i is below the horizon. `target`: which SIMD code runs (render/simd_targets.h).
 void eval_lambert_batch(const Rgb& albedo, EvaluationBatch& batch, SimdTarget target = SimdTarget::best);
-// Fills the batch's i (cosine-weighted, by the concentric map of the disc) and found for its
+// Fills the batch's i (cosine-weighted, model/warps-inl.h) and found for its
 // padded_size() entries.
 void sample_lambert_batch(SampleBatch& batch, SimdTarget target = SimdTarget::best);
 

@@ -258,6 +258,9 @@ namespace smith_formulas {
 namespace fresnel_formulas {
 #include "model/fresnel_terms-inl.h"
 }  // namespace fresnel_formulas
+namespace warps {
+#include "model/warps-inl.h"
+}  // namespace warps
 
 // What those formulas need of DT's vectors (ScalarOps, model/scalar_ops.h, for double): the lanes'
 // division and reciprocal, the square root, constants, min and max, and choices by sign.
@@ -398,14 +401,14 @@ template <class DT, class Lobe>
 void sample_proposal(DT d, const ProposalWeights& weights, const Coat& coat, SampleBatch& batch, bool lobe_turns, const Lobe& lobe) {
   using VT = hn::Vec<DT>;
   const std::size_t n = batch.padded_size();
-  const VT zero = hn::Zero(d), one = set(d, 1.0), two = set(d, 2.0);
-  const VT quarter_pi = set(d, 0.25 * kPi), half_pi = set(d, 0.5 * kPi);
+  const VT zero = hn::Zero(d), one = set(d, 1.0);
   const VT coat_alpha = set(d, coat.alpha), lobe_weight = set(d, weights.lobe_weight);
   const VT part_lobe = set(d, weights.part_lobe), part_body = set(d, weights.part_body);
   // Their reciprocals once (a part the model lacks gives infinity; no lane that picks it reads the result).
   const VT per_lobe = set(d, 1.0 / weights.part_lobe), per_body = set(d, 1.0 / weights.part_body);
   const VT per_coat = set(d, 1.0 / weights.part_coat);
-  const bool with_coat = coat.present(), body = weights.part_body > 0.0, turns = lobe_turns || with_coat || body;
+  const bool with_coat = coat.present(), body = weights.part_body > 0.0, cosine_part = weights.lobe_weight < 1.0;
+  const bool turns = lobe_turns || with_coat || body || cosine_part;
   for (std::size_t k = 0; k < n; k += hn::Lanes(d)) {
     const VT ox = load(d, batch.ox.data() + k), oy = load(d, batch.oy.data() + k), oz = load(d, batch.oz.data() + k);
     const VT u1 = load(d, batch.u1.data() + k), u2 = load(d, batch.u2.data() + k), u3 = load(d, batch.u3.data() + k);
@@ -418,9 +421,9 @@ void sample_proposal(DT d, const ProposalWeights& weights, const Coat& coat, Sam
     auto refused = hn::Not(in_lobe);  // parts past the lobe that this model lacks
     if (body) {
       const auto in_body = hn::AndNot(in_lobe, rest < part_body);
-      const VT r = hn::Sqrt(rest * per_body);
-      i.x = hn::IfThenElse(in_body, r * cos_phi, i.x), i.y = hn::IfThenElse(in_body, r * sin_phi, i.y);
-      i.z = hn::IfThenElse(in_body, hn::Sqrt(hn::Max(zero, one - r * r)), i.z);
+      VT x, y, z;
+      warps::cosine_hemisphere(LaneOps<DT>{d}, rest * per_body, cos_phi, sin_phi, x, y, z);
+      i.x = hn::IfThenElse(in_body, x, i.x), i.y = hn::IfThenElse(in_body, y, i.y), i.z = hn::IfThenElse(in_body, z, i.z);
       refused = hn::AndNot(in_body, refused);
     }
     if (with_coat) {
@@ -430,21 +433,13 @@ void sample_proposal(DT d, const ProposalWeights& weights, const Coat& coat, Sam
       i.x = hn::IfThenElse(in_coat, c.x, i.x), i.y = hn::IfThenElse(in_coat, c.y, i.y), i.z = hn::IfThenElse(in_coat, c.z, i.z);
       refused = hn::AndNot(in_coat, refused);
     }
-    // Cosine sampling otherwise, by the concentric map of the disc (ShadingModel::sample_direction).
-    // Skipped where no lane draws it (with 8 lanes, a quarter of the vectors).
+    // Cosine sampling otherwise (ShadingModel::sample_direction), by the same warp as the body's; skipped
+    // where no lane draws it.
     const auto cosine = u3 >= lobe_weight;
-    if (!hn::AllFalse(d, cosine)) {
-      const VT a = two * u1 - one, b = two * u2 - one;
-      const auto a_wins = hn::Abs(a) > hn::Abs(b), centre = hn::And(a == zero, b == zero);
-      const VT r = hn::IfThenElseZero(hn::Not(centre), hn::IfThenElse(a_wins, a, b));
-      // b / a where |a| wins, else a / b; guarded, for the lanes that use neither.
-      const VT num = hn::IfThenElse(a_wins, b, a), den = hn::IfThenElse(a_wins, a, b);
-      const VT ratio = divide(d, num, hn::IfThenElse(den == zero, one, den));
-      const VT disc_phi = hn::IfThenElseZero(hn::Not(centre), hn::IfThenElse(a_wins, quarter_pi * ratio, half_pi - quarter_pi * ratio));
-      const CosSinOf<VT> disc = cos_sin(d, disc_phi);
-      const VT x = r * disc.c, y = r * disc.s;
-      i.x = hn::IfThenElse(cosine, x, i.x), i.y = hn::IfThenElse(cosine, y, i.y);
-      i.z = hn::IfThenElse(cosine, hn::Sqrt(hn::Max(zero, one - x * x - y * y)), i.z);
+    if (cosine_part && !hn::AllFalse(d, cosine)) {
+      VT x, y, z;
+      warps::cosine_hemisphere(LaneOps<DT>{d}, u1, cos_phi, sin_phi, x, y, z);
+      i.x = hn::IfThenElse(cosine, x, i.x), i.y = hn::IfThenElse(cosine, y, i.y), i.z = hn::IfThenElse(cosine, z, i.z);
       refused = hn::AndNot(cosine, refused);
     }
     // The proposal's parts refuse i below the horizon; the cosine's i.z >= 0 stands.

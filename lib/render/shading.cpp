@@ -91,20 +91,7 @@ std::optional<ShadingModel::Sample> ShadingModel::sample(const Vec3& o, double u
 std::optional<Vec3> ShadingModel::sample_direction(const Vec3& o, double u1, double u2, double u3) const {
   if (!above_horizon(o)) return std::nullopt;
   if (u3 < lobe_weight_) return proposal_->sample_direction(o, u1, u2);
-  // cosine-weighted hemisphere (concentric disc)
-  const double a = 2.0 * u1 - 1.0, b = 2.0 * u2 - 1.0;
-  double r = 0.0, phi = 0.0;
-  if (a != 0.0 || b != 0.0) {
-    if (std::abs(a) > std::abs(b)) {
-      r = a;
-      phi = 0.25 * kPi * (b / a);
-    } else {
-      r = b;
-      phi = 0.5 * kPi - 0.25 * kPi * (a / b);
-    }
-  }
-  const double x = r * std::cos(phi), y = r * std::sin(phi);
-  return Vec3(x, y, std::sqrt(std::max(0.0, 1.0 - x * x - y * y)));
+  return cosine_direction(u1, u2);  // the cosine part, whose density mixture() adds
 }
 
 }  // namespace facetfit
