@@ -10,8 +10,13 @@
 
 #include "core/vec.h"
 #include "model/ndf.h"
+#include "model/scalar_ops.h"
 
 namespace facetfit {
+
+namespace ggx {
+#include "model/ggx_visible-inl.h"
+}  // namespace ggx
 
 // The reflected direction of a visible normal of GGX (alpha_x, alpha_y along the frame's axes) seen from o,
 // from the point (r cos phi, r sin phi) of the unit disk that ggx_visible_direction's two numbers map to
@@ -19,14 +24,8 @@ namespace facetfit {
 inline std::optional<Vec3> ggx_visible_direction_of_disk(const Vec3& o, double alpha_x, double alpha_y, double r, double cos_phi,
                                                          double sin_phi) {
   if (o.z <= 0.0) return std::nullopt;
-  const Vec3 v = glm::normalize(Vec3(alpha_x * o.x, alpha_y * o.y, o.z));  // to the unit-roughness frame
-  const double len2 = v.x * v.x + v.y * v.y;
-  const Vec3 t1 = len2 > 0.0 ? Vec3(-v.y, v.x, 0.0) / std::sqrt(len2) : Vec3(1.0, 0.0, 0.0);
-  const Vec3 t2 = glm::cross(v, t1);
-  const double p1 = r * cos_phi, s = 0.5 * (1.0 + v.z);
-  const double p2 = (1.0 - s) * std::sqrt(std::max(0.0, 1.0 - p1 * p1)) + s * r * sin_phi;
-  const Vec3 n = p1 * t1 + p2 * t2 + std::sqrt(std::max(0.0, 1.0 - p1 * p1 - p2 * p2)) * v;
-  const Vec3 h = glm::normalize(Vec3(alpha_x * n.x, alpha_y * n.y, std::max(0.0, n.z)));
+  Vec3 h;
+  ggx::visible_normal(ScalarOps{}, o.x, o.y, o.z, alpha_x, alpha_y, r, cos_phi, sin_phi, h.x, h.y, h.z);
   const Vec3 i = reflect_about(o, h);
   if (i.z <= 0.0) return std::nullopt;
   return i;

@@ -14,10 +14,15 @@ struct ScalarOps {
   static double sqrt(double x) { return std::sqrt(x); }
   static double inverse_sqrt(double x) { return 1.0 / std::sqrt(x); }
   static double constant(double c) { return c; }
+  static double negate(double x) { return -x; }
   static double min(double a, double b) { return std::min(a, b); }
   static double max(double a, double b) { return std::max(a, b); }
   // v where x > 0, else 0.
   static double where_positive(double x, double v) { return x > 0.0 ? v : 0.0; }
+  // a / sqrt(b) (the lanes multiply by an inverse square root).
+  static double divide_by_sqrt(double a, double b) { return a / std::sqrt(b); }
+  // a where x > 0, else b.
+  static double select_positive(double x, double a, double b) { return x > 0.0 ? a : b; }
   // x where x > 0, else `otherwise`: a divisor that stays harmless in the lanes that discard the quotient.
   static double positive_or(double x, double otherwise) { return x > 0.0 ? x : otherwise; }
 };

@@ -251,6 +251,7 @@ HWY_INLINE CosSinOf<VT> cos_sin_turn(DT d, VT u) {
 // this target.
 namespace ggx {
 #include "model/ggx_terms-inl.h"
+#include "model/ggx_visible-inl.h"
 }  // namespace ggx
 namespace smith_formulas {
 #include "model/smith_terms-inl.h"
@@ -275,6 +276,10 @@ struct LaneOps {
   VT max(VT a, VT b) const { return hn::Max(a, b); }
   VT where_positive(VT x, VT v) const { return hn::IfThenElseZero(x > hn::Zero(d), v); }
   VT positive_or(VT x, VT otherwise) const { return hn::IfThenElse(x > hn::Zero(d), x, otherwise); }
+  VT negate(VT x) const { return hn::Neg(x); }
+  VT inverse_sqrt(VT x) const { return lanes::inverse_sqrt(d, x); }
+  VT divide_by_sqrt(VT a, VT b) const { return a * lanes::inverse_sqrt(d, b); }
+  VT select_positive(VT x, VT a, VT b) const { return hn::IfThenElse(x > hn::Zero(d), a, b); }
 };
 
 // Smith's Lambda of GGX for w above the horizon (ggx::lambda).
@@ -355,25 +360,8 @@ HWY_INLINE DirectionOf<VT> reflect(DT d, VT ox, VT oy, VT oz, VT hx, VT hy, VT h
 // and (cos, sin) of phi = 2 pi u2: i, to be refused where i.z <= 0.
 template <class DT, class VT = hn::Vec<DT>>
 HWY_INLINE DirectionOf<VT> ggx_visible_direction(DT d, VT ox, VT oy, VT oz, VT alpha, VT u1, VT cos_phi, VT sin_phi) {
-  const VT zero = hn::Zero(d), one = set(d, 1.0), half = set(d, 0.5);
-  // to the unit-roughness frame
-  VT vx = alpha * ox, vy = alpha * oy, vz = oz;
-  const VT inv_v = inverse_sqrt(d, vx * vx + vy * vy + vz * vz);
-  vx = vx * inv_v, vy = vy * inv_v, vz = vz * inv_v;
-  const VT len2 = vx * vx + vy * vy;
-  const auto tilted = len2 > zero;
-  const VT inv_len = inverse_sqrt(d, hn::IfThenElse(tilted, len2, one));
-  const VT t1x = hn::IfThenElse(tilted, hn::Neg(vy) * inv_len, one), t1y = hn::IfThenElseZero(tilted, vx * inv_len);
-  // t2 = v x t1, t1.z = 0 (written out as glm::cross does)
-  const VT t2x = vy * zero - t1y * vz, t2y = vz * t1x - zero * vx, t2z = vx * t1y - t1x * vy;
-  const VT r = hn::Sqrt(u1);
-  const VT p1 = r * cos_phi, s = half * (one + vz);
-  const VT p2 = (one - s) * hn::Sqrt(hn::Max(zero, one - p1 * p1)) + s * r * sin_phi;
-  const VT w = hn::Sqrt(hn::Max(zero, one - p1 * p1 - p2 * p2));
-  const VT nx = p1 * t1x + p2 * t2x + w * vx, ny = p1 * t1y + p2 * t2y + w * vy, nz = p1 * zero + p2 * t2z + w * vz;
-  VT hx = alpha * nx, hy = alpha * ny, hz = hn::Max(zero, nz);
-  const VT inv_h = inverse_sqrt(d, hx * hx + hy * hy + hz * hz);
-  hx = hx * inv_h, hy = hy * inv_h, hz = hz * inv_h;
+  VT hx, hy, hz;
+  ggx::visible_normal(LaneOps<DT>{d}, ox, oy, oz, alpha, alpha, hn::Sqrt(u1), cos_phi, sin_phi, hx, hy, hz);
   return reflect(d, ox, oy, oz, hx, hy, hz);
 }
 
