@@ -8,6 +8,7 @@
 #include <glm/matrix.hpp>
 
 #include "core/error.h"
+#include "fit/representations.h"
 #include "fit/roughness.h"
 #include "io/image_file.h"
 
@@ -383,6 +384,23 @@ struct StoredFit {
 constexpr StoredFit kStoredFits[] = {{"ggx", &LutMetadata::ggx, &LutMetadata::error_ggx},
                                      {"beckmann", &LutMetadata::beckmann, &LutMetadata::error_beckmann},
                                      {"lsq", &LutMetadata::lsq, &LutMetadata::error_lsq}};
+
+constexpr bool same_name(const char* a, const char* b) {
+  while (*a != '\0' && *a == *b) ++a, ++b;
+  return *a == *b;
+}
+// Every parametric representation (fit/representations.h) has its place in the metadata: a new row without
+// one is a compile error here, not a null fit in `info`.
+constexpr bool every_parametric_stored() {
+  for (const RepresentationRow& r : kRepresentations) {
+    if (r.parametric == nullptr) continue;
+    bool stored = false;
+    for (const StoredFit& s : kStoredFits) stored = stored || same_name(r.name, s.name);
+    if (!stored) return false;
+  }
+  return true;
+}
+static_assert(every_parametric_stored(), "a parametric representation of kRepresentations has no kStoredFits entry");
 
 }  // namespace
 

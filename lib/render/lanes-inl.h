@@ -383,8 +383,9 @@ constexpr double kBelowOne = kSingle<DT> ? 1.0 - 0x1.0p-24 : 1.0 - 1e-16;
 // (ShadingModel::sample_direction). `lobe(ox, oy, oz, u1, u2, cos_phi, sin_phi)` draws the lobe's
 // direction (to be refused where i.z <= 0) with u1 rescaled to the lobe's part and (cos, sin) of
 // phi = 2 pi u2 (where `lobe_turns`; zeros otherwise: the series costs as much as a tabulated lobe's
-// cell draw, and only GGX lobes, the body and the coat read it); it runs on every lane, the lanes that
-// pick another part discard it.
+// cell draw, and only GGX lobes, the body, the coat and the cosine part read it; the cosine part turns its own
+// where nothing else did and a lane draws it); it runs on every lane, the lanes that pick another part
+// discard it.
 template <class DT, class Lobe>
 void sample_proposal(DT d, const ProposalWeights& weights, const Coat& coat, SampleBatch& batch, bool lobe_turns, const Lobe& lobe) {
   using VT = hn::Vec<DT>;
@@ -396,7 +397,7 @@ void sample_proposal(DT d, const ProposalWeights& weights, const Coat& coat, Sam
   const VT per_lobe = set(d, 1.0 / weights.part_lobe), per_body = set(d, 1.0 / weights.part_body);
   const VT per_coat = set(d, 1.0 / weights.part_coat);
   const bool with_coat = coat.present(), body = weights.part_body > 0.0, cosine_part = weights.lobe_weight < 1.0;
-  const bool turns = lobe_turns || with_coat || body || cosine_part;
+  const bool turns = lobe_turns || with_coat || body;
   for (std::size_t k = 0; k < n; k += hn::Lanes(d)) {
     const VT ox = load(d, batch.ox.data() + k), oy = load(d, batch.oy.data() + k), oz = load(d, batch.oz.data() + k);
     const VT u1 = load(d, batch.u1.data() + k), u2 = load(d, batch.u2.data() + k), u3 = load(d, batch.u3.data() + k);
@@ -425,13 +426,14 @@ void sample_proposal(DT d, const ProposalWeights& weights, const Coat& coat, Sam
     // where no lane draws it.
     const auto cosine = u3 >= lobe_weight;
     if (cosine_part && !hn::AllFalse(d, cosine)) {
+      const CosSinOf<VT> t = turns ? turn : cos_sin_turn(d, u2);
       VT x, y, z;
-      warps::cosine_hemisphere(LaneOps<DT>{d}, u1, cos_phi, sin_phi, x, y, z);
+      warps::cosine_hemisphere(LaneOps<DT>{d}, u1, t.c, t.s, x, y, z);
       i.x = hn::IfThenElse(cosine, x, i.x), i.y = hn::IfThenElse(cosine, y, i.y), i.z = hn::IfThenElse(cosine, z, i.z);
       refused = hn::AndNot(cosine, refused);
     }
-    // The proposal's parts refuse i below the horizon; the cosine's i.z >= 0 stands.
-    const auto found = hn::AndNot(refused, hn::And(oz > zero, hn::Or(cosine, i.z > zero)));
+    // Every part refuses i on or below the horizon (cosine_direction too, at u1 = 1 in DT's precision).
+    const auto found = hn::AndNot(refused, hn::And(oz > zero, i.z > zero));
     store(d, i.x, batch.ix.data() + k), store(d, i.y, batch.iy.data() + k), store(d, i.z, batch.iz.data() + k);
     store(d, hn::IfThenElseZero(found, one), batch.found.data() + k);
   }

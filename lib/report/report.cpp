@@ -493,8 +493,8 @@ json report_head(const ReportOptions& o) {
 
 // One material's renders: the measurement and each representation of its LUT, their pictures, Delta E and
 // heat maps, and the paper's figures, into `images`; the entry's figures added to `entry`.
-void render_material(const ReportOptions& o, const std::string& source, const std::string& lut, const fs::path& images,
-                     const std::string& key, json& entry) {
+void render_material(const ReportOptions& o, const DisplayTransform& display, const std::string& source, const std::string& lut,
+                     const fs::path& images, const std::string& key, json& entry) {
   const auto render_as = [&](const std::string& type, const std::string& file) {
     MaterialDesc m;
     m.type = type;
@@ -504,7 +504,6 @@ void render_material(const ReportOptions& o, const std::string& source, const st
     settings.max_memory = o.max_memory;
     return render(report_scene(m, o), settings);
   };
-  const DisplayTransform display;
   const DisplayTransform& pictures = o.pictures ? *o.pictures : display;
   std::vector<std::string> written;  // the entry's files, for its stamp
   const auto image = [&](const std::string& file) { return (images / written.emplace_back(file)).string(); };
@@ -534,8 +533,8 @@ enum class MaterialRun { rendered, reused };
 
 // One material of the report: baked (or found baked), then its previous entry reused where its key (the bake,
 // the render settings and facetfit) is unchanged and its images complete, else rendered again.
-MaterialRun report_material(const ReportOptions& o, const std::string& source, const fs::path& luts, const Fitter& fitter,
-                            const std::map<std::string, json>& reusable, json& report) {
+MaterialRun report_material(const ReportOptions& o, const DisplayTransform& display, const std::string& source, const fs::path& luts,
+                            const Fitter& fitter, const std::map<std::string, json>& reusable, json& report) {
   const std::string name = source_name(source);
   const fs::path images = fs::path(o.out_dir) / "images" / name;
   const auto bake_start = std::chrono::steady_clock::now();
@@ -561,7 +560,7 @@ MaterialRun report_material(const ReportOptions& o, const std::string& source, c
   entry["representation"] = baked.record["representation"];
   entry["warnings"] = baked.record.value("warnings", json::array());
   entry["seconds"]["bake"] = bake_seconds;
-  render_material(o, source, (luts / (name + ".exr")).string(), images, key, entry);
+  render_material(o, display, source, (luts / (name + ".exr")).string(), images, key, entry);
   report["materials"].push_back(entry);
   return MaterialRun::rendered;
 }
@@ -593,13 +592,14 @@ json run_report(const ReportOptions& o) {
 
   json report = report_head(o);
   const Fitter fitter(o.bake.fit);
+  const DisplayTransform display;  // the sRGB display, through which Delta E is measured
   std::size_t done = 0;
   for (const std::string& source : mine) {
     const std::string name = source_name(source);
     std::string what;
     try {
       if (owner.at(name) != source) fail(source, "output name " + name + " is already taken by " + owner.at(name));
-      what = report_material(o, source, luts, fitter, reusable, report) == MaterialRun::reused ? "reused" : "rendered";
+      what = report_material(o, display, source, luts, fitter, reusable, report) == MaterialRun::reused ? "reused" : "rendered";
     } catch (const Error& e) {
       report["failures"].push_back({{"source", source}, {"error", e.what()}});
       what = "failed";
