@@ -4,6 +4,7 @@
 #include <limits>
 #include <map>
 #include <sstream>
+#include <string_view>
 
 #include <glm/matrix.hpp>
 
@@ -385,17 +386,13 @@ constexpr StoredFit kStoredFits[] = {{"ggx", &LutMetadata::ggx, &LutMetadata::er
                                      {"beckmann", &LutMetadata::beckmann, &LutMetadata::error_beckmann},
                                      {"lsq", &LutMetadata::lsq, &LutMetadata::error_lsq}};
 
-constexpr bool same_name(const char* a, const char* b) {
-  while (*a != '\0' && *a == *b) ++a, ++b;
-  return *a == *b;
-}
 // Every parametric representation (fit/representations.h) has its place in the metadata: a new row without
 // one is a compile error here, not a null fit in `info`.
 constexpr bool every_parametric_stored() {
   for (const RepresentationRow& r : kRepresentations) {
     if (r.parametric == nullptr) continue;
     bool stored = false;
-    for (const StoredFit& s : kStoredFits) stored = stored || same_name(r.name, s.name);
+    for (const StoredFit& s : kStoredFits) stored = stored || std::string_view(r.name) == s.name;
     if (!stored) return false;
   }
   return true;

@@ -52,16 +52,15 @@ std::string line_chart_svg(const std::string& title, const std::string& x_label,
   return svg.str();
 }
 
-std::vector<PlotSeries> incidence_plane(double theta_i_degrees, const std::vector<std::pair<std::string, const Brdf*>>& brdfs) {
-  static const char* kColours[] = {"black", "#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b"};
+std::vector<PlotSeries> incidence_plane(double theta_i_degrees, const std::vector<PlotBrdf>& brdfs) {
   const Vec3 i = spherical_direction(theta_i_degrees * kPi / 180.0, kPi);
   std::vector<PlotSeries> out;
   for (std::size_t k = 0; k < brdfs.size(); ++k) {
-    PlotSeries s{brdfs[k].first, kColours[k % std::size(kColours)], {}, k > 0};
+    PlotSeries s{brdfs[k].label, brdfs[k].colour, {}, k > 0};
     for (int d = -89; d <= 89; ++d) {
       // theta_o > 0: the mirror side (phi = 0); < 0: the side of i (phi = pi).
       const Vec3 o = spherical_direction(std::abs(d) * kPi / 180.0, d >= 0 ? 0.0 : kPi);
-      const auto f = brdfs[k].second->eval(o, i);
+      const auto f = brdfs[k].brdf->eval(o, i);
       s.points.emplace_back(d, f ? std::cbrt(std::max(0.0, luminance(*f) * o.z)) : std::nan(""));
     }
     out.push_back(std::move(s));
@@ -76,8 +75,7 @@ std::vector<std::pair<std::string, std::string>> material_figures(const Brdf& me
   const ClosureBrdf closures(lut.closures());
   std::vector<ParametricBrdf> fits;
   fits.reserve(std::size(kRepresentations));  // the pointers into it below stay valid
-  std::vector<std::pair<std::string, const Brdf*>> brdfs{{"measured", &measured}};
-  std::vector<std::string> colours{"black"};
+  std::vector<PlotBrdf> brdfs{{"measured", "black", &measured}};
   for (const RepresentationRow& r : kRepresentations) {
     const std::string name = r.name;
     const Brdf* brdf = name == "tabulated" ? &tabulated : name == "closures" ? static_cast<const Brdf*>(&closures) : nullptr;
@@ -87,15 +85,12 @@ std::vector<std::pair<std::string, std::string>> material_figures(const Brdf& me
       brdf = &fits.emplace_back(*p);
     }
     if (!brdf) throw Error("material_figures: no BRDF for the representation " + name + " (report/plots.cpp)");
-    brdfs.emplace_back(r.name, brdf);
-    colours.emplace_back(r.colour);
+    brdfs.push_back({r.name, r.colour, brdf});
   }
   std::vector<std::pair<std::string, std::string>> out;
   for (const double theta_i : {0.0, 30.0, 60.0}) {
-    std::vector<PlotSeries> series = incidence_plane(theta_i, brdfs);
-    for (std::size_t k = 0; k < series.size(); ++k) series[k].colour = colours[k];
     out.emplace_back("lobes_" + std::to_string(int(theta_i)) + ".svg", line_chart_svg("incidence plane, theta_i " + std::to_string(int(theta_i)) + " deg", "theta_o (deg)",
-                          "cbrt(f cos)", series));
+                          "cbrt(f cos)", incidence_plane(theta_i, brdfs)));
   }
   // NDF: the tabulated one and the analytic D of the parametric fits.
   const auto colour = [](const char* name) { return find_representation(name)->colour; };
